@@ -1,0 +1,49 @@
+#include "pipeline/cli.h"
+
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
+#include <memory>
+
+namespace drift::pipeline {
+
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name,
+                         const std::string& description, std::function<void()> run) {
+  CLI::App* sub = parent.add_subcommand(name, description);
+  auto threads = std::make_shared<int>(0);
+  sub->add_option("--threads", *threads,
+                  "worker threads (0 = all cores); results do not depend on it")
+      ->check(CLI::Range(0, 4096));
+  sub->callback([threads, run = std::move(run)] {
+    std::unique_ptr<tbb::global_control> limit;
+    if (*threads > 0) {
+      limit = std::make_unique<tbb::global_control>(
+          tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(*threads));
+    }
+    run();
+  });
+  return sub;
+}
+
+CLI::App& command_group(CLI::App& root, const std::string& name, const std::string& description) {
+  for (CLI::App* existing : root.get_subcommands({})) {
+    if (existing->get_name() == name) return *existing;
+  }
+  CLI::App* group = root.add_subcommand(name, description);
+  group->require_subcommand(1);
+  return *group;
+}
+
+void add_seed_option(CLI::App& sub, unsigned long long& seed) {
+  sub.add_option("--seed", seed, "random seed; the same seed gives the same bits")
+      ->capture_default_str();
+}
+
+void usage_error(const std::string& message) { throw CLI::ValidationError(message); }
+
+std::vector<CommandRegistration>& command_registry() {
+  static std::vector<CommandRegistration> registry;
+  return registry;
+}
+
+}  // namespace drift::pipeline

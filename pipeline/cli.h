@@ -1,0 +1,56 @@
+// The shape every subcommand shares: options parsed by CLI11, one action run
+// after a successful parse, and the options every subcommand takes (--threads).
+//
+// Each subcommand lives in its own file, pipeline/cmd_<name>.cpp, which defines
+// `void add_<name>_command(CLI::App&)` and registers it with DRIFT_COMMAND; the
+// build picks up every cmd_*.cpp, so adding a subcommand touches no other file.
+// The action only calls library code and reports. Library errors are
+// drift::Error (exit 1); CLI11 parse errors and usage_error() exit 2.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace drift::pipeline {
+
+// Adds subcommand `name` to `parent` with --threads N, and arranges for `run` to be
+// called (with TBB limited to N threads when N > 0) once its options are parsed.
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name,
+                         const std::string& description, std::function<void()> run);
+
+// A group of subcommands such as `drift snow cover` / `drift snow fall`: returns
+// the group `name` under `root`, creating it on first use.
+CLI::App& command_group(CLI::App& root, const std::string& name, const std::string& description);
+
+// Adds the standard --seed option (a 64-bit unsigned seed).
+void add_seed_option(CLI::App& sub, unsigned long long& seed);
+
+// Throws a usage error (exit 2) with `message`, e.g. for incompatible options.
+[[noreturn]] void usage_error(const std::string& message);
+
+// --- registry --------------------------------------------------------------
+using CommandAdder = void (*)(CLI::App& root);
+
+struct CommandRegistration {
+  int order;  // position in `drift --help`
+  CommandAdder add;
+};
+
+std::vector<CommandRegistration>& command_registry();
+
+struct RegisterCommand {
+  RegisterCommand(int order, CommandAdder add) { command_registry().push_back({order, add}); }
+};
+
+}  // namespace drift::pipeline
+
+// Registers a subcommand adder at static-initialisation time. `order` sorts the
+// help listing: 10 import, 20 info, 30 dunes, 40 snow, 50 marks, 60 soil,
+// 70 render, 80 merge, 90 compare, 100 sheet.
+#define DRIFT_COMMAND(order, adder) \
+  static const ::drift::pipeline::RegisterCommand drift_register_##adder{order, adder}

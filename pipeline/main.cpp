@@ -1,0 +1,48 @@
+// drift: the Driftscape command line. Parses, runs one subcommand, and turns
+// failures into "drift: error: ..." with exit status 1 (2 for usage errors).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include <algorithm>
+
+#include "pipeline/cli.h"
+#include "terrain/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Driftscape: natural ground from real elevation data, rendered.", "drift"};
+  app.set_version_flag("--version", "drift 0.1.0");
+  app.require_subcommand(1);
+  app.fallthrough(false);
+
+  auto registry = drift::pipeline::command_registry();
+  std::stable_sort(registry.begin(), registry.end(),
+                   [](const auto& a, const auto& b) { return a.order < b.order; });
+  for (const auto& command : registry) command.add(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "drift: usage error: %s\nRun with --help for the options.\n", e.what());
+    return 2;
+  } catch (const drift::Cancelled&) {
+    std::fprintf(stderr, "drift: cancelled; no output written\n");
+    return 1;
+  } catch (const drift::Error& e) {
+    std::fprintf(stderr, "drift: error: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "drift: error: out of memory; use a smaller input or size\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drift: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

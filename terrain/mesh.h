@@ -1,0 +1,23 @@
+// A triangle mesh: the plain data type for objects (rocks, trees, huts, feet,
+// wheels) and for surfaces the stages produce (snowy meshes, soil surfaces).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <vector>
+
+namespace drift::terrain {
+
+struct Mesh {
+  std::vector<Eigen::Vector3f> positions;            // metres, x east, y north, z up
+  std::vector<std::array<int, 3>> triangles;         // counter-clockwise seen from outside
+  std::vector<Eigen::Vector3f> normals;              // per vertex, optional (empty or = positions)
+  // Named per-vertex scalar attributes (e.g. "snow_depth", "snow_coverage").
+  std::vector<std::pair<std::string, std::vector<float>>> vertex_attributes;
+
+  std::size_t vertex_count() const { return positions.size(); }
+  std::size_t triangle_count() const { return triangles.size(); }
+};
+
+}  // namespace drift::terrain

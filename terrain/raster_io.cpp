@@ -1,0 +1,203 @@
+#include "terrain/raster_io.h"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal_priv.h>
+
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <system_error>
+
+#include "terrain/atomic_file.h"
+#include "terrain/error.h"
+#include "terrain/memory.h"
+
+namespace drift::terrain {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+thread_local std::string g_last_gdal_message;
+
+void CPL_STDCALL quiet_gdal_handler(CPLErr level, CPLErrorNum, const char* msg) {
+  if (level >= CE_Warning && msg) g_last_gdal_message = msg;
+}
+
+struct DatasetCloser {
+  void operator()(GDALDataset* ds) const {
+    if (ds) GDALClose(GDALDataset::ToHandle(ds));
+  }
+};
+using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
+
+DatasetPtr open_raster(const fs::path& path) {
+  ensure_gdal();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) {
+    throw Error("cannot read '" + path.string() + "': no such file");
+  }
+  if (fs::is_directory(path, ec)) {
+    throw Error("cannot read '" + path.string() + "': it is a directory, not a raster file");
+  }
+  g_last_gdal_message.clear();
+  auto* ds = static_cast<GDALDataset*>(
+      GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
+  if (!ds) {
+    std::string why = g_last_gdal_message.empty() ? "not a raster format GDAL can read"
+                                                  : g_last_gdal_message;
+    throw Error("cannot read '" + path.string() + "' as a raster: " + why +
+                " (check the file is a DEM such as GeoTIFF, .hgt, DTED or ASCII grid)");
+  }
+  if (ds->GetRasterCount() < 1 || ds->GetRasterXSize() < 1 || ds->GetRasterYSize() < 1) {
+    GDALClose(GDALDataset::ToHandle(ds));
+    throw Error("cannot read '" + path.string() + "': it holds no raster band");
+  }
+  return DatasetPtr(ds);
+}
+
+GeoReference georeference_of(GDALDataset& ds, GDALRasterBand& band) {
+  GeoReference geo;
+  double gt[6];
+  if (ds.GetGeoTransform(gt) == CE_None) {
+    std::copy(gt, gt + 6, geo.geotransform.begin());
+  }
+  if (const OGRSpatialReference* srs = ds.GetSpatialRef()) {
+    char* wkt = nullptr;
+    const char* opts[] = {"FORMAT=WKT2_2018", nullptr};
+    if (srs->exportToWkt(&wkt, opts) == OGRERR_NONE && wkt) geo.crs_wkt = wkt;
+    CPLFree(wkt);
+  }
+  int has_nodata = 0;
+  const double nd = band.GetNoDataValue(&has_nodata);
+  if (has_nodata) geo.nodata = nd;
+  return geo;
+}
+
+}  // namespace
+
+void ensure_gdal() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    GDALAllRegister();
+    CPLSetErrorHandler(quiet_gdal_handler);
+  });
+}
+
+std::string last_gdal_message() { return g_last_gdal_message; }
+
+RasterHeader read_raster_header(const fs::path& path) {
+  DatasetPtr ds = open_raster(path);
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  RasterHeader h;
+  h.width = ds->GetRasterXSize();
+  h.height = ds->GetRasterYSize();
+  h.bands = ds->GetRasterCount();
+  h.driver = ds->GetDriver() ? ds->GetDriver()->GetDescription() : "";
+  h.data_type = GDALGetDataTypeName(band->GetRasterDataType());
+  h.geo = georeference_of(*ds, *band);
+  return h;
+}
+
+HeightField read_raster(const fs::path& path, const ReadOptions& options) {
+  DatasetPtr ds = open_raster(path);
+  if (options.band < 1 || options.band > ds->GetRasterCount()) {
+    throw Error("cannot read band " + std::to_string(options.band) + " of '" + path.string() +
+                "': it has " + std::to_string(ds->GetRasterCount()) + " band(s)");
+  }
+  GDALRasterBand* band = ds->GetRasterBand(options.band);
+  RasterWindow win{0, 0, ds->GetRasterXSize(), ds->GetRasterYSize()};
+  if (options.window) {
+    win = *options.window;
+    if (win.width < 1 || win.height < 1 || win.x_off < 0 || win.y_off < 0 ||
+        win.x_off + win.width > ds->GetRasterXSize() ||
+        win.y_off + win.height > ds->GetRasterYSize()) {
+      throw Error("window " + std::to_string(win.width) + "x" + std::to_string(win.height) +
+                  "+" + std::to_string(win.x_off) + "+" + std::to_string(win.y_off) +
+                  " lies outside '" + path.string() + "' (" +
+                  std::to_string(ds->GetRasterXSize()) + "x" +
+                  std::to_string(ds->GetRasterYSize()) + ")");
+    }
+  }
+  const std::uint64_t bytes = static_cast<std::uint64_t>(win.width) * win.height * sizeof(float);
+  require_memory(bytes,
+                 "raster '" + path.string() + "' (" + std::to_string(win.width) + " x " +
+                     std::to_string(win.height) + " cells as float32)",
+                 "crop it (drift import --crop) or resample it to a coarser cell size first");
+
+  GeoReference geo = georeference_of(*ds, *band);
+  // Shift the geotransform to the window's origin.
+  auto& gt = geo.geotransform;
+  gt[0] += win.x_off * gt[1] + win.y_off * gt[2];
+  gt[3] += win.x_off * gt[4] + win.y_off * gt[5];
+
+  HeightField grid(win.width, win.height, 0.0f, geo);
+  g_last_gdal_message.clear();
+  const CPLErr err = band->RasterIO(GF_Read, win.x_off, win.y_off, win.width, win.height,
+                                    grid.data(), win.width, win.height, GDT_Float32, 0, 0,
+                                    nullptr);
+  if (err != CE_None) {
+    throw Error("cannot read the cells of '" + path.string() + "': " +
+                (g_last_gdal_message.empty() ? std::string("read failed")
+                                             : g_last_gdal_message) +
+                " (the file may be truncated or corrupt)");
+  }
+  // Invalid cells become NaN in memory, whatever the file called them.
+  if (geo.nodata) {
+    const float nd = static_cast<float>(*geo.nodata);
+    for (float& v : grid.values()) {
+      if (v == nd) v = std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  return grid;
+}
+
+void write_geotiff(const HeightField& grid, const fs::path& path, const WriteOptions& options) {
+  ensure_gdal();
+  if (grid.empty()) throw Error("cannot write '" + path.string() + "': the raster is empty");
+  AtomicFile out(path);
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  if (!driver) throw Error("GDAL has no GTiff driver; reinstall libgdal");
+
+  CPLStringList co;
+  co.SetNameValue("COMPRESS", "DEFLATE");
+  co.SetNameValue("PREDICTOR", "3");  // floating-point predictor: 2-3x smaller DEMs
+  co.SetNameValue("BIGTIFF", "IF_SAFER");
+  if (grid.width() >= 512 && grid.height() >= 512) {
+    co.SetNameValue("TILED", "YES");
+  }
+  g_last_gdal_message.clear();
+  DatasetPtr ds(driver->Create(out.temp_path().c_str(), grid.width(), grid.height(), 1,
+                               GDT_Float32, co.List()));
+  if (!ds) {
+    throw Error("cannot create '" + path.string() + "': " + last_gdal_message());
+  }
+  const GeoReference& geo = grid.geo();
+  double gt[6];
+  std::copy(geo.geotransform.begin(), geo.geotransform.end(), gt);
+  ds->SetGeoTransform(gt);
+  if (!geo.crs_wkt.empty()) {
+    OGRSpatialReference srs;
+    if (srs.importFromWkt(geo.crs_wkt.c_str()) == OGRERR_NONE) ds->SetSpatialRef(&srs);
+  }
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  band->SetNoDataValue(std::numeric_limits<double>::quiet_NaN());
+  if (!options.description.empty()) band->SetDescription(options.description.c_str());
+  if (!options.units.empty()) band->SetUnitType(options.units.c_str());
+  CPLErr err = band->RasterIO(GF_Write, 0, 0, grid.width(), grid.height(),
+                              const_cast<float*>(grid.data()), grid.width(), grid.height(),
+                              GDT_Float32, 0, 0, nullptr);
+  // Closing flushes: a failed close is a failed write.
+  // GDAL 3.6's GDALClose returns nothing: watch the error state across it.
+  CPLErrorReset();
+  GDALClose(GDALDataset::ToHandle(ds.release()));
+  if (CPLGetLastErrorType() == CE_Failure) err = CE_Failure;
+  if (err != CE_None) {
+    throw Error("cannot write '" + path.string() + "': " + last_gdal_message() +
+                " (disk full or not writable?)");
+  }
+  out.commit();
+}
+
+}  // namespace drift::terrain

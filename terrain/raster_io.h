@@ -1,0 +1,57 @@
+// Reading any raster GDAL reads into a Grid<float>, and writing float32
+// compressed GeoTIFFs that keep the georeference.
+//
+// In memory, invalid cells are NaN whatever nodata value the file declared;
+// GeoReference::nodata keeps the declared value for information.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "terrain/grid.h"
+
+namespace drift::terrain {
+
+// Registers GDAL's drivers once and routes GDAL's messages into our errors
+// instead of stderr. Safe to call many times from any thread.
+void ensure_gdal();
+
+// The last message GDAL reported on this thread (empty if none).
+std::string last_gdal_message();
+
+struct RasterWindow {
+  int x_off = 0, y_off = 0, width = 0, height = 0;  // pixels of the source
+};
+
+struct ReadOptions {
+  int band = 1;                        // 1-based, as in GDAL
+  std::optional<RasterWindow> window;  // read a part only (crop at read time)
+};
+
+// Header facts, read without loading the cells.
+struct RasterHeader {
+  int width = 0, height = 0, bands = 0;
+  std::string driver;  // GDAL short name, e.g. "GTiff", "SRTMHGT"
+  std::string data_type;
+  GeoReference geo;
+};
+
+RasterHeader read_raster_header(const std::filesystem::path& path);
+
+// Throws drift::Error naming the file for: a missing file, a file GDAL cannot
+// read as a raster, a band that does not exist, a read failure (truncated or
+// corrupt data), or a raster larger than the memory available.
+HeightField read_raster(const std::filesystem::path& path, const ReadOptions& options = {});
+
+struct WriteOptions {
+  std::string description;  // stored as the band description (e.g. "snow depth (m)")
+  std::string units;        // band unit type, e.g. "m"
+};
+
+// Float32 GeoTIFF, DEFLATE with the floating-point predictor, tiled when large,
+// georeference and CRS kept, NaN declared as nodata. Written atomically.
+void write_geotiff(const HeightField& grid, const std::filesystem::path& path,
+                   const WriteOptions& options = {});
+
+}  // namespace drift::terrain
