@@ -11,6 +11,7 @@ packages=(
   libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev libtinyobjloader-dev
+  fonts-dejavu-core
 )
 
 missing=()

@@ -1,0 +1,191 @@
+// Image files through OpenImageIO 2.4. EXR keeps linear float channels as
+// stored; 8/16-bit formats are display-referred sRGB and are decoded to linear
+// on read and encoded (after the DisplayTransform) on write. Every output goes
+// through drift::AtomicFile: a failed write leaves no file behind.
+#include "render/image_io.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+
+#include "terrain/atomic_file.h"
+#include "terrain/error.h"
+
+namespace drift::render {
+
+namespace {
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+std::string oiio_message(const std::string& detail) {
+  return detail.empty() ? std::string("unknown OpenImageIO error") : detail;
+}
+
+// Opens `path` for writing as `spec`, writes float pixels and closes; any
+// failure (including a failed close, which is where buffered formats flush)
+// throws naming the target.
+void write_with_oiio(const std::filesystem::path& target, const std::filesystem::path& temp,
+                     const OIIO::ImageSpec& spec, OIIO::TypeDesc pixel_type, const void* data) {
+  auto out = OIIO::ImageOutput::create(temp.string());
+  if (!out) {
+    throw Error("cannot write image " + target.string() + ": " + oiio_message(OIIO::geterror()));
+  }
+  if (!out->open(temp.string(), spec) || !out->write_image(pixel_type, data) || !out->close()) {
+    throw Error("cannot write image " + target.string() + ": " + oiio_message(out->geterror()) +
+                " (check the disk space and that the folder is writable)");
+  }
+}
+
+}  // namespace
+
+Image read_image(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw Error("image " + path.string() + " does not exist or is not a file; check the path");
+  }
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) {
+    throw Error("cannot read image " + path.string() + ": " + oiio_message(OIIO::geterror()) +
+                " (expected EXR, PNG, JPEG or TIFF)");
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.depth > 1) {
+    throw Error("image " + path.string() + " has an unsupported shape (" +
+                std::to_string(spec.width) + "x" + std::to_string(spec.height) + ", " +
+                std::to_string(spec.nchannels) + " channels)");
+  }
+  const int nc = spec.nchannels;
+  std::vector<float> raw(static_cast<std::size_t>(spec.width) * spec.height * nc);
+  const bool ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, raw.data());
+  const std::string read_error = ok ? std::string() : in->geterror();
+  in->close();
+  if (!ok) {
+    throw Error("cannot read the pixels of image " + path.string() + ": " +
+                oiio_message(read_error) + " (the file may be truncated or corrupt)");
+  }
+
+  const bool is_float_format = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
+                               spec.format.basetype == OIIO::TypeDesc::HALF ||
+                               spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+  const bool is_exr = lower_extension(path) == ".exr" ||
+                      std::string(in->format_name()) == "openexr";
+  if (is_exr || is_float_format) {
+    // Linear data as stored, channel names kept (EXR names AOVs "albedo.R" etc.).
+    std::vector<std::string> names;
+    for (int c = 0; c < nc; ++c) {
+      std::string name = c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c]
+                                                                        : std::string();
+      if (name.empty()) name = "channel" + std::to_string(c);
+      names.push_back(name);
+    }
+    Image image(spec.width, spec.height, names);
+    image.pixels = std::move(raw);
+    return image;
+  }
+
+  // Display-referred integer image: sRGB-decode to linear R, G, B[, A]. Grey
+  // (1 channel) and grey+alpha (2 channels) are spread over R, G, B.
+  const bool has_alpha = spec.alpha_channel >= 0 || nc == 2 || nc >= 4;
+  const int colour = nc >= 3 ? 3 : 1;
+  std::vector<std::string> names = {"R", "G", "B"};
+  if (has_alpha) names.push_back("A");
+  Image image(spec.width, spec.height, names);
+  const int alpha_src = nc == 2 ? 1 : (nc >= 4 ? 3 : -1);
+  const std::size_t n = static_cast<std::size_t>(spec.width) * spec.height;
+  for (std::size_t p = 0; p < n; ++p) {
+    const float* s = &raw[p * nc];
+    float* d = &image.pixels[p * names.size()];
+    for (int c = 0; c < 3; ++c) d[c] = srgb_decode(s[colour == 3 ? c : 0]);
+    if (has_alpha) d[3] = alpha_src >= 0 ? s[alpha_src] : 1.0f;  // alpha is linear coverage
+  }
+  return image;
+}
+
+void write_exr(const Image& image, const std::filesystem::path& path) {
+  if (lower_extension(path) != ".exr") {
+    throw Error("EXR output " + path.string() + " must end in .exr");
+  }
+  if (image.width < 1 || image.height < 1 || image.channels.empty() ||
+      image.pixels.size() != static_cast<std::size_t>(image.width) * image.height *
+                                 image.channels.size()) {
+    throw Error("cannot write " + path.string() + ": the image is empty or its pixel count does "
+                "not match its size and channels");
+  }
+  AtomicFile file(path);
+  OIIO::ImageSpec spec(image.width, image.height, image.channel_count(), OIIO::TypeDesc::FLOAT);
+  spec.channelnames = image.channels;
+  spec.alpha_channel = image.channel_index("A");
+  spec.attribute("compression", "zip");
+  write_with_oiio(path, file.temp_path(), spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
+  file.commit();
+}
+
+static std::vector<std::uint8_t> to_srgb8(const Image& linear, const DisplayTransform& display,
+                                   const std::filesystem::path& path) {
+  int r = linear.channel_index("R"), g = linear.channel_index("G"), b = linear.channel_index("B");
+  if (r < 0 || g < 0 || b < 0) {
+    if (linear.channel_count() != 1) {
+      throw Error("cannot write " + path.string() +
+                  " as PNG: the image has no R, G, B channels and more than one channel; "
+                  "write it as .exr instead");
+    }
+    r = g = b = 0;  // a single channel (depth, mask, height) shows as grey
+  }
+  const std::size_t n = static_cast<std::size_t>(linear.width) * linear.height;
+  std::vector<std::uint8_t> out(n * 3);
+  const int idx[3] = {r, g, b};
+  for (std::size_t p = 0; p < n; ++p) {
+    const float* s = &linear.pixels[p * linear.channels.size()];
+    for (int c = 0; c < 3; ++c) {
+      const float e = srgb_encode(apply_tone_curve(s[idx[c]], display));
+      // Round to nearest: deterministic, and decode->encode round trips exactly.
+      out[p * 3 + c] = static_cast<std::uint8_t>(std::lround(e * 255.0f));
+    }
+  }
+  return out;
+}
+
+void write_png(const Image& linear, const std::filesystem::path& path,
+               const DisplayTransform& display) {
+  if (lower_extension(path) != ".png") {
+    throw Error("PNG output " + path.string() + " must end in .png");
+  }
+  if (linear.width < 1 || linear.height < 1 ||
+      linear.pixels.size() != static_cast<std::size_t>(linear.width) * linear.height *
+                                  linear.channels.size()) {
+    throw Error("cannot write " + path.string() + ": the image is empty or inconsistent");
+  }
+  if (!std::isfinite(display.exposure_ev) || std::abs(display.exposure_ev) > 64.0) {
+    throw Error("exposure " + std::to_string(display.exposure_ev) + " EV for " + path.string() +
+                " is out of range; use a value in [-64, 64]");
+  }
+  const std::vector<std::uint8_t> bytes = to_srgb8(linear, display, path);
+  AtomicFile file(path);
+  OIIO::ImageSpec spec(linear.width, linear.height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("oiio:ColorSpace", "sRGB");
+  write_with_oiio(path, file.temp_path(), spec, OIIO::TypeDesc::UINT8, bytes.data());
+  file.commit();
+}
+
+void write_image(const Image& image, const std::filesystem::path& path,
+                 const DisplayTransform& display) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".exr") {
+    write_exr(image, path);
+  } else if (ext == ".png") {
+    write_png(image, path, display);
+  } else {
+    throw Error("cannot write image " + path.string() + ": unknown extension '" + ext +
+                "'; use .exr (linear float) or .png (8-bit sRGB)");
+  }
+}
+
+}  // namespace drift::render
