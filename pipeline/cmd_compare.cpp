@@ -47,13 +47,14 @@ void run_compare(const CompareCommandOptions& o) {
   }
   std::string channels;
   for (const auto& c : r.channels) channels += (channels.empty() ? "" : ",") + c;
-  std::printf("compare:   %s against reference %s (%dx%d, channels %s)\n", o.a.c_str(),
-              o.b.c_str(), a.width, a.height, channels.c_str());
+  std::printf("compare:   %s against reference %s (%dx%d, channels %s)\n", o.a.c_str(), o.b.c_str(),
+              a.width, a.height, channels.c_str());
   std::printf("rmse:      %.6g\n", r.rmse);
   std::printf("relmse:    %.6g\n", r.relmse);
   std::printf("ssim:      %.6f (dssim = 1 - ssim = %.6g)\n", r.ssim, 1.0 - r.ssim);
-  std::printf("metric:    %s error %.6g, threshold %.6g -> %s\n", render::metric_name(options.metric),
-              r.error, options.threshold, r.error <= options.threshold ? "within" : "OVER");
+  std::printf("metric:    %s error %.6g, threshold %.6g -> %s\n",
+              render::metric_name(options.metric), r.error, options.threshold,
+              r.error <= options.threshold ? "within" : "OVER");
   std::printf("pixels:    %.4f%% over per-pixel tolerance %.6g (allowed %.4g%%, max %.6g) -> %s\n",
               r.percent_over, r.pixel_threshold, options.fail_percent, r.max_pixel_error,
               r.percent_over <= options.fail_percent ? "within" : "OVER");
@@ -67,9 +68,9 @@ void run_compare(const CompareCommandOptions& o) {
 
 void add_compare_command(CLI::App& root) {
   auto o = std::make_shared<CompareCommandOptions>();
-  CLI::App* sub = add_subcommand(root, "compare",
-                                 "compare an image with a reference (exit 0 pass, 1 fail)",
-                                 [o] { run_compare(*o); });
+  CLI::App* sub =
+      add_subcommand(root, "compare", "compare an image with a reference (exit 0 pass, 1 fail)",
+                     [o] { run_compare(*o); });
   sub->add_option("image", o->a, "image to test (EXR or PNG)")->required();
   sub->add_option("reference", o->b, "reference image (EXR or PNG), same size")->required();
   sub->add_option("--metric", o->metric, "rmse | relmse | ssim (error of ssim is 1 - SSIM)")

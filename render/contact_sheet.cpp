@@ -33,9 +33,9 @@ void draw_text(Image& sheet, const std::filesystem::path& font, int x, int y,
 }  // namespace
 
 std::filesystem::path default_font() {
-  for (const char* p : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-                        "/usr/share/fonts/TTF/DejaVuSans.ttf",
-                        "/usr/share/fonts/dejavu/DejaVuSans.ttf"}) {
+  for (const char* p :
+       {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf", "/usr/share/fonts/TTF/DejaVuSans.ttf",
+        "/usr/share/fonts/dejavu/DejaVuSans.ttf"}) {
     std::error_code ec;
     if (std::filesystem::is_regular_file(p, ec)) return p;
   }
@@ -66,14 +66,15 @@ Image contact_sheet(const std::vector<Image>& images, const ContactSheetOptions&
   if ((has_labels || !o.title.empty())) {
     std::error_code ec;
     if (font.empty() || !std::filesystem::is_regular_file(font, ec)) {
-      throw Error("no font for the labels" + (o.font.empty() ? std::string() : " (" + o.font.string() + " not found)") +
+      throw Error("no font for the labels" +
+                  (o.font.empty() ? std::string() : " (" + o.font.string() + " not found)") +
                   "; install fonts-dejavu-core (scripts/install-deps.sh) or pass --font FILE.ttf");
     }
   }
   if (progress && !progress(0.0, "contact sheet")) throw Cancelled();
 
-  const int columns = o.columns > 0 ? o.columns
-                                    : static_cast<int>(std::ceil(std::sqrt(double(count))));
+  const int columns =
+      o.columns > 0 ? o.columns : static_cast<int>(std::ceil(std::sqrt(double(count))));
   const int rows = (count + columns - 1) / columns;
   int cell_w = 0, cell_h = 0;
   for (const Image& im : images) {
@@ -93,7 +94,8 @@ Image contact_sheet(const std::vector<Image>& images, const ContactSheetOptions&
   }
   Image sheet(static_cast<int>(width), static_cast<int>(height), {"R", "G", "B"}, kBackground);
 
-  if (!o.title.empty()) draw_text(sheet, font, static_cast<int>(width / 2), pad, o.title, title_size);
+  if (!o.title.empty())
+    draw_text(sheet, font, static_cast<int>(width / 2), pad, o.title, title_size);
   for (int i = 0; i < count; ++i) {
     const Image& im = images[i];
     int ir = im.channel_index("R"), ig = im.channel_index("G"), ib = im.channel_index("B");

@@ -48,8 +48,8 @@ std::vector<float> luma8(const Image& im, const std::vector<int>& idx) {
   for (std::size_t p = 0; p < n; ++p) {
     const float* s = &im.pixels[p * im.channels.size()];
     // Rec. 709 / sRGB luminance weights.
-    const float y = rgb ? 0.2126f * s[idx[0]] + 0.7152f * s[idx[1]] + 0.0722f * s[idx[2]]
-                        : s[idx[0]];
+    const float y =
+        rgb ? 0.2126f * s[idx[0]] + 0.7152f * s[idx[1]] + 0.0722f * s[idx[2]] : s[idx[0]];
     out[p] = 255.0f * srgb_encode(y);
   }
   return out;
@@ -222,7 +222,7 @@ Image difference_image(const ComparisonResult& result) {
   // Display-referred ramp stops (sRGB 0..1) at t = 0, 0.25, 0.5, 0.75, 1.
   static constexpr float stops[5][3] = {
       {0.0f, 0.0f, 0.0f}, {0.1f, 0.2f, 0.8f}, {0.8f, 0.2f, 0.7f}, {1.0f, 0.6f, 0.1f}, {1, 1, 1}};
-  const double scale = result.pixel_threshold > 0 ? 0.5 / result.pixel_threshold
+  const double scale = result.pixel_threshold > 0   ? 0.5 / result.pixel_threshold
                        : result.max_pixel_error > 0 ? 1.0 / result.max_pixel_error
                                                     : 0.0;
   for (std::size_t p = 0; p < e.pixels.size(); ++p) {

@@ -35,9 +35,9 @@ enum class CompareMetric { Rmse, RelMse, Ssim };
 
 struct ComparisonOptions {
   CompareMetric metric = CompareMetric::RelMse;
-  double threshold = 1e-2;        // maximum error of `metric` (DSSIM for ssim), >= 0
-  double pixel_threshold = -1.0;  // per-pixel tolerance, >= 0; < 0 means "same as threshold"
-  double fail_percent = 100.0;    // % of pixels allowed above pixel_threshold, [0, 100]
+  double threshold = 1e-2;            // maximum error of `metric` (DSSIM for ssim), >= 0
+  double pixel_threshold = -1.0;      // per-pixel tolerance, >= 0; < 0 means "same as threshold"
+  double fail_percent = 100.0;        // % of pixels allowed above pixel_threshold, [0, 100]
   std::vector<std::string> channels;  // empty: R,G,B if both have them, else all of A
   double relmse_epsilon = 1e-2;       // eps of relMSE, > 0
 };

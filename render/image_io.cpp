@@ -75,14 +75,14 @@ Image read_image(const std::filesystem::path& path) {
   const bool is_float_format = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
                                spec.format.basetype == OIIO::TypeDesc::HALF ||
                                spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-  const bool is_exr = lower_extension(path) == ".exr" ||
-                      std::string(in->format_name()) == "openexr";
+  const bool is_exr =
+      lower_extension(path) == ".exr" || std::string(in->format_name()) == "openexr";
   if (is_exr || is_float_format) {
     // Linear data as stored, channel names kept (EXR names AOVs "albedo.R" etc.).
     std::vector<std::string> names;
     for (int c = 0; c < nc; ++c) {
-      std::string name = c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c]
-                                                                        : std::string();
+      std::string name =
+          c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : std::string();
       if (name.empty()) name = "channel" + std::to_string(c);
       names.push_back(name);
     }
@@ -114,9 +114,10 @@ void write_exr(const Image& image, const std::filesystem::path& path) {
     throw Error("EXR output " + path.string() + " must end in .exr");
   }
   if (image.width < 1 || image.height < 1 || image.channels.empty() ||
-      image.pixels.size() != static_cast<std::size_t>(image.width) * image.height *
-                                 image.channels.size()) {
-    throw Error("cannot write " + path.string() + ": the image is empty or its pixel count does "
+      image.pixels.size() !=
+          static_cast<std::size_t>(image.width) * image.height * image.channels.size()) {
+    throw Error("cannot write " + path.string() +
+                ": the image is empty or its pixel count does "
                 "not match its size and channels");
   }
   AtomicFile file(path);
@@ -129,7 +130,7 @@ void write_exr(const Image& image, const std::filesystem::path& path) {
 }
 
 static std::vector<std::uint8_t> to_srgb8(const Image& linear, const DisplayTransform& display,
-                                   const std::filesystem::path& path) {
+                                          const std::filesystem::path& path) {
   int r = linear.channel_index("R"), g = linear.channel_index("G"), b = linear.channel_index("B");
   if (r < 0 || g < 0 || b < 0) {
     if (linear.channel_count() != 1) {
@@ -159,8 +160,8 @@ void write_png(const Image& linear, const std::filesystem::path& path,
     throw Error("PNG output " + path.string() + " must end in .png");
   }
   if (linear.width < 1 || linear.height < 1 ||
-      linear.pixels.size() != static_cast<std::size_t>(linear.width) * linear.height *
-                                  linear.channels.size()) {
+      linear.pixels.size() !=
+          static_cast<std::size_t>(linear.width) * linear.height * linear.channels.size()) {
     throw Error("cannot write " + path.string() + ": the image is empty or inconsistent");
   }
   if (!std::isfinite(display.exposure_ev) || std::abs(display.exposure_ev) > 64.0) {

@@ -77,7 +77,7 @@ TEST(Compare, ThresholdAndFailPercentLogic) {
   EXPECT_TRUE(compare_images(a, b, o).passed);  // 5% <= 5%
   o.threshold = 0.1;
   EXPECT_FALSE(compare_images(a, b, o).passed);  // rmse 0.112 > 0.1
-  o.pixel_threshold = 0.6;  // per-pixel error 0.5 now within tolerance
+  o.pixel_threshold = 0.6;                       // per-pixel error 0.5 now within tolerance
   o.threshold = 0.2;
   o.fail_percent = 0.0;
   r = compare_images(a, b, o);

@@ -43,9 +43,8 @@ TEST(ImageIo, ExrRoundTripIsBitExactWithAllChannels) {
       for (int c = 0; c < im.channel_count(); ++c) {
         const int bc = back.channel_index(im.channels[c]);
         const float va = im.at(x, y, c), vb = back.at(x, y, bc);
-        ASSERT_EQ(std::memcmp(&va, &vb, 4), 0)
-            << im.channels[c] << " at " << x << "," << y << ": " << im.at(x, y, c) << " vs "
-            << back.at(x, y, bc);
+        ASSERT_EQ(std::memcmp(&va, &vb, 4), 0) << im.channels[c] << " at " << x << "," << y << ": "
+                                               << im.at(x, y, c) << " vs " << back.at(x, y, bc);
       }
 }
 
@@ -110,8 +109,8 @@ void expect_read_error(const fs::path& p) {
 void truncate_copy(const fs::path& from, const fs::path& to, double fraction) {
   std::ifstream in(from, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), {});
-  std::ofstream(to, std::ios::binary).write(bytes.data(),
-                                            static_cast<std::streamsize>(bytes.size() * fraction));
+  std::ofstream(to, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size() * fraction));
 }
 
 TEST(ImageIo, BadFilesAreErrorsNamingTheFile) {
