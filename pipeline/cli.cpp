@@ -7,8 +7,8 @@
 
 namespace drift::pipeline {
 
-CLI::App* add_subcommand(CLI::App& parent, const std::string& name,
-                         const std::string& description, std::function<void()> run) {
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
+                         std::function<void()> run) {
   CLI::App* sub = parent.add_subcommand(name, description);
   auto threads = std::make_shared<int>(0);
   sub->add_option("--threads", *threads,
@@ -17,8 +17,8 @@ CLI::App* add_subcommand(CLI::App& parent, const std::string& name,
   sub->callback([threads, run = std::move(run)] {
     std::unique_ptr<tbb::global_control> limit;
     if (*threads > 0) {
-      limit = std::make_unique<tbb::global_control>(
-          tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(*threads));
+      limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    static_cast<std::size_t>(*threads));
     }
     run();
   });

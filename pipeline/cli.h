@@ -20,8 +20,8 @@ namespace drift::pipeline {
 
 // Adds subcommand `name` to `parent` with --threads N, and arranges for `run` to be
 // called (with TBB limited to N threads when N > 0) once its options are parsed.
-CLI::App* add_subcommand(CLI::App& parent, const std::string& name,
-                         const std::string& description, std::function<void()> run);
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
+                         std::function<void()> run);
 
 // A group of subcommands such as `drift snow cover` / `drift snow fall`: returns
 // the group `name` under `root`, creating it on first use.
@@ -53,4 +53,4 @@ struct RegisterCommand {
 // help listing: 10 import, 20 info, 30 dunes, 40 snow, 50 marks, 60 soil,
 // 70 render, 80 merge, 90 compare, 100 sheet.
 #define DRIFT_COMMAND(order, adder) \
-  static const ::drift::pipeline::RegisterCommand drift_register_##adder{order, adder}
+  static const ::drift::pipeline::RegisterCommand drift_register_##adder { order, adder }

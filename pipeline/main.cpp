@@ -1,15 +1,14 @@
 // drift: the Driftscape command line. Parses, runs one subcommand, and turns
 // failures into "drift: error: ..." with exit status 1 (2 for usage errors).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <exception>
-
-#include <algorithm>
 
 #include "pipeline/cli.h"
 #include "terrain/error.h"
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   CLI::App app{"Driftscape: natural ground from real elevation data, rendered.", "drift"};
   app.set_version_flag("--version", "drift 0.1.0");
   app.require_subcommand(1);
@@ -45,4 +44,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+} catch (const std::exception& e) {
+  // Anything escaping the handlers above (e.g. from building the command table).
+  std::fprintf(stderr, "drift: error: %s\n", e.what());
+  return 1;
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -22,11 +23,11 @@ struct BarState {
 
 std::string format_seconds(double s) {
   char buf[32];
-  const int t = static_cast<int>(s + 0.5);
+  const long t = std::lround(s);
   if (t >= 3600) {
-    std::snprintf(buf, sizeof buf, "%dh%02dm", t / 3600, (t / 60) % 60);
+    std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
   } else {
-    std::snprintf(buf, sizeof buf, "%dm%02ds", t / 60, t % 60);
+    std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
   }
   return buf;
 }
