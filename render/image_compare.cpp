@@ -59,8 +59,9 @@ std::vector<float> luma8(const Image& im, const std::vector<int>& idx) {
 // 2004, section III-C), applied separably; at the borders the weights that fall
 // inside the image are renormalised to sum to 1.
 std::vector<double> gaussian_mean(const std::vector<double>& v, int w, int h) {
-  constexpr int radius = 5;
-  std::array<double, 2 * radius + 1> k{};
+  constexpr int taps = 11;
+  constexpr int radius = taps / 2;
+  std::array<double, taps> k{};
   for (int i = -radius; i <= radius; ++i) k[i + radius] = std::exp(-(i * i) / (2.0 * 1.5 * 1.5));
   std::vector<double> tmp(v.size()), out(v.size());
   for (int y = 0; y < h; ++y) {

@@ -33,7 +33,8 @@ std::string oiio_message(const std::string& detail) {
 // failure (including a failed close, which is where buffered formats flush)
 // throws naming the target.
 void write_with_oiio(const std::filesystem::path& target, const std::filesystem::path& temp,
-                     const OIIO::ImageSpec& spec, OIIO::TypeDesc pixel_type, const void* data) {
+                     const OIIO::ImageSpec& spec, const OIIO::TypeDesc& pixel_type,
+                     const void* data) {
   auto out = OIIO::ImageOutput::create(temp.string());
   if (!out) {
     throw Error("cannot write image " + target.string() + ": " + oiio_message(OIIO::geterror()));
