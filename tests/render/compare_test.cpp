@@ -58,6 +58,30 @@ TEST(Compare, SsimDropsWithNoise) {
   EXPECT_LT(previous, 0.8);
 }
 
+TEST(Compare, SsimOfConstantImagesMatchesTheLuminanceTerm) {
+  // Constant images have zero variance, so SSIM reduces to Wang et al. 2004
+  // eq. 6: (2 mx my + C1) / (mx^2 + my^2 + C1), with C1 = (0.01 * 255)^2.
+  const int w = 23, h = 17;
+  const std::vector<float> x(w * h, 100.0f), y(w * h, 140.0f);
+  const double c1 = (0.01 * 255) * (0.01 * 255);
+  const double expected = (2 * 100.0 * 140.0 + c1) / (100.0 * 100.0 + 140.0 * 140.0 + c1);
+  std::vector<float> map;
+  const double s = ssim_index(x, y, w, h, &map);
+  EXPECT_NEAR(s, expected, 1e-9) << "ssim " << s << " vs closed form " << expected;
+  EXPECT_NEAR(map[0], expected, 1e-6);  // also at the border (renormalised window)
+}
+
+TEST(Compare, SsimIsSymmetricAndSeesContrastLoss) {
+  // SSIM is symmetric in its two images (eq. 7), and halving the contrast
+  // lowers its contrast term.
+  const Image a = picture(40, 30);
+  Image b = a;
+  for (float& v : b.pixels) v = 0.5f + 0.5f * (v - 0.5f);
+  const ComparisonResult ab = compare_images(a, b, {}), ba = compare_images(b, a, {});
+  EXPECT_NEAR(ab.ssim, ba.ssim, 1e-12);
+  EXPECT_LT(ab.ssim, 0.99);
+}
+
 TEST(Compare, ThresholdAndFailPercentLogic) {
   const Image b(10, 10, {"R", "G", "B"}, 0.5f);
   Image a = b;
