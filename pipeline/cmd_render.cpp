@@ -1,0 +1,96 @@
+// drift render SCENE.toml: path-trace a scene file into EXR and/or PNG.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <regex>
+
+#include "pipeline/cli.h"
+#include "pipeline/progress_bar.h"
+#include "pipeline/scene_file.h"
+#include "render/image_io.h"
+#include "render/renderer.h"
+#include "terrain/error.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+struct RenderOptions {
+  std::string scene;
+  int spp = 0;
+  std::string size;
+  std::vector<std::string> outputs;
+  unsigned long long seed = 0;
+  bool seed_given = false;
+};
+
+void run_render(const RenderOptions& o, const CLI::App& sub) {
+  SceneFile scene = read_scene_file(o.scene);
+  if (o.spp > 0) scene.settings.samples_per_pixel = o.spp;
+  if (!o.size.empty()) {
+    std::smatch m;
+    if (!std::regex_match(o.size, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
+      usage_error("--size '" + o.size + "' must be WIDTHxHEIGHT, e.g. 1280x720");
+    }
+    scene.settings.width = std::stoi(m[1]);
+    scene.settings.height = std::stoi(m[2]);
+    if (scene.settings.width < 1 || scene.settings.height < 1 || scene.settings.width > 16384 ||
+        scene.settings.height > 16384) {
+      usage_error("--size '" + o.size + "': each side must be 1..16384");
+    }
+  }
+  if (sub.count("--seed")) scene.settings.seed = o.seed;
+  if (!o.outputs.empty()) {
+    scene.outputs.clear();
+    for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
+  }
+  if (scene.outputs.empty()) {
+    throw Error("nothing to write: give -o NAME.png|NAME.exr or [output] files in '" + o.scene +
+                "'");
+  }
+  for (const auto& f : scene.outputs) {
+    std::string ext = f.extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".png" && ext != ".exr") {
+      throw Error("cannot write '" + f.string() + "': use a .png or .exr file name");
+    }
+  }
+  load_scene_terrain(scene);
+  const auto start = std::chrono::steady_clock::now();
+  const render::TerrainScene embree_scene(scene.input);
+  const render::Camera camera =
+      scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
+  const render::Image image = render::render_image(embree_scene, scene.input, camera,
+                                                   scene.settings, terminal_progress("render"));
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
+  std::printf("rendered %dx%d at %d spp in %.1f s -> ", scene.settings.width, scene.settings.height,
+              scene.settings.samples_per_pixel, seconds);
+  for (const auto& f : scene.outputs) std::printf("%s ", f.c_str());
+  std::printf("\n");
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& root) {
+  auto o = std::make_shared<RenderOptions>();
+  // The action needs its own App (to ask whether --seed was given), which exists
+  // only after add_subcommand returns: hand it over through a shared slot.
+  auto self = std::make_shared<CLI::App*>(nullptr);
+  CLI::App* sub = add_subcommand(root, "render", "path-trace a scene file (TOML) to EXR and/or PNG",
+                                 [o, self] { run_render(*o, **self); });
+  *self = sub;
+  sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
+  sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)")
+      ->check(CLI::Range(1, 1 << 20));
+  sub->add_option("--size", o->size, "image size WIDTHxHEIGHT (overrides the scene)");
+  sub->add_option("-o,--output", o->outputs,
+                  "output file(s), .png and/or .exr (override the scene)");
+  add_seed_option(*sub, o->seed);
+}
+
+DRIFT_COMMAND(70, add_render_command);
+
+}  // namespace drift::pipeline

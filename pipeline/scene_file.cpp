@@ -1,0 +1,279 @@
+#include "pipeline/scene_file.h"
+
+#include <ogr_spatialref.h>
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <set>
+
+#include "terrain/error.h"
+#include "terrain/mesh_io.h"
+#include "terrain/raster_io.h"
+
+namespace drift::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Reads one table's keys, remembering which were used, so that anything left
+// over is reported as unknown (like pbrt's ReportUnused).
+class Section {
+ public:
+  Section(const toml::table* table, std::string name, const fs::path& file)
+      : table_(table), name_(std::move(name)), file_(file) {}
+
+  double number(const char* key, double fallback, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return fallback;
+    std::optional<double> v = node->value<double>();
+    if (!v || node->is_boolean()) fail(key, *node, "must be a number");
+    if (!std::isfinite(*v) || *v < lo || *v > hi) {
+      fail(key, *node, "is " + fmt(*v) + "; it must lie in [" + fmt(lo) + ", " + fmt(hi) + "]");
+    }
+    return *v;
+  }
+  int integer(const char* key, int fallback, long lo, long hi) {
+    const toml::node* node = take(key);
+    if (!node) return fallback;
+    std::optional<std::int64_t> v = node->as_integer() ? node->value<std::int64_t>() : std::nullopt;
+    if (!v) fail(key, *node, "must be an integer");
+    if (*v < lo || *v > hi) {
+      fail(key, *node,
+           "is " + std::to_string(*v) + "; it must lie in [" + std::to_string(lo) + ", " +
+               std::to_string(hi) + "]");
+    }
+    return static_cast<int>(*v);
+  }
+  bool boolean(const char* key, bool fallback) {
+    const toml::node* node = take(key);
+    if (!node) return fallback;
+    if (!node->is_boolean()) fail(key, *node, "must be true or false");
+    return *node->value<bool>();
+  }
+  std::optional<std::string> string(const char* key) {
+    const toml::node* node = take(key);
+    if (!node) return std::nullopt;
+    if (!node->is_string()) fail(key, *node, "must be a string");
+    return *node->value<std::string>();
+  }
+  std::vector<std::string> strings(const char* key) {
+    const toml::node* node = take(key);
+    if (!node) return {};
+    if (node->is_string()) return {*node->value<std::string>()};
+    const toml::array* a = node->as_array();
+    std::vector<std::string> out;
+    if (!a) fail(key, *node, "must be a string or an array of strings");
+    for (const toml::node& e : *a) {
+      if (!e.is_string()) fail(key, *node, "must be a string or an array of strings");
+      out.push_back(*e.value<std::string>());
+    }
+    return out;
+  }
+  // An array of exactly N numbers, each in [lo, hi].
+  template <int N>
+  std::optional<Eigen::Matrix<double, N, 1>> vector(const char* key, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return std::nullopt;
+    const toml::array* a = node->as_array();
+    if (!a || a->size() != N) {
+      fail(key, *node, "must be an array of " + std::to_string(N) + " numbers");
+    }
+    Eigen::Matrix<double, N, 1> v;
+    for (int i = 0; i < N; ++i) {
+      const toml::node& e = *a->get(static_cast<std::size_t>(i));
+      std::optional<double> d = e.value<double>();
+      if (!d || e.is_boolean() || !std::isfinite(*d) || *d < lo || *d > hi) {
+        fail(key, *node,
+             "must hold " + std::to_string(N) + " finite numbers in [" + fmt(lo) + ", " + fmt(hi) +
+                 "]");
+      }
+      v[i] = *d;
+    }
+    return v;
+  }
+  Eigen::Vector3f color(const char* key, const Eigen::Vector3f& fallback) {
+    auto v = vector<3>(key, 0.0, 1.0);
+    return v ? v->cast<float>() : fallback;
+  }
+
+  // Call last: any key not taken is unknown.
+  void finish() const {
+    if (!table_) return;
+    for (const auto& [k, node] : *table_) {
+      if (!used_.count(std::string(k.str()))) {
+        throw Error(where(node) + ": unknown key '" + name_ + "." + std::string(k.str()) +
+                    "' (see docs/rendering.md for the keys of [" + name_ + "])");
+      }
+    }
+  }
+
+ private:
+  const toml::node* take(const char* key) {
+    used_.insert(key);
+    return table_ ? table_->get(key) : nullptr;
+  }
+  std::string where(const toml::node& node) const {
+    std::string s = file_.string();
+    if (node.source().begin.line > 0) s += ":" + std::to_string(node.source().begin.line);
+    return s;
+  }
+  [[noreturn]] void fail(const char* key, const toml::node& node, const std::string& what) const {
+    throw Error(where(node) + ": '" + name_ + "." + key + "' " + what);
+  }
+  static std::string fmt(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+  }
+
+  const toml::table* table_;
+  std::string name_;
+  fs::path file_;
+  std::set<std::string> used_;
+};
+
+const toml::table* subtable(const toml::table& root, const char* name, const fs::path& file) {
+  const toml::node* node = root.get(name);
+  if (!node) return nullptr;
+  if (!node->is_table()) {
+    throw Error(file.string() + ": '" + name + "' must be a table ([" + name + "])");
+  }
+  return node->as_table();
+}
+
+}  // namespace
+
+SceneFile read_scene_file(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw Error("cannot read scene '" + path.string() + "': no such file");
+  toml::table root;
+  try {
+    root = toml::parse_file(path.string());
+  } catch (const toml::parse_error& e) {
+    throw Error(path.string() + ":" + std::to_string(e.source().begin.line) +
+                ": TOML syntax error: " + std::string(e.description()));
+  }
+  static const std::set<std::string> sections = {"terrain", "sun",    "sky",    "camera",
+                                                 "render",  "output", "objects"};
+  for (const auto& [k, node] : root) {
+    if (!sections.count(std::string(k.str()))) {
+      throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
+                  ": unknown section '" + std::string(k.str()) +
+                  "' (known: terrain, sun, sky, camera, objects, render, output)");
+    }
+  }
+  const fs::path base = path.parent_path();
+  SceneFile scene;
+  render::SceneInput& in = scene.input;
+
+  Section terrain(subtable(root, "terrain", path), "terrain", path);
+  const auto raster = terrain.string("raster");
+  if (!raster) throw Error(path.string() + ": '[terrain] raster' is required (a DEM GeoTIFF)");
+  scene.terrain_raster = fs::path(*raster).is_absolute() ? fs::path(*raster) : base / *raster;
+  in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
+  in.terrain_albedo = terrain.color("color", in.terrain_albedo);
+  terrain.finish();
+
+  Section sun(subtable(root, "sun", path), "sun", path);
+  in.sun.azimuth_deg = sun.number("azimuth", in.sun.azimuth_deg, 0.0, 360.0);
+  in.sun.elevation_deg = sun.number("elevation", in.sun.elevation_deg, -90.0, 90.0);
+  in.sun.angular_diameter_deg =
+      sun.number("angular_diameter", in.sun.angular_diameter_deg, 1e-3, 20.0);
+  in.sun.irradiance = sun.number("irradiance", in.sun.irradiance, 0.0, 1e6);
+  in.sun.color = sun.color("color", in.sun.color);
+  sun.finish();
+
+  Section sky(subtable(root, "sky", path), "sky", path);
+  in.sky.zenith = sky.color("zenith", in.sky.zenith);
+  in.sky.horizon = sky.color("horizon", in.sky.horizon);
+  in.sky.intensity = static_cast<float>(sky.number("intensity", in.sky.intensity, 0.0, 1e6));
+  in.sky.ground_factor =
+      static_cast<float>(sky.number("ground_factor", in.sky.ground_factor, 0.0, 10.0));
+  in.sky.constant = sky.boolean("constant", in.sky.constant);
+  sky.finish();
+
+  if (const toml::table* cam_table = subtable(root, "camera", path)) {
+    Section cam(cam_table, "camera", path);
+    render::Camera camera;
+    const auto from = cam.vector<3>("from", -1e8, 1e8);
+    const auto to = cam.vector<3>("to", -1e8, 1e8);
+    camera.vertical_fov_deg = cam.number("fov", camera.vertical_fov_deg, 0.1, 179.0);
+    cam.finish();
+    if (!from || !to)
+      throw Error(path.string() +
+                  ": [camera] needs both 'from' and 'to' ([x, y, z] in the raster's CRS, metres)");
+    camera.from = *from;
+    camera.to = *to;
+    in.camera = camera;
+  }
+
+  if (const toml::node* objects = root.get("objects")) {
+    const toml::array* list = objects->as_array();
+    if (!list) throw Error(path.string() + ": 'objects' must be an array of tables ([[objects]])");
+    for (const toml::node& entry : *list) {
+      if (!entry.is_table())
+        throw Error(path.string() + ": every [[objects]] entry must be a table");
+      Section obj(entry.as_table(), "objects", path);
+      const auto mesh_path = obj.string("mesh");
+      if (!mesh_path)
+        throw Error(path.string() + ": an [[objects]] entry needs 'mesh' (an OBJ file)");
+      const bool y_up = obj.boolean("y_up", false);
+      const auto position = obj.vector<3>("position", -1e8, 1e8);
+      const double scale = obj.number("scale", 1.0, 1e-6, 1e6);
+      const double rotate = obj.number("rotate_z", 0.0, -360.0, 360.0);
+      render::PlacedMesh placed;
+      placed.albedo = obj.color("color", placed.albedo);
+      obj.finish();
+      const fs::path mp =
+          fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path) : base / *mesh_path;
+      placed.mesh = terrain::read_obj(mp, y_up);
+      const double a = rotate * M_PI / 180.0;
+      const Eigen::Vector3d t = position ? *position : Eigen::Vector3d::Zero();
+      for (auto& p : placed.mesh.positions) {
+        const double x = p.x() * scale, y = p.y() * scale, z = p.z() * scale;
+        p = Eigen::Vector3f(static_cast<float>(std::cos(a) * x - std::sin(a) * y + t.x()),
+                            static_cast<float>(std::sin(a) * x + std::cos(a) * y + t.y()),
+                            static_cast<float>(z + t.z()));
+      }
+      in.meshes.push_back(std::move(placed));
+    }
+  }
+
+  Section rs(subtable(root, "render", path), "render", path);
+  scene.settings.width = rs.integer("width", scene.settings.width, 1, 16384);
+  scene.settings.height = rs.integer("height", scene.settings.height, 1, 16384);
+  scene.settings.samples_per_pixel =
+      rs.integer("spp", scene.settings.samples_per_pixel, 1, 1 << 20);
+  scene.settings.max_depth = rs.integer("max_depth", scene.settings.max_depth, 1, 1024);
+  scene.settings.seed = static_cast<std::uint64_t>(rs.integer("seed", 1, 0, 2147483647));
+  rs.finish();
+
+  Section out(subtable(root, "output", path), "output", path);
+  for (const std::string& f : out.strings("files")) scene.outputs.emplace_back(f);
+  scene.display.exposure_ev = out.number("exposure", 0.0, -20.0, 20.0);
+  const auto tone = out.string("tone");
+  if (tone && *tone != "filmic" && *tone != "clamp") {
+    throw Error(path.string() + ": 'output.tone' is '" + *tone + "'; use \"filmic\" or \"clamp\"");
+  }
+  scene.display.curve =
+      (tone && *tone == "clamp") ? render::ToneCurve::Clamp : render::ToneCurve::Filmic;
+  out.finish();
+  return scene;
+}
+
+void load_scene_terrain(SceneFile& scene) {
+  scene.input.terrain = terrain::read_raster(scene.terrain_raster);
+  const std::string& wkt = scene.input.terrain.geo().crs_wkt;
+  if (!wkt.empty()) {
+    OGRSpatialReference srs;
+    if (srs.importFromWkt(wkt.c_str()) == OGRERR_NONE && srs.IsGeographic()) {
+      throw Error("terrain '" + scene.terrain_raster.string() +
+                  "' is in degrees (geographic CRS); convert it to metres first: drift import " +
+                  scene.terrain_raster.string() + " -o DEM_metric.tif");
+    }
+  }
+}
+
+}  // namespace drift::pipeline

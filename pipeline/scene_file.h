@@ -1,0 +1,30 @@
+// Scene files (TOML) for `drift render`: parsing with strict validation.
+// Unknown keys, wrong types and out-of-range values are drift::Error naming the
+// key, the file and the line. See docs/rendering.md for every key.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "render/render_settings.h"
+#include "render/tonemap.h"
+
+namespace drift::pipeline {
+
+struct SceneFile {
+  std::filesystem::path terrain_raster;  // resolved against the scene file's folder
+  render::SceneInput input;              // terrain not loaded yet (see load_scene_terrain)
+  render::RenderSettings settings;
+  std::vector<std::filesystem::path> outputs;  // resolved against the current directory
+  render::DisplayTransform display;
+};
+
+// Parses and validates; meshes are loaded, the terrain raster is not.
+SceneFile read_scene_file(const std::filesystem::path& path);
+
+// Reads the scene's terrain raster; a geographic (degree) raster is an error
+// telling the user to run `drift import` first.
+void load_scene_terrain(SceneFile& scene);
+
+}  // namespace drift::pipeline

@@ -1,0 +1,63 @@
+// Everything a render needs, as plain data. The scene-file parser
+// (pipeline/scene_file) fills it; tests build it directly.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "terrain/grid.h"
+#include "terrain/mesh.h"
+
+namespace drift::render {
+
+struct Sun {
+  double azimuth_deg = 135.0;          // clockwise from north, [0, 360)
+  double elevation_deg = 35.0;         // above the horizon, [-90, 90]
+  double angular_diameter_deg = 0.53;  // the real sun; (0, 20]
+  double irradiance = 3.0;             // on a surface facing the sun, render units (W/m^2 scaled)
+  Eigen::Vector3f color{1.0f, 0.95f, 0.88f};  // linear RGB tint
+};
+
+// A simple analytic sky (the physical atmosphere replaces it, issue 7): radiance
+// blends from `horizon` to `zenith` with the sine of the elevation; below the
+// horizon it is `horizon` * ground_factor.
+struct Sky {
+  Eigen::Vector3f zenith{0.25f, 0.42f, 0.80f};
+  Eigen::Vector3f horizon{0.70f, 0.78f, 0.90f};
+  float intensity = 1.0f;      // multiplies both
+  float ground_factor = 1.0f;  // below the horizon: horizon x this (distant haze)
+  bool constant = false;       // constant radiance `intensity` everywhere (white furnace)
+};
+
+struct Camera {
+  Eigen::Vector3d from{0, 0, 0};  // world metres (x east, y north, z up)
+  Eigen::Vector3d to{0, 1, 0};
+  double vertical_fov_deg = 40.0;  // (0, 180)
+};
+
+struct PlacedMesh {
+  terrain::Mesh mesh;
+  Eigen::Vector3f albedo{0.5f, 0.5f, 0.5f};
+};
+
+struct RenderSettings {
+  int width = 960;
+  int height = 540;
+  int samples_per_pixel = 64;
+  int max_depth = 4;  // path vertices after the camera; >= 1
+  std::uint64_t seed = 1;
+};
+
+struct SceneInput {
+  terrain::HeightField terrain;  // metric CRS (or local), heights in metres
+  double vertical_exaggeration = 1.0;
+  Eigen::Vector3f terrain_albedo{0.28f, 0.26f, 0.23f};
+  std::vector<PlacedMesh> meshes;  // in world metres
+  Sun sun;
+  Sky sky;
+  std::optional<Camera> camera;  // none: the default view of the terrain
+};
+
+}  // namespace drift::render

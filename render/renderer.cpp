@@ -1,0 +1,210 @@
+#include "render/renderer.h"
+
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <numbers>
+
+#include "render/random.h"
+#include "terrain/error.h"
+
+namespace drift::render {
+
+namespace {
+
+using Eigen::Vector3f;
+constexpr float kPi = std::numbers::pi_v<float>;
+
+Vector3f direction_from_az_el(double azimuth_deg, double elevation_deg) {
+  const double az = azimuth_deg * std::numbers::pi / 180.0;
+  const double el = elevation_deg * std::numbers::pi / 180.0;
+  return Vector3f(static_cast<float>(std::sin(az) * std::cos(el)),
+                  static_cast<float>(std::cos(az) * std::cos(el)),
+                  static_cast<float>(std::sin(el)));
+}
+
+// An orthonormal basis around unit n (Duff et al. 2017, "Building an
+// orthonormal basis, revisited").
+void basis(const Vector3f& n, Vector3f& t, Vector3f& b) {
+  const float sign = std::copysign(1.0f, n.z());
+  const float a = -1.0f / (sign + n.z());
+  const float c = n.x() * n.y() * a;
+  t = Vector3f(1.0f + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
+  b = Vector3f(c, sign + n.y() * n.y() * a, -n.y());
+}
+
+Vector3f cosine_sample(const Vector3f& n, float u1, float u2) {
+  const float r = std::sqrt(u1), phi = 2.0f * kPi * u2;
+  Vector3f t, b;
+  basis(n, t, b);
+  return (t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
+          n * std::sqrt(std::max(0.0f, 1.0f - u1)))
+      .normalized();
+}
+
+// Uniform direction in the cone of half-angle with cosine `cos_max` around `axis`.
+Vector3f cone_sample(const Vector3f& axis, float cos_max, float u1, float u2) {
+  const float cos_t = 1.0f - u1 * (1.0f - cos_max);
+  const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+  const float phi = 2.0f * kPi * u2;
+  Vector3f t, b;
+  basis(axis, t, b);
+  return (t * (sin_t * std::cos(phi)) + b * (sin_t * std::sin(phi)) + axis * cos_t).normalized();
+}
+
+float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCoeff()); }
+
+struct PixelSample {
+  Vector3f radiance{0, 0, 0};
+  float depth = 0.0f;
+  Vector3f normal{0, 0, 0};
+  Vector3f albedo{0, 0, 0};
+};
+
+}  // namespace
+
+Vector3f sky_radiance(const Sky& sky, const Vector3f& dir) {
+  if (sky.constant) return Vector3f::Constant(sky.intensity);
+  if (dir.z() < 0.0f) return sky.horizon * (sky.intensity * sky.ground_factor);
+  // sqrt of the sine: a quick rise from the pale horizon to the deep zenith.
+  const float t = std::sqrt(std::clamp(dir.z(), 0.0f, 1.0f));
+  return (sky.horizon * (1.0f - t) + sky.zenith * t) * sky.intensity;
+}
+
+Camera default_camera(const TerrainScene& scene) {
+  // Stand on the far side of the DEM's centre from its highest point, above the
+  // terrain, and look at the summit across the whole DEM. A summit at the very
+  // centre is looked at from the south.
+  const Vector3f top = scene.highest_point();
+  Eigen::Vector2f away = -top.head<2>();
+  if (away.norm() < 1e-3f * scene.extent().norm()) away = {0.0f, -1.0f};
+  away.normalize();
+  const float half = 0.5f * scene.extent().minCoeff();
+  const Eigen::Vector2f xy = away * (0.9f * half);
+  // Slightly above the summit, so ridges between camera and peak do not hide it.
+  const float z = std::max(scene.height_at(xy.x(), xy.y()), top.z()) + 0.12f * half;
+  const Eigen::Vector3d origin = scene.origin();
+  Camera camera;
+  camera.from = origin + Eigen::Vector3d(xy.x(), xy.y(), z);
+  // Aim a little below the summit: the peak sits in the upper part of the frame
+  // and the slopes in front fill the rest.
+  camera.to = origin + top.cast<double>() - Eigen::Vector3d(0, 0, 0.25 * half);
+  camera.vertical_fov_deg = 45.0;
+  return camera;
+}
+
+Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,
+                   const RenderSettings& settings, const ProgressFn& progress) {
+  if (settings.width < 1 || settings.height < 1 || settings.samples_per_pixel < 1 ||
+      settings.max_depth < 1) {
+    throw Error("render size, samples per pixel and max depth must all be at least 1");
+  }
+  Image image(settings.width, settings.height,
+              {"R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G",
+               "albedo.B"});
+
+  // Camera frame (z up). Looking straight up or down: pick north as "up".
+  const Vector3f eye = scene.to_local(camera.from);
+  Vector3f forward = (scene.to_local(camera.to) - eye);
+  if (!(forward.norm() > 0.0f)) throw Error("camera 'from' and 'to' are the same point");
+  forward.normalize();
+  Vector3f right = forward.cross(Vector3f::UnitZ());
+  if (right.norm() < 1e-6f) right = forward.cross(Vector3f::UnitY());
+  right.normalize();
+  const Vector3f up = right.cross(forward);
+  const float tan_half =
+      static_cast<float>(std::tan(camera.vertical_fov_deg * std::numbers::pi / 360.0));
+  const float aspect = static_cast<float>(settings.width) / static_cast<float>(settings.height);
+
+  const Sun& sun = input.sun;
+  const Vector3f sun_dir = direction_from_az_el(sun.azimuth_deg, sun.elevation_deg);
+  const float sun_cos_max =
+      static_cast<float>(std::cos(sun.angular_diameter_deg * std::numbers::pi / 360.0));
+  const Vector3f sun_irradiance = sun.color * static_cast<float>(sun.irradiance);
+  const bool sun_up = sun.irradiance > 0.0 && sun_dir.z() > -0.2f;
+
+  auto trace = [&](int px, int py, SampleStream& rng) {
+    PixelSample out;
+    const float sx = (2.0f * (px + rng.next()) / settings.width - 1.0f) * tan_half * aspect;
+    const float sy = (1.0f - 2.0f * (py + rng.next()) / settings.height) * tan_half;
+    Vector3f dir = (forward + right * sx + up * sy).normalized();
+    Vector3f origin = eye;
+    Vector3f throughput(1, 1, 1);
+    for (int depth = 0; depth < settings.max_depth; ++depth) {
+      Hit hit;
+      if (!scene.intersect(origin, dir, hit)) {
+        out.radiance += throughput.cwiseProduct(sky_radiance(input.sky, dir));
+        break;
+      }
+      if (depth == 0) {
+        out.depth = hit.distance;
+        out.normal = hit.normal;
+        out.albedo = hit.albedo;
+      }
+      const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
+      const Vector3f brdf = hit.albedo / kPi;  // Lambert
+      // Next-event estimation of the sun: uniform in its cone, pdf 1/solid angle,
+      // radiance E/solid angle, so the estimate is E * cos * brdf.
+      const float u1 = rng.next(), u2 = rng.next();
+      if (sun_up) {
+        const Vector3f l = cone_sample(sun_dir, sun_cos_max, u1, u2);
+        const float cos_l = hit.normal.dot(l);
+        if (cos_l > 0.0f && l.z() > -0.2f && !scene.occluded(p, l, 1e30f)) {
+          out.radiance += throughput.cwiseProduct(brdf).cwiseProduct(sun_irradiance) * cos_l;
+        }
+      }
+      // Bounce: cosine-weighted, so the weight is the albedo.
+      dir = cosine_sample(hit.normal, rng.next(), rng.next());
+      origin = p;
+      throughput = throughput.cwiseProduct(hit.albedo);
+      if (depth >= 2) {  // Russian roulette (unbiased)
+        const float q = std::min(0.95f, throughput.maxCoeff());
+        if (rng.next() >= q) break;
+        throughput /= q;
+      }
+    }
+    return out;
+  };
+
+  constexpr int kTile = 32;
+  const int tiles_x = (settings.width + kTile - 1) / kTile;
+  const int tiles_y = (settings.height + kTile - 1) / kTile;
+  const int tile_count = tiles_x * tiles_y;
+  std::atomic<int> done{0};
+  std::atomic<bool> cancelled{false};
+  progress(0.0, "rendering");
+  const float inv_spp = 1.0f / static_cast<float>(settings.samples_per_pixel);
+  tbb::parallel_for(0, tile_count, [&](int tile) {
+    if (cancelled.load(std::memory_order_relaxed)) return;
+    const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+    for (int y = y0; y < std::min(y0 + kTile, settings.height); ++y) {
+      for (int x = x0; x < std::min(x0 + kTile, settings.width); ++x) {
+        PixelSample sum;
+        const std::uint64_t pixel = static_cast<std::uint64_t>(y) * settings.width + x;
+        for (int s = 0; s < settings.samples_per_pixel; ++s) {
+          SampleStream rng(settings.seed, pixel, static_cast<std::uint64_t>(s));
+          const PixelSample one = trace(x, y, rng);
+          sum.radiance += one.radiance;
+          sum.depth += one.depth;
+          sum.normal += one.normal;
+          sum.albedo += one.albedo;
+        }
+        const float values[10] = {sum.radiance.x() * inv_spp, sum.radiance.y() * inv_spp,
+                                  sum.radiance.z() * inv_spp, sum.depth * inv_spp,
+                                  sum.normal.x() * inv_spp,   sum.normal.y() * inv_spp,
+                                  sum.normal.z() * inv_spp,   sum.albedo.x() * inv_spp,
+                                  sum.albedo.y() * inv_spp,   sum.albedo.z() * inv_spp};
+        for (int c = 0; c < 10; ++c) image.at(x, y, c) = values[c];
+      }
+    }
+    const int finished = ++done;
+    if (!progress(static_cast<double>(finished) / tile_count, "")) cancelled = true;
+  });
+  if (cancelled) throw Cancelled();
+  return image;
+}
+
+}  // namespace drift::render

@@ -1,0 +1,239 @@
+#include "render/terrain_scene.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "terrain/error.h"
+#include "terrain/memory.h"
+
+namespace drift::render {
+
+namespace {
+
+// Embree calls this from C code: never throw through it; remember the message and
+// raise it after the call returns (check_device).
+thread_local std::string g_embree_message;
+void embree_error(void*, RTCError, const char* message) {
+  g_embree_message = message ? message : "unknown error";
+}
+
+void check_device(RTCDevice device, const char* what) {
+  if (rtcGetDeviceError(device) != RTC_ERROR_NONE) {
+    throw Error(std::string("Embree failed to ") + what + ": " + g_embree_message);
+  }
+}
+
+// Embree grids are at most 32767 vertices a side (RTCGrid::width is 16-bit).
+constexpr int kMaxGridSide = 32767;
+
+}  // namespace
+
+struct TerrainScene::Embree {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<RTCGrid> grids;
+  ~Embree() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<Embree>()) {
+  const terrain::HeightField& dem = input.terrain;
+  if (dem.width() < 2 || dem.height() < 2) {
+    throw Error("the terrain raster must be at least 2 x 2 cells, got " +
+                std::to_string(dem.width()) + " x " + std::to_string(dem.height()));
+  }
+  if (!dem.geo().north_up()) {
+    throw Error("the terrain raster is rotated; warp it north-up first (drift import)");
+  }
+  width_ = dem.width();
+  height_ = dem.height();
+  dx_ = static_cast<float>(dem.geo().cell_size_x());
+  dy_ = static_cast<float>(dem.geo().cell_size_y());
+  if (!(dx_ > 0) || !(dy_ > 0)) {
+    throw Error("the terrain raster's cell size must be positive (north-up, metres)");
+  }
+  terrain_albedo_ = input.terrain_albedo;
+  const std::size_t n = dem.size();
+  // Vertices, normals and Embree's own grid data (~17.5 B per vertex).
+  require_memory(n * (4 + 12 + 12 + 20), "the terrain scene", "crop or resample the DEM");
+
+  // Heights: nodata cells become the lowest valid height.
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (float v : dem.values()) {
+    if (!std::isnan(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  }
+  if (!std::isfinite(lo)) throw Error("the terrain raster holds no valid height (all nodata)");
+  const float k = static_cast<float>(input.vertical_exaggeration);
+  heights_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    heights_[i] = (std::isnan(dem.values()[i]) ? lo : dem.values()[i]) * k;
+  }
+  // Local frame: origin at the DEM's centre (cell centres) and lowest height, so
+  // float coordinates stay small.
+  const auto centre = dem.geo().cell_center((width_ - 1) / 2.0, (height_ - 1) / 2.0);
+  origin_ = Eigen::Vector3d(centre[0], centre[1], static_cast<double>(lo) * k);
+  const auto nw = dem.geo().cell_center(0, 0);
+  const float x0 = static_cast<float>(nw[0] - origin_.x());
+  const float y0 = static_cast<float>(nw[1] - origin_.y());
+
+  vertices_.resize(n);
+  vertex_normals_.resize(n);
+  tbb::parallel_for(0, height_, [&](int row) {
+    for (int x = 0; x < width_; ++x) {
+      const std::size_t i = static_cast<std::size_t>(row) * width_ + x;
+      vertices_[i] = {x0 + x * dx_, y0 - row * dy_, heights_[i] - static_cast<float>(origin_.z())};
+      // Central differences (one-sided at the edges); y grows north, rows south.
+      const int xl = std::max(x - 1, 0), xr = std::min(x + 1, width_ - 1);
+      const int rn = std::max(row - 1, 0), rs = std::min(row + 1, height_ - 1);
+      const float dzdx = (heights_[static_cast<std::size_t>(row) * width_ + xr] -
+                          heights_[static_cast<std::size_t>(row) * width_ + xl]) /
+                         ((xr - xl) * dx_);
+      const float dzdy = (heights_[static_cast<std::size_t>(rn) * width_ + x] -
+                          heights_[static_cast<std::size_t>(rs) * width_ + x]) /
+                         ((rs - rn) * dy_);
+      vertex_normals_[i] = Eigen::Vector3f(-dzdx, -dzdy, 1.0f).normalized();
+    }
+  });
+  std::size_t hi_i = 0, lo_i = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (heights_[i] > heights_[hi_i]) hi_i = i;
+    if (heights_[i] < heights_[lo_i]) lo_i = i;
+  }
+  highest_ = vertices_[hi_i];
+  lowest_ = vertices_[lo_i];
+  extent_ = {(width_ - 1) * dx_, (height_ - 1) * dy_};
+
+  embree_->device = rtcNewDevice("threads=0");
+  if (!embree_->device) throw Error("cannot create an Embree device");
+  rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
+  embree_->scene = rtcNewScene(embree_->device);
+  rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
+
+  // Terrain: grids of at most kMaxGridSide vertices a side over one shared
+  // vertex buffer (stride = raster width); neighbours share their edge row.
+  for (int gy = 0; gy < height_ - 1; gy += kMaxGridSide - 1) {
+    for (int gx = 0; gx < width_ - 1; gx += kMaxGridSide - 1) {
+      RTCGrid g;
+      g.startVertexID = static_cast<unsigned>(static_cast<std::size_t>(gy) * width_ + gx);
+      g.stride = static_cast<unsigned>(width_);
+      g.width = static_cast<unsigned short>(std::min(kMaxGridSide, width_ - gx));
+      g.height = static_cast<unsigned short>(std::min(kMaxGridSide, height_ - gy));
+      embree_->grids.push_back(g);
+    }
+  }
+  RTCGeometry grid_geometry = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_GRID);
+  rtcSetSharedGeometryBuffer(grid_geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                             vertices_.data(), 0, sizeof(Eigen::Vector3f), n);
+  rtcSetSharedGeometryBuffer(grid_geometry, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
+                             embree_->grids.data(), 0, sizeof(RTCGrid), embree_->grids.size());
+  rtcCommitGeometry(grid_geometry);
+  rtcAttachGeometryByID(embree_->scene, grid_geometry, 0);
+  rtcReleaseGeometry(grid_geometry);
+  terrain_geometries_ = 1;
+  mesh_albedo_.push_back(terrain_albedo_);
+
+  // Meshes: triangle geometry with their own (copied, shifted) buffers.
+  for (const PlacedMesh& placed : input.meshes) {
+    RTCGeometry geom = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                          placed.mesh.positions.size()));
+    for (std::size_t i = 0; i < placed.mesh.positions.size(); ++i) {
+      for (int c = 0; c < 3; ++c) v[3 * i + c] = placed.mesh.positions[i][c];
+    }
+    auto* idx = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), placed.mesh.triangles.size()));
+    for (std::size_t t = 0; t < placed.mesh.triangles.size(); ++t) {
+      for (int c = 0; c < 3; ++c)
+        idx[3 * t + c] = static_cast<unsigned>(placed.mesh.triangles[t][c]);
+    }
+    rtcCommitGeometry(geom);
+    const unsigned id = rtcAttachGeometry(embree_->scene, geom);
+    rtcReleaseGeometry(geom);
+    if (mesh_albedo_.size() <= id) mesh_albedo_.resize(id + 1);
+    mesh_albedo_[id] = placed.albedo;
+  }
+  rtcCommitScene(embree_->scene);
+  check_device(embree_->device, "build the scene");
+}
+
+TerrainScene::~TerrainScene() = default;
+
+float TerrainScene::height_at(float x, float y) const {
+  const auto nwx = vertices_.front().x(), nwy = vertices_.front().y();
+  const float fx = std::clamp((x - nwx) / dx_, 0.0f, static_cast<float>(width_ - 1));
+  const float fr = std::clamp((nwy - y) / dy_, 0.0f, static_cast<float>(height_ - 1));
+  const int x0 = std::min(static_cast<int>(fx), width_ - 2);
+  const int r0 = std::min(static_cast<int>(fr), height_ - 2);
+  const float tx = fx - x0, tr = fr - r0;
+  auto h = [&](int xx, int rr) {
+    return vertices_[static_cast<std::size_t>(rr) * width_ + xx].z();
+  };
+  return (1 - tr) * ((1 - tx) * h(x0, r0) + tx * h(x0 + 1, r0)) +
+         tr * ((1 - tx) * h(x0, r0 + 1) + tx * h(x0 + 1, r0 + 1));
+}
+
+bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh{};
+  rh.ray.org_x = o.x(), rh.ray.org_y = o.y(), rh.ray.org_z = o.z();
+  rh.ray.dir_x = d.x(), rh.ray.dir_y = d.y(), rh.ray.dir_z = d.z();
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = std::numeric_limits<float>::infinity();
+  rh.ray.mask = 0xffffffffu;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(embree_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  hit.distance = rh.ray.tfar;
+  hit.position = o + d * rh.ray.tfar;
+  Eigen::Vector3f n;
+  if (rh.hit.geomID < terrain_geometries_) {
+    // Smooth shading: bilinear vertex normals at the hit's cell position.
+    const auto nw = vertices_.front();
+    const float fx = std::clamp((hit.position.x() - nw.x()) / dx_, 0.0f, width_ - 1.0f);
+    const float fr = std::clamp((nw.y() - hit.position.y()) / dy_, 0.0f, height_ - 1.0f);
+    const int x0 = std::min(static_cast<int>(fx), width_ - 2);
+    const int r0 = std::min(static_cast<int>(fr), height_ - 2);
+    const float tx = fx - x0, tr = fr - r0;
+    auto vn = [&](int xx, int rr) {
+      return vertex_normals_[static_cast<std::size_t>(rr) * width_ + xx];
+    };
+    n = ((1 - tr) * ((1 - tx) * vn(x0, r0) + tx * vn(x0 + 1, r0)) +
+         tr * ((1 - tx) * vn(x0, r0 + 1) + tx * vn(x0 + 1, r0 + 1)))
+            .normalized();
+    hit.albedo = terrain_albedo_;
+  } else {
+    n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+    hit.albedo = mesh_albedo_[rh.hit.geomID];
+  }
+  // Face the ray: a mesh may be seen from either side, and terrain from below
+  // at the edges. (Embree's Ng of our grids points down: rows run south.)
+  if (n.dot(d) > 0) n = -n;
+  hit.normal = n;
+  return true;
+}
+
+bool TerrainScene::occluded(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                            float max_distance) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray{};
+  ray.org_x = o.x(), ray.org_y = o.y(), ray.org_z = o.z();
+  ray.dir_x = d.x(), ray.dir_y = d.y(), ray.dir_z = d.z();
+  ray.tnear = 0.0f;
+  ray.tfar = max_distance;
+  ray.mask = 0xffffffffu;
+  rtcOccluded1(embree_->scene, &context, &ray);
+  return ray.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+}  // namespace drift::render

@@ -1,0 +1,67 @@
+// The Embree 3 scene of a render: the height field as grid geometry
+// (RTC_GEOMETRY_TYPE_GRID, 12 bytes of vertex per DEM cell instead of a triangle
+// soup) plus triangle meshes.
+//
+// Coordinates: the interface speaks the raster's own CRS (x east, y north,
+// metres) and heights in metres. Inside, everything is shifted by `origin()`
+// (the DEM's centre) so that UTM-sized numbers keep float precision in Embree.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "render/render_settings.h"
+
+namespace drift::render {
+
+struct Hit {
+  float distance = 0.0f;
+  Eigen::Vector3f position{0, 0, 0};  // local (origin-shifted) coordinates
+  Eigen::Vector3f normal{0, 0, 1};    // unit shading normal, facing the ray
+  Eigen::Vector3f albedo{0, 0, 0};
+};
+
+class TerrainScene {
+ public:
+  // Throws drift::Error for an empty or all-nodata terrain. NaN (nodata) cells
+  // are filled with the lowest valid height so that holes read as low ground.
+  explicit TerrainScene(const SceneInput& input);
+  ~TerrainScene();
+  TerrainScene(const TerrainScene&) = delete;
+  TerrainScene& operator=(const TerrainScene&) = delete;
+
+  bool intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, Hit& hit) const;
+  // True if anything lies on the ray within (0, max_distance).
+  bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
+                float max_distance) const;
+
+  // CRS -> local coordinates and back.
+  Eigen::Vector3d origin() const { return origin_; }
+  Eigen::Vector3f to_local(const Eigen::Vector3d& world) const {
+    return (world - origin_).cast<float>();
+  }
+
+  // Terrain facts in local coordinates, for default cameras.
+  Eigen::Vector3f highest_point() const { return highest_; }
+  Eigen::Vector3f lowest_point() const { return lowest_; }
+  Eigen::Vector2f extent() const { return extent_; }  // metres east-west, north-south
+  float height_at(float x, float y) const;            // bilinear, local coordinates
+
+ private:
+  struct Embree;
+  std::unique_ptr<Embree> embree_;
+  int width_ = 0, height_ = 0;
+  float dx_ = 1.0f, dy_ = 1.0f;
+  Eigen::Vector3d origin_{0, 0, 0};
+  std::vector<float> heights_;             // filled, exaggerated, row 0 = north
+  std::vector<Eigen::Vector3f> vertices_;  // Embree's shared vertex buffer
+  std::vector<Eigen::Vector3f> vertex_normals_;
+  Eigen::Vector3f terrain_albedo_{0.3f, 0.3f, 0.3f};
+  std::vector<Eigen::Vector3f> mesh_albedo_;  // by Embree geometry id
+  unsigned terrain_geometries_ = 0;           // geometry ids [0, n) are terrain grids
+  Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};
+  Eigen::Vector2f extent_{0, 0};
+};
+
+}  // namespace drift::render

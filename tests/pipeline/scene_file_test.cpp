@@ -1,0 +1,131 @@
+// Scene files: every mistake names the key and the file; the CLI exits 1 and
+// writes nothing.
+#include "pipeline/scene_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "terrain/error.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path write_scene(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::temp_directory_path() / "drift_scene_tests";
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+// The error message of reading `text` as a scene (empty if it parsed).
+std::string error_of(const std::string& text) {
+  const fs::path p = write_scene("s.toml", text);
+  try {
+    drift::pipeline::read_scene_file(p);
+  } catch (const drift::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kTerrain = "[terrain]\nraster = \"dem.tif\"\n";
+
+}  // namespace
+
+TEST(SceneFile, ReadsEveryKey) {
+  const fs::path p =
+      write_scene("full.toml", std::string(kTerrain) +
+                                   "exaggeration = 1.5\ncolor = [0.3, 0.2, 0.1]\n"
+                                   "[sun]\nazimuth = 200\nelevation = 12.5\n"
+                                   "[camera]\nfrom = [1, 2, 3]\nto = [4, 5, 6]\nfov = 30\n"
+                                   "[render]\nwidth = 320\nheight = 200\nspp = 7\nseed = 9\n"
+                                   "[output]\nfiles = [\"a.png\", \"a.exr\"]\nexposure = -1\n");
+  const auto s = drift::pipeline::read_scene_file(p);
+  EXPECT_EQ(s.terrain_raster, p.parent_path() / "dem.tif");
+  EXPECT_DOUBLE_EQ(s.input.vertical_exaggeration, 1.5);
+  EXPECT_DOUBLE_EQ(s.input.sun.elevation_deg, 12.5);
+  ASSERT_TRUE(s.input.camera.has_value());
+  EXPECT_DOUBLE_EQ(s.input.camera->to.z(), 6.0);
+  EXPECT_EQ(s.settings.width, 320);
+  EXPECT_EQ(s.settings.samples_per_pixel, 7);
+  EXPECT_EQ(s.settings.seed, 9u);
+  EXPECT_EQ(s.outputs.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.display.exposure_ev, -1.0);
+}
+
+TEST(SceneFile, UnknownKeyNamesKeyAndFile) {
+  const std::string e = error_of(std::string(kTerrain) + "[sun]\nazimuht = 3\n");
+  EXPECT_NE(e.find("sun.azimuht"), std::string::npos) << e;
+  EXPECT_NE(e.find("s.toml:4"), std::string::npos) << e;
+}
+
+TEST(SceneFile, UnknownSectionIsAnError) {
+  EXPECT_NE(error_of(std::string(kTerrain) + "[camrea]\nfov = 3\n").find("camrea"),
+            std::string::npos);
+}
+
+TEST(SceneFile, WrongTypeIsAnError) {
+  const std::string e = error_of(std::string(kTerrain) + "[render]\nspp = \"many\"\n");
+  EXPECT_NE(e.find("render.spp"), std::string::npos) << e;
+  EXPECT_NE(e.find("integer"), std::string::npos) << e;
+}
+
+TEST(SceneFile, OutOfRangeValuesAreErrors) {
+  EXPECT_NE(error_of(std::string(kTerrain) + "[render]\nspp = -4\n").find("render.spp"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[render]\nwidth = 0\n").find("render.width"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[sun]\nelevation = nan\n").find("sun.elevation"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(std::string(kTerrain) + "[camera]\nfrom = [0, 0, 1]\nto = [0, 1, 1]\nfov = 180\n")
+          .find("camera.fov"),
+      std::string::npos);
+}
+
+TEST(SceneFile, SyntaxErrorNamesFileAndLine) {
+  const std::string e = error_of(std::string(kTerrain) + "[sun\nazimuth = 3\n");
+  EXPECT_NE(e.find("s.toml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("syntax"), std::string::npos) << e;
+}
+
+TEST(SceneFile, MissingRasterIsAnError) {
+  EXPECT_NE(error_of("[sun]\nazimuth = 3\n").find("raster"), std::string::npos);
+}
+
+TEST(RenderCommand, BadSceneExitsOneAndWritesNothing) {
+  const fs::path scene = write_scene("bad.toml", std::string(kTerrain) + "[render]\nspp = 0\n");
+  const fs::path out = scene.parent_path() / "bad_out.png";
+  fs::remove(out);
+  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " render " + scene.string() + " -o " +
+                          out.string() + " 2>/dev/null";
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(RenderCommand, FailedRunKeepsExistingOutput) {
+  // The raster is missing: the run fails after parsing and must not touch out.png.
+  const fs::path scene = write_scene("missing_raster.toml", std::string(kTerrain));
+  const fs::path out = scene.parent_path() / "keep.png";
+  std::ofstream(out) << "good";
+  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " render " + scene.string() + " -o " +
+                          out.string() + " 2>/dev/null";
+  EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1);
+  std::ifstream in(out);
+  std::string s;
+  in >> s;
+  EXPECT_EQ(s, "good");
+}
+
+TEST(RenderCommand, BadSizeIsAUsageError) {
+  const fs::path scene = write_scene("ok.toml", std::string(kTerrain));
+  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " render " + scene.string() +
+                          " --size 0x10 -o /tmp/x.png 2>/dev/null";
+  EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 2);
+}
