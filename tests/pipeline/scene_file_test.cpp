@@ -15,7 +15,9 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path write_scene(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "drift_scene_tests";
+  // One folder per test: CTest runs test cases in parallel processes.
+  const fs::path dir = fs::temp_directory_path() / "drift_scene_tests" /
+                       ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::create_directories(dir);
   const fs::path p = dir / name;
   std::ofstream(p) << text;
@@ -61,7 +63,7 @@ TEST(SceneFile, ReadsEveryKey) {
 TEST(SceneFile, UnknownKeyNamesKeyAndFile) {
   const std::string e = error_of(std::string(kTerrain) + "[sun]\nazimuht = 3\n");
   EXPECT_NE(e.find("sun.azimuht"), std::string::npos) << e;
-  EXPECT_NE(e.find("s.toml:4"), std::string::npos) << e;
+  EXPECT_NE(e.find("s.toml:4"), std::string::npos) << e;  // the line of the bad key
 }
 
 TEST(SceneFile, UnknownSectionIsAnError) {
