@@ -21,6 +21,7 @@ struct RenderOptions {
   int spp = 0;
   std::string size;
   std::vector<std::string> outputs;
+  std::string terrain;
   unsigned long long seed = 0;
   bool seed_given = false;
 };
@@ -41,6 +42,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     }
   }
   if (sub.count("--seed")) scene.settings.seed = o.seed;
+  if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
   if (!o.outputs.empty()) {
     scene.outputs.clear();
     for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
@@ -88,6 +90,7 @@ void add_render_command(CLI::App& root) {
   sub->add_option("--size", o->size, "image size WIDTHxHEIGHT (overrides the scene)");
   sub->add_option("-o,--output", o->outputs,
                   "output file(s), .png and/or .exr (override the scene)");
+  sub->add_option("--terrain", o->terrain, "terrain raster (overrides [terrain] raster)");
   add_seed_option(*sub, o->seed);
 }
 

@@ -69,8 +69,10 @@ struct PixelSample {
 Vector3f sky_radiance(const Sky& sky, const Vector3f& dir) {
   if (sky.constant) return Vector3f::Constant(sky.intensity);
   if (dir.z() < 0.0f) return sky.horizon * (sky.intensity * sky.ground_factor);
-  // sqrt of the sine: a quick rise from the pale horizon to the deep zenith.
-  const float t = std::sqrt(std::clamp(dir.z(), 0.0f, 1.0f));
+  // A smooth rise from the pale horizon to the deep zenith, flat at the horizon
+  // so there is no visible seam with the below-horizon haze.
+  const float e = std::clamp(dir.z() / 0.7f, 0.0f, 1.0f);
+  const float t = 0.5f - 0.5f * std::cos(kPi * e);
   return (sky.horizon * (1.0f - t) + sky.zenith * t) * sky.intensity;
 }
 
@@ -96,8 +98,31 @@ Camera default_camera(const TerrainScene& scene) {
   return camera;
 }
 
+Pinhole make_pinhole(const TerrainScene& scene, const Camera& camera, int width, int height) {
+  Pinhole p;
+  p.eye = scene.to_local(camera.from);
+  p.forward = scene.to_local(camera.to) - p.eye;
+  if (!(p.forward.norm() > 0.0f)) throw Error("camera 'from' and 'to' are the same point");
+  p.forward.normalize();
+  p.right = p.forward.cross(Vector3f::UnitZ());
+  if (p.right.norm() < 1e-6f) p.right = p.forward.cross(Vector3f::UnitY());
+  p.right.normalize();
+  p.up = p.right.cross(p.forward);
+  p.tan_half = static_cast<float>(std::tan(camera.vertical_fov_deg * std::numbers::pi / 360.0));
+  p.aspect = static_cast<float>(width) / static_cast<float>(height);
+  p.width = width;
+  p.height = height;
+  return p;
+}
+
+Vector3f Pinhole::direction(float x, float y) const {
+  const float sx = (2.0f * x / static_cast<float>(width) - 1.0f) * tan_half * aspect;
+  const float sy = (1.0f - 2.0f * y / static_cast<float>(height)) * tan_half;
+  return (forward + right * sx + up * sy).normalized();
+}
+
 Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,
-                   const RenderSettings& settings, const ProgressFn& progress) {
+                   const RenderSettings& settings, const ProgressFn& progress, RenderStats* stats) {
   if (settings.width < 1 || settings.height < 1 || settings.samples_per_pixel < 1 ||
       settings.max_depth < 1) {
     throw Error("render size, samples per pixel and max depth must all be at least 1");
@@ -106,18 +131,8 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
               {"R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G",
                "albedo.B"});
 
-  // Camera frame (z up). Looking straight up or down: pick north as "up".
-  const Vector3f eye = scene.to_local(camera.from);
-  Vector3f forward = (scene.to_local(camera.to) - eye);
-  if (!(forward.norm() > 0.0f)) throw Error("camera 'from' and 'to' are the same point");
-  forward.normalize();
-  Vector3f right = forward.cross(Vector3f::UnitZ());
-  if (right.norm() < 1e-6f) right = forward.cross(Vector3f::UnitY());
-  right.normalize();
-  const Vector3f up = right.cross(forward);
-  const float tan_half =
-      static_cast<float>(std::tan(camera.vertical_fov_deg * std::numbers::pi / 360.0));
-  const float aspect = static_cast<float>(settings.width) / static_cast<float>(settings.height);
+  const Pinhole pinhole = make_pinhole(scene, camera, settings.width, settings.height);
+  const Vector3f eye = pinhole.eye;
 
   const Sun& sun = input.sun;
   const Vector3f sun_dir = direction_from_az_el(sun.azimuth_deg, sun.elevation_deg);
@@ -126,15 +141,15 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const Vector3f sun_irradiance = sun.color * static_cast<float>(sun.irradiance);
   const bool sun_up = sun.irradiance > 0.0 && sun_dir.z() > -0.2f;
 
-  auto trace = [&](int px, int py, SampleStream& rng) {
+  auto trace = [&](int px, int py, SampleStream& rng, std::uint64_t& rays) {
     PixelSample out;
-    const float sx = (2.0f * (px + rng.next()) / settings.width - 1.0f) * tan_half * aspect;
-    const float sy = (1.0f - 2.0f * (py + rng.next()) / settings.height) * tan_half;
-    Vector3f dir = (forward + right * sx + up * sy).normalized();
+    const float jx = rng.next(), jy = rng.next();
+    Vector3f dir = pinhole.direction(static_cast<float>(px) + jx, static_cast<float>(py) + jy);
     Vector3f origin = eye;
     Vector3f throughput(1, 1, 1);
     for (int depth = 0; depth < settings.max_depth; ++depth) {
       Hit hit;
+      ++rays;
       if (!scene.intersect(origin, dir, hit)) {
         out.radiance += throughput.cwiseProduct(sky_radiance(input.sky, dir));
         break;
@@ -152,7 +167,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
       if (sun_up) {
         const Vector3f l = cone_sample(sun_dir, sun_cos_max, u1, u2);
         const float cos_l = hit.normal.dot(l);
-        if (cos_l > 0.0f && l.z() > -0.2f && !scene.occluded(p, l, 1e30f)) {
+        if (cos_l > 0.0f && l.z() > -0.2f && (++rays, !scene.occluded(p, l, 1e30f))) {
           out.radiance += throughput.cwiseProduct(brdf).cwiseProduct(sun_irradiance) * cos_l;
         }
       }
@@ -175,18 +190,20 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const int tile_count = tiles_x * tiles_y;
   std::atomic<int> done{0};
   std::atomic<bool> cancelled{false};
+  std::atomic<std::uint64_t> total_rays{0};
   progress(0.0, "rendering");
   const float inv_spp = 1.0f / static_cast<float>(settings.samples_per_pixel);
   tbb::parallel_for(0, tile_count, [&](int tile) {
     if (cancelled.load(std::memory_order_relaxed)) return;
     const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+    std::uint64_t tile_rays = 0;
     for (int y = y0; y < std::min(y0 + kTile, settings.height); ++y) {
       for (int x = x0; x < std::min(x0 + kTile, settings.width); ++x) {
         PixelSample sum;
         const std::uint64_t pixel = static_cast<std::uint64_t>(y) * settings.width + x;
         for (int s = 0; s < settings.samples_per_pixel; ++s) {
           SampleStream rng(settings.seed, pixel, static_cast<std::uint64_t>(s));
-          const PixelSample one = trace(x, y, rng);
+          const PixelSample one = trace(x, y, rng, tile_rays);
           sum.radiance += one.radiance;
           sum.depth += one.depth;
           sum.normal += one.normal;
@@ -200,10 +217,16 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         for (int c = 0; c < 10; ++c) image.at(x, y, c) = values[c];
       }
     }
+    total_rays += tile_rays;  // integer sums: the same whatever the order
     const int finished = ++done;
     if (!progress(static_cast<double>(finished) / tile_count, "")) cancelled = true;
   });
   if (cancelled) throw Cancelled();
+  if (stats) {
+    stats->camera_rays = static_cast<std::uint64_t>(settings.width) * settings.height *
+                         static_cast<std::uint64_t>(settings.samples_per_pixel);
+    stats->rays = total_rays;
+  }
   return image;
 }
 

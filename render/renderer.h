@@ -4,6 +4,8 @@
 // the image is the same bits for any thread count and tile order.
 #pragma once
 
+#include <cstdint>
+
 #include "render/image.h"
 #include "render/render_settings.h"
 #include "render/terrain_scene.h"
@@ -15,14 +17,32 @@ namespace drift::render {
 // looking north at its highest point.
 Camera default_camera(const TerrainScene& scene);
 
+// A pinhole camera in the scene's local frame (z up; straight up or down keeps
+// north as "up" in the image).
+struct Pinhole {
+  Eigen::Vector3f eye, forward, right, up;
+  float tan_half = 0.0f, aspect = 1.0f;
+  int width = 1, height = 1;
+  // Unit direction through image position (x, y) in pixels, (0, 0) top left.
+  Eigen::Vector3f direction(float x, float y) const;
+};
+Pinhole make_pinhole(const TerrainScene& scene, const Camera& camera, int width, int height);
+
 // Radiance of the simple sky in direction `dir` (unit, world z up); the sun's
 // disc is not included (the sun is sampled explicitly).
 Eigen::Vector3f sky_radiance(const Sky& sky, const Eigen::Vector3f& dir);
+
+// Counts of the work a render did (for benchmarks and logs).
+struct RenderStats {
+  std::uint64_t camera_rays = 0;
+  std::uint64_t rays = 0;  // all intersection and shadow rays
+};
 
 // Renders channels R, G, B (linear radiance) and AOVs "depth" (metres along
 // the camera ray to the first hit, 0 for sky), "normal.X/Y/Z" and
 // "albedo.R/G/B" of the first hit. `camera` is in the raster's CRS.
 Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,
-                   const RenderSettings& settings, const ProgressFn& progress = no_progress);
+                   const RenderSettings& settings, const ProgressFn& progress = no_progress,
+                   RenderStats* stats = nullptr);
 
 }  // namespace drift::render
