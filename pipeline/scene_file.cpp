@@ -230,12 +230,12 @@ SceneFile read_scene_file(const fs::path& path) {
           fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path) : base / *mesh_path;
       placed.mesh = terrain::read_obj(mp, y_up);
       const double a = rotate * M_PI / 180.0;
-      const Eigen::Vector3d t = position ? *position : Eigen::Vector3d::Zero();
+      placed.position = position ? *position : Eigen::Vector3d::Zero();
       for (auto& p : placed.mesh.positions) {
         const double x = p.x() * scale, y = p.y() * scale, z = p.z() * scale;
-        p = Eigen::Vector3f(static_cast<float>(std::cos(a) * x - std::sin(a) * y + t.x()),
-                            static_cast<float>(std::sin(a) * x + std::cos(a) * y + t.y()),
-                            static_cast<float>(z + t.z()));
+        p = Eigen::Vector3f(static_cast<float>(std::cos(a) * x - std::sin(a) * y),
+                            static_cast<float>(std::sin(a) * x + std::cos(a) * y),
+                            static_cast<float>(z));
       }
       in.meshes.push_back(std::move(placed));
     }

@@ -38,7 +38,10 @@ struct Camera {
 };
 
 struct PlacedMesh {
-  terrain::Mesh mesh;
+  terrain::Mesh mesh;  // in its own frame (metres), already rotated and scaled
+  // Where the mesh's origin stands, in the raster's CRS. Kept in double: UTM
+  // coordinates in float would lose half a metre.
+  Eigen::Vector3d position{0, 0, 0};
   Eigen::Vector3f albedo{0.5f, 0.5f, 0.5f};
 };
 
@@ -54,7 +57,7 @@ struct SceneInput {
   terrain::HeightField terrain;  // metric CRS (or local), heights in metres
   double vertical_exaggeration = 1.0;
   Eigen::Vector3f terrain_albedo{0.28f, 0.26f, 0.23f};
-  std::vector<PlacedMesh> meshes;  // in world metres
+  std::vector<PlacedMesh> meshes;
   Sun sun;
   Sky sky;
   std::optional<Camera> camera;  // none: the default view of the terrain

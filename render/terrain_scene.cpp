@@ -145,8 +145,10 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                           RTC_FORMAT_FLOAT3, 3 * sizeof(float),
                                                           placed.mesh.positions.size()));
+    const Eigen::Vector3d shift = placed.position - origin_;  // CRS -> local
     for (std::size_t i = 0; i < placed.mesh.positions.size(); ++i) {
-      for (int c = 0; c < 3; ++c) v[3 * i + c] = placed.mesh.positions[i][c];
+      const Eigen::Vector3d local = placed.mesh.positions[i].cast<double>() + shift;
+      for (int c = 0; c < 3; ++c) v[3 * i + c] = static_cast<float>(local[c]);
     }
     auto* idx = static_cast<unsigned*>(
         rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,

@@ -131,3 +131,21 @@ TEST(RenderCommand, BadSizeIsAUsageError) {
                           " --size 0x10 -o /tmp/x.png 2>/dev/null";
   EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 2);
 }
+
+TEST(SceneFile, ObjectsAreLoadedAndPlaced) {
+  const fs::path dir = fs::temp_directory_path() / "drift_scene_tests" / "objects";
+  fs::create_directories(dir);
+  std::ofstream(dir / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const fs::path p = write_scene(
+      "obj.toml", std::string(kTerrain) + "[[objects]]\nmesh = \"" + (dir / "tri.obj").string() +
+                      "\"\nposition = [100, 200, 5]\nscale = 2\nrotate_z = 90\n");
+  const auto s = drift::pipeline::read_scene_file(p);
+  ASSERT_EQ(s.input.meshes.size(), 1u);
+  const auto& v = s.input.meshes[0].mesh.positions;
+  // (1, 0, 0) scaled by 2 and turned 90 degrees anticlockwise is (0, 2, 0),
+  // standing at the object's position.
+  EXPECT_NEAR(v[1].x(), 0.0f, 1e-5f);
+  EXPECT_NEAR(v[1].y(), 2.0f, 1e-5f);
+  EXPECT_NEAR(v[1].z(), 0.0f, 1e-5f);
+  EXPECT_EQ(s.input.meshes[0].position, Eigen::Vector3d(100, 200, 5));
+}

@@ -135,3 +135,31 @@ TEST(Renderer, AllNodataTerrainIsAnError) {
   in.terrain = make_dem(8, 1.0, [](double, double) { return std::nan(""); });
   EXPECT_THROW(TerrainScene scene(in), drift::Error);
 }
+
+TEST(Renderer, MeshRoofShadowsTheGround) {
+  // A 40 m square roof 20 m above flat ground, sun overhead, black sky: the
+  // ground under the roof's centre is dark, open ground follows the cosine law.
+  SceneInput in;
+  in.terrain = make_dem(64, 10.0, [](double, double) { return 0.0; });
+  in.terrain_albedo = {0.5f, 0.5f, 0.5f};
+  in.sky.constant = true;
+  in.sky.intensity = 0.0f;
+  in.sun.elevation_deg = 90.0;
+  in.sun.color = {1, 1, 1};
+  in.sun.irradiance = 1.0;
+  const TerrainScene probe(in);
+  PlacedMesh roof;
+  roof.position = probe.origin();  // the DEM's centre, ground level
+  const float z = 20.0f;
+  for (auto [x, y] : {std::pair{-20.f, -20.f}, {20.f, -20.f}, {20.f, 20.f}, {-20.f, 20.f}}) {
+    roof.mesh.positions.emplace_back(x, y, z);
+  }
+  roof.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  in.meshes.push_back(roof);
+  const TerrainScene scene(in);
+  Hit hit;
+  ASSERT_TRUE(scene.intersect({0, 0, 100}, {0, 0, -1}, hit));
+  EXPECT_NEAR(hit.position.z(), z, 1e-3f) << "the first hit from above is the roof";
+  EXPECT_TRUE(scene.occluded({0, 0, 0.01f}, {0, 0, 1}, 1e30f)) << "under the roof";
+  EXPECT_FALSE(scene.occluded({60, 0, 0.01f}, {0, 0, 1}, 1e30f)) << "open ground";
+}
