@@ -94,3 +94,20 @@ TEST(RasterIo, FailedWriteLeavesExistingFileUntouched) {
   in >> s;
   EXPECT_EQ(s, "good");
 }
+
+TEST(RasterIo, RasterLargerThanMemoryIsRefusedBeforeReading) {
+  // A 200000 x 200000 float32 raster (160 GB) described by a tiny VRT: the read
+  // must be refused up front, naming the file and the fix, never attempted.
+  const fs::path vrt = scratch("huge.vrt");
+  std::ofstream(vrt) << "<VRTDataset rasterXSize=\"200000\" rasterYSize=\"200000\">\n"
+                        "  <VRTRasterBand dataType=\"Float32\" band=\"1\"/>\n"
+                        "</VRTDataset>\n";
+  try {
+    drift::terrain::read_raster(vrt);
+    FAIL() << "no error";
+  } catch (const drift::Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("huge.vrt"), std::string::npos) << m;
+    EXPECT_NE(m.find("crop"), std::string::npos) << m;
+  }
+}
