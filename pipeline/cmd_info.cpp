@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "pipeline/cli.h"
+#include "terrain/import.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -33,6 +34,10 @@ void run_info(const InfoOptions& o) {
   std::printf("driver:    %s (%s, %d band%s)\n", header.driver.c_str(), header.data_type.c_str(),
               header.bands, header.bands == 1 ? "" : "s");
   std::printf("size:      %d x %d cells\n", header.width, header.height);
+  std::string crs;
+  const auto metres = terrain::cell_size_metres(header.geo, header.width, header.height, &crs);
+  std::printf("crs:       %s\n", crs.c_str());
+  std::printf("cell:      %.2f x %.2f m (east-west x north-south)\n", metres[0], metres[1]);
   if (invalid == grid.size()) {
     std::printf("heights:   all cells are nodata\n");
   } else {

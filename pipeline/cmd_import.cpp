@@ -1,0 +1,62 @@
+// drift import DEM -o OUT.tif: any raster GDAL reads -> float32 GeoTIFF in
+// metres (UTM of its centre), nodata filled, optionally cropped and resampled.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+
+#include "pipeline/cli.h"
+#include "terrain/import.h"
+#include "terrain/raster_io.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+struct ImportCommand {
+  std::string input, output;
+  std::vector<double> crop, crop_lonlat;
+  double resample = 0.0;
+  terrain::ImportOptions options;
+};
+
+void run_import(const ImportCommand& c) {
+  terrain::ImportOptions o = c.options;
+  if (!c.crop.empty()) o.crop = std::array<double, 4>{c.crop[0], c.crop[1], c.crop[2], c.crop[3]};
+  if (!c.crop_lonlat.empty()) {
+    o.crop_lonlat = std::array<double, 4>{c.crop_lonlat[0], c.crop_lonlat[1], c.crop_lonlat[2],
+                                          c.crop_lonlat[3]};
+  }
+  if (c.resample > 0) o.resample_m = c.resample;
+  const terrain::ImportResult r = terrain::import_dem(c.input, o);
+  terrain::write_geotiff(r.grid, c.output, {"height (m)", "m"});
+  for (const auto& line : r.report) std::printf("import: %s\n", line.c_str());
+  std::printf("import: wrote %s\n", c.output.c_str());
+}
+
+}  // namespace
+
+void add_import_command(CLI::App& root) {
+  auto c = std::make_shared<ImportCommand>();
+  CLI::App* sub = add_subcommand(
+      root, "import", "any DEM GDAL reads -> float32 GeoTIFF in metres (UTM), nodata filled",
+      [c] { run_import(*c); });
+  sub->add_option("dem", c->input, "input raster (GeoTIFF, .hgt, DTED, ASCII grid, USGS DEM, ...)")
+      ->required();
+  sub->add_option("-o,--output", c->output, "output GeoTIFF")->required();
+  auto* crop = sub->add_option("--crop", c->crop, "xmin,ymin,xmax,ymax in the DEM's own CRS")
+                   ->expected(4)
+                   ->delimiter(',');
+  sub->add_option("--crop-lonlat", c->crop_lonlat, "west,south,east,north in degrees (WGS 84)")
+      ->expected(4)
+      ->delimiter(',')
+      ->excludes(crop);
+  sub->add_option("--resample", c->resample, "output cell size in metres")
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--keep-crs", c->options.keep_crs, "keep a geographic CRS (cells stay degrees)");
+  sub->add_option("--exaggerate", c->options.exaggeration, "vertical exaggeration (0, 100]")
+      ->check(CLI::Range(1e-6, 100.0));
+}
+
+DRIFT_COMMAND(10, add_import_command);
+
+}  // namespace drift::pipeline

@@ -1,0 +1,211 @@
+#include "terrain/import.h"
+
+#include <gdal_priv.h>
+#include <gdal_utils.h>
+#include <ogr_spatialref.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <memory>
+
+#include "terrain/error.h"
+#include "terrain/memory.h"
+#include "terrain/raster_io.h"
+
+namespace drift::terrain {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+// lon/lat (WGS 84) of a point given in `srs`.
+std::array<double, 2> to_lonlat(const OGRSpatialReference& srs, double x, double y) {
+  OGRSpatialReference wgs84;
+  wgs84.importFromEPSG(4326);
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRSpatialReference src(srs);
+  src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&src, &wgs84));
+  if (!ct || !ct->Transform(1, &x, &y)) throw Error("cannot locate the DEM on the globe");
+  return {x, y};
+}
+
+}  // namespace
+
+// Metres per degree of latitude and longitude at `lat_deg` on WGS 84 (the
+// standard series expansion, accurate to centimetres).
+std::array<double, 2> metres_per_degree(double lat_deg) {
+  const double lat = lat_deg * M_PI / 180.0;
+  return {111412.84 * std::cos(lat) - 93.5 * std::cos(3 * lat),
+          111132.92 - 559.82 * std::cos(2 * lat) + 1.175 * std::cos(4 * lat)};
+}
+
+std::array<double, 2> cell_size_metres(const GeoReference& geo, int width, int height,
+                                       std::string* crs_name) {
+  OGRSpatialReference srs;
+  const double dx = std::fabs(geo.cell_size_x()), dy = std::fabs(geo.cell_size_y());
+  if (geo.crs_wkt.empty() || srs.importFromWkt(geo.crs_wkt.c_str()) != OGRERR_NONE) {
+    if (crs_name) *crs_name = "none (local grid, units taken as metres)";
+    return {dx, dy};
+  }
+  if (crs_name) *crs_name = srs.GetName() ? srs.GetName() : "unnamed";
+  if (!srs.IsGeographic()) {
+    const double unit = srs.GetLinearUnits();
+    return {dx * unit, dy * unit};
+  }
+  const auto c = geo.cell_center(width / 2.0 - 0.5, height / 2.0 - 0.5);
+  const auto lonlat = to_lonlat(srs, c[0], c[1]);
+  const auto m = metres_per_degree(lonlat[1]);
+  return {dx * m[0], dy * m[1]};
+}
+
+int utm_epsg(double lon, double lat) {
+  const int zone = std::clamp(static_cast<int>(std::floor((lon + 180.0) / 6.0)) + 1, 1, 60);
+  return (lat >= 0 ? 32600 : 32700) + zone;
+}
+
+std::size_t fill_nodata(HeightField& g, const std::string& what) {
+  std::size_t missing = 0;
+  for (float v : g.values()) missing += std::isnan(v);
+  if (missing == g.size()) {
+    throw Error("'" + what + "' holds no valid height (every cell is nodata or NaN)");
+  }
+  std::size_t filled = 0;
+  while (missing > 0) {
+    HeightField next = g;
+    for (int r = 0; r < g.height(); ++r) {
+      for (int x = 0; x < g.width(); ++x) {
+        if (!std::isnan(g(x, r))) continue;
+        double sum = 0;
+        int count = 0;
+        for (int dr = -1; dr <= 1; ++dr)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx, rr = r + dr;
+            if (xx < 0 || rr < 0 || xx >= g.width() || rr >= g.height()) continue;
+            if (!std::isnan(g(xx, rr))) sum += g(xx, rr), ++count;
+          }
+        if (count > 0) {
+          next(x, r) = static_cast<float>(sum / count);
+          ++filled;
+          --missing;
+        }
+      }
+    }
+    g = std::move(next);
+  }
+  return filled;
+}
+
+ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
+  if (o.crop && o.crop_lonlat) throw Error("give --crop or --crop-lonlat, not both");
+  if (o.resample_m && !(*o.resample_m > 0 && std::isfinite(*o.resample_m))) {
+    throw Error("--resample must be a positive cell size in metres");
+  }
+  if (!(o.exaggeration > 0 && o.exaggeration <= 100)) {
+    throw Error("--exaggerate must lie in (0, 100], got " + fmt(o.exaggeration));
+  }
+  const RasterHeader header = read_raster_header(path);  // clear errors for bad files
+  ImportResult result;
+  result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
+                          std::to_string(header.width) + " x " + std::to_string(header.height));
+
+  OGRSpatialReference srs;
+  const bool has_crs =
+      !header.geo.crs_wkt.empty() && srs.importFromWkt(header.geo.crs_wkt.c_str()) == OGRERR_NONE;
+  const bool geographic = has_crs && srs.IsGeographic();
+  const bool reproject = geographic && !o.keep_crs;
+
+  std::vector<std::string> args = {"-of",      "GTiff",      "-ot", "Float32",   "-r",
+                                   "bilinear", "-dstnodata", "nan", "-overwrite"};
+  double cell = 0.0;
+  if (reproject) {
+    const auto c = header.geo.cell_center(header.width / 2.0 - 0.5, header.height / 2.0 - 0.5);
+    const auto lonlat = to_lonlat(srs, c[0], c[1]);
+    const int epsg = utm_epsg(lonlat[0], lonlat[1]);
+    // Square cells near the source's finest metric spacing.
+    const auto metric = cell_size_metres(header.geo, header.width, header.height);
+    const double cx = metric[0], cy = metric[1];
+    cell = std::round(std::min(cx, cy) * 100.0) / 100.0;
+    args.insert(args.end(), {"-t_srs", "EPSG:" + std::to_string(epsg)});
+    result.report.push_back("reprojected " + std::string(srs.GetName() ? srs.GetName() : "?") +
+                            " -> EPSG:" + std::to_string(epsg) + " (UTM zone " +
+                            std::to_string(epsg % 100) + (epsg < 32700 ? "N" : "S") +
+                            "), source cells " + fmt(std::round(cx * 100) / 100) + " x " +
+                            fmt(std::round(cy * 100) / 100) + " m");
+  } else {
+    cell = std::fabs(header.geo.cell_size_x());
+    if (geographic)
+      result.report.push_back("kept the geographic CRS (--keep-crs): cells are degrees");
+  }
+  if (o.resample_m) cell = *o.resample_m;
+  if (!(cell > 0)) throw Error("'" + path.string() + "' has no usable cell size");
+  args.insert(args.end(), {"-tr", fmt(cell), fmt(cell)});
+  if (o.crop) {
+    const auto& b = *o.crop;
+    args.insert(args.end(), {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3])});
+    if (has_crs) args.insert(args.end(), {"-te_srs", header.geo.crs_wkt});
+  } else if (o.crop_lonlat) {
+    const auto& b = *o.crop_lonlat;
+    if (!(b[0] < b[2] && b[1] < b[3])) throw Error("--crop-lonlat needs W < E and S < N");
+    args.insert(args.end(),
+                {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3]), "-te_srs", "EPSG:4326"});
+  }
+  // The warped grid covers at most about the source's area at `cell`: check it fits.
+  const double src_area_cells = static_cast<double>(header.width) * header.height;
+  require_memory(static_cast<std::uint64_t>(src_area_cells * 4.0 * 6.0),
+                 "importing '" + path.string() + "'", "crop it with --crop-lonlat first");
+
+  ensure_gdal();
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopts(
+      GDALWarpAppOptionsNew(argv.data(), nullptr), GDALWarpAppOptionsFree);
+  if (!wopts) throw Error("internal: bad warp options for '" + path.string() + "'");
+  GDALDatasetH src = GDALOpen(path.c_str(), GA_ReadOnly);
+  if (!src) throw Error("cannot open '" + path.string() + "': " + last_gdal_message());
+  const fs::path temp =
+      fs::temp_directory_path() / ("drift-import-" + std::to_string(getpid()) + ".tif");
+  int usage_error = 0;
+  GDALDatasetH dst = GDALWarp(temp.c_str(), nullptr, 1, &src, wopts.get(), &usage_error);
+  GDALClose(src);
+  if (!dst) {
+    std::error_code ec;
+    fs::remove(temp, ec);
+    throw Error("cannot warp '" + path.string() + "': " + last_gdal_message() +
+                (o.crop || o.crop_lonlat ? " (does the crop box overlap the DEM?)" : ""));
+  }
+  GDALClose(dst);
+  try {
+    result.grid = read_raster(temp);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(temp, ec);
+    throw;
+  }
+  std::error_code ec;
+  fs::remove(temp, ec);
+  result.report.push_back("grid " + std::to_string(result.grid.width()) + " x " +
+                          std::to_string(result.grid.height()) + " cells of " + fmt(cell) +
+                          (reproject || !geographic ? " m" : " deg"));
+
+  result.filled_cells = fill_nodata(result.grid, path.string());
+  if (result.filled_cells > 0) {
+    result.report.push_back("filled " + std::to_string(result.filled_cells) +
+                            " nodata cells from their neighbours");
+  }
+  if (o.exaggeration != 1.0) {
+    for (float& v : result.grid.values()) v = static_cast<float>(v * o.exaggeration);
+    result.report.push_back("heights exaggerated x" + fmt(o.exaggeration));
+  }
+  result.grid.geo().nodata.reset();
+  return result;
+}
+
+}  // namespace drift::terrain

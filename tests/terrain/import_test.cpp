@@ -1,0 +1,113 @@
+// DEM import: reprojection to UTM with metric cells, nodata fill, crop, and the
+// command line's behaviour on bad input.
+#include "terrain/import.h"
+
+#include <gtest/gtest.h>
+#include <ogr_spatialref.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "terrain/error.h"
+#include "terrain/raster_io.h"
+
+namespace fs = std::filesystem;
+using namespace drift::terrain;
+
+namespace {
+fs::path data(const char* name) { return fs::path(DRIFT_SOURCE_DIR) / "data" / name; }
+
+int epsg_of(const HeightField& g) {
+  OGRSpatialReference srs;
+  srs.importFromWkt(g.geo().crs_wkt.c_str());
+  srs.AutoIdentifyEPSG();
+  const char* code = srs.GetAuthorityCode(nullptr);
+  return code ? std::atoi(code) : 0;
+}
+}  // namespace
+
+TEST(Import, GeographicDemBecomesUtmWithMetricCells) {
+  // Yarigatake: 0.4" cells are ~10.0 m E-W and ~12.3 m N-S at 36.4 N (data/SOURCES.md).
+  const ImportResult r = import_dem(data("yarigatake_gsi_dem10b_jgd2000.tif"), {});
+  EXPECT_EQ(epsg_of(r.grid), 32653);  // UTM zone 53N
+  EXPECT_NEAR(r.grid.geo().cell_size_x(), 9.97, 0.05);
+  EXPECT_DOUBLE_EQ(r.grid.geo().cell_size_x(), r.grid.geo().cell_size_y());
+  float hi = -1e9f;
+  for (float v : r.grid.values()) {
+    ASSERT_FALSE(std::isnan(v));
+    hi = std::max(hi, v);
+  }
+  EXPECT_NEAR(hi, 3181.4f, 5.0f) << "the summit survives bilinear warping";
+}
+
+TEST(Import, UtmZoneFromLonLat) {
+  EXPECT_EQ(utm_epsg(137.69, 36.37), 32653);
+  EXPECT_EQ(utm_epsg(-118.3, 36.5), 32611);
+  EXPECT_EQ(utm_epsg(151.2, -33.9), 32756);  // Sydney: southern hemisphere
+}
+
+TEST(Import, ProjectedDemKeepsCrsAndFillsNodata) {
+  // St Helens: UTM 10N (NAD27), 30 m, 4151 nodata cells (data/SOURCES.md).
+  const ImportResult r = import_dem(data("mount_st_helens_usgs_30m.dem"), {});
+  EXPECT_EQ(r.grid.width(), 327);
+  EXPECT_EQ(r.grid.height(), 468);
+  EXPECT_EQ(r.filled_cells, 4151u);
+  EXPECT_EQ(epsg_of(r.grid), 26710);
+}
+
+TEST(Import, CropByLonLatBox) {
+  ImportOptions o;
+  o.crop_lonlat = std::array<double, 4>{-118.4, 36.5, -118.2, 36.65};
+  const ImportResult r = import_dem(data("N36W119.hgt"), o);
+  // 0.2 deg x 0.15 deg at 36.6 N is about 17.9 km x 16.6 km; cells ~74.7 m.
+  EXPECT_NEAR(r.grid.width() * r.grid.geo().cell_size_x(), 17900, 600);
+  EXPECT_NEAR(r.grid.height() * r.grid.geo().cell_size_y(), 16650, 600);
+}
+
+TEST(Import, ResampleAndExaggerate) {
+  ImportOptions o;
+  o.resample_m = 60.0;
+  o.exaggeration = 2.0;
+  const ImportResult base = import_dem(data("mount_st_helens_usgs_30m.dem"), {});
+  const ImportResult r = import_dem(data("mount_st_helens_usgs_30m.dem"), o);
+  EXPECT_DOUBLE_EQ(r.grid.geo().cell_size_x(), 60.0);
+  EXPECT_NEAR(r.grid.width(), 327 / 2, 1);
+  float hi_base = -1e9f, hi = -1e9f;
+  for (float v : base.grid.values()) hi_base = std::max(hi_base, v);
+  for (float v : r.grid.values()) hi = std::max(hi, v);
+  EXPECT_NEAR(hi, 2.0f * hi_base, 0.05f * hi_base);
+}
+
+TEST(Import, AllNodataIsAnError) {
+  HeightField g(4, 4, std::nanf(""));
+  EXPECT_THROW(fill_nodata(g, "test grid"), drift::Error);
+}
+
+TEST(Import, FillNodataIsLocalAndComplete) {
+  HeightField g(5, 5, 10.0f);
+  g(2, 2) = std::nanf("");
+  g(0, 0) = std::nanf("");
+  EXPECT_EQ(fill_nodata(g, "g"), 2u);
+  EXPECT_FLOAT_EQ(g(2, 2), 10.0f);
+  EXPECT_FLOAT_EQ(g(0, 0), 10.0f);
+}
+
+TEST(ImportCommand, MissingFileExitsOneAndWritesNothing) {
+  const fs::path out = fs::temp_directory_path() / "drift_import_missing.tif";
+  fs::remove(out);
+  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " import /nonexistent.tif -o " +
+                          out.string() + " 2>/dev/null";
+  EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(ImportCommand, WritesAUtmGeoTiff) {
+  const fs::path out = fs::temp_directory_path() / "drift_import_ok.tif";
+  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " import " +
+                          data("jacksboro_fault_tn_3arcsec.tif").string() + " -o " + out.string() +
+                          " >/dev/null";
+  ASSERT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 0);
+  const HeightField g = read_raster(out);
+  EXPECT_EQ(epsg_of(g), 32616);  // 84.2 W -> UTM zone 16N
+}
