@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
 
@@ -83,22 +84,14 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   const float x0 = static_cast<float>(nw[0] - origin_.x());
   const float y0 = static_cast<float>(nw[1] - origin_.y());
 
+  // Shading normals: Horn's gradient of the (exaggerated) DEM, the same as
+  // the slope and aspect rasters (terrain/derivatives.h).
+  vertex_normals_ = terrain::normals(dem, k).values();
   vertices_.resize(n);
-  vertex_normals_.resize(n);
   tbb::parallel_for(0, height_, [&](int row) {
     for (int x = 0; x < width_; ++x) {
       const std::size_t i = static_cast<std::size_t>(row) * width_ + x;
       vertices_[i] = {x0 + x * dx_, y0 - row * dy_, heights_[i] - static_cast<float>(origin_.z())};
-      // Central differences (one-sided at the edges); y grows north, rows south.
-      const int xl = std::max(x - 1, 0), xr = std::min(x + 1, width_ - 1);
-      const int rn = std::max(row - 1, 0), rs = std::min(row + 1, height_ - 1);
-      const float dzdx = (heights_[static_cast<std::size_t>(row) * width_ + xr] -
-                          heights_[static_cast<std::size_t>(row) * width_ + xl]) /
-                         ((xr - xl) * dx_);
-      const float dzdy = (heights_[static_cast<std::size_t>(rn) * width_ + x] -
-                          heights_[static_cast<std::size_t>(rs) * width_ + x]) /
-                         ((rs - rn) * dy_);
-      vertex_normals_[i] = Eigen::Vector3f(-dzdx, -dzdy, 1.0f).normalized();
     }
   });
   std::size_t hi_i = 0, lo_i = 0;

@@ -1,0 +1,76 @@
+// Terrain stage throughput: import (GDAL warp to UTM, nodata fill) of the
+// shipped Yarigatake DEM, and derived rasters (slope, normals, pyramid) on
+// square DEMs of the sizes users render.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "terrain/derivatives.h"
+#include "terrain/import.h"
+#include "tests/bench/peak_memory.h"
+
+namespace {
+
+using drift::terrain::HeightField;
+
+// Rolling synthetic relief (a few octaves of sines), 10 m cells.
+HeightField relief(int n) {
+  HeightField dem(n, n, 0.0f, drift::terrain::local_georeference(10.0));
+  for (int row = 0; row < n; ++row) {
+    for (int x = 0; x < n; ++x) {
+      float z = 0.0f;
+      for (int octave = 0; octave < 4; ++octave) {
+        const float f = 0.003f * static_cast<float>(1 << octave);
+        z += 400.0f / static_cast<float>(1 << octave) * std::sin(f * x + 1.3f * octave) *
+             std::cos(f * 0.8f * row);
+      }
+      dem(x, row) = 1000.0f + z;
+    }
+  }
+  return dem;
+}
+
+void report(benchmark::State& state, double cells) {
+  state.counters["cells/s"] = benchmark::Counter(cells * static_cast<double>(state.iterations()),
+                                                 benchmark::Counter::kIsRate);
+  state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
+}
+
+void BM_Import(benchmark::State& state) {
+  const auto source =
+      std::filesystem::path(DRIFT_SOURCE_DIR) / "data" / "yarigatake_gsi_dem10b_jgd2000.tif";
+  double cells = 0;
+  for (auto _ : state) {
+    const auto result = drift::terrain::import_dem(source, {});
+    cells = static_cast<double>(result.grid.size());
+    benchmark::DoNotOptimize(result.grid.data());
+  }
+  report(state, cells);
+}
+BENCHMARK(BM_Import)->Unit(benchmark::kMillisecond);
+
+void BM_Slope(benchmark::State& state) {
+  const HeightField dem = relief(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(drift::terrain::slope_degrees(dem).data());
+  report(state, static_cast<double>(dem.size()));
+}
+BENCHMARK(BM_Slope)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+void BM_Normals(benchmark::State& state) {
+  const HeightField dem = relief(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(drift::terrain::normals(dem).data());
+  report(state, static_cast<double>(dem.size()));
+}
+BENCHMARK(BM_Normals)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+void BM_Pyramid(benchmark::State& state) {
+  const HeightField dem = relief(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(drift::terrain::pyramid(dem).size());
+  report(state, static_cast<double>(dem.size()));
+}
+BENCHMARK(BM_Pyramid)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
