@@ -65,6 +65,37 @@ TEST(Import, CropByLonLatBox) {
   EXPECT_NEAR(r.grid.height() * r.grid.geo().cell_size_y(), 16650, 600);
 }
 
+TEST(Import, CropByBoxInTheDemsOwnCrs) {
+  // St Helens in its UTM 10N metres: a 3 km x 2.4 km box on whole 30 m cells.
+  const ImportResult full = import_dem(data("mount_st_helens_usgs_30m.dem"), {});
+  const auto& gt = full.grid.geo().geotransform;
+  const double x0 = gt[0] + 60 * 30.0, y1 = gt[3] - 90 * 30.0;
+  ImportOptions o;
+  o.crop = std::array<double, 4>{x0, y1 - 2400.0, x0 + 3000.0, y1};
+  const ImportResult r = import_dem(data("mount_st_helens_usgs_30m.dem"), o);
+  EXPECT_EQ(r.grid.width(), 100);
+  EXPECT_EQ(r.grid.height(), 80);
+  EXPECT_DOUBLE_EQ(r.grid.geo().geotransform[0], x0);
+  EXPECT_DOUBLE_EQ(r.grid.geo().geotransform[3], y1);
+  EXPECT_EQ(epsg_of(r.grid), 26710);
+  // Same heights as the uncropped import, cell for cell.
+  for (int row = 0; row < r.grid.height(); row += 7) {
+    for (int x = 0; x < r.grid.width(); x += 9) {
+      EXPECT_FLOAT_EQ(r.grid(x, row), full.grid(x + 60, row + 90)) << x << "," << row;
+    }
+  }
+}
+
+TEST(Import, KeepCrsLeavesAGeographicDemInDegrees) {
+  ImportOptions o;
+  o.keep_crs = true;
+  const ImportResult r = import_dem(data("mount_whitney_srtm3_crop.asc"), o);
+  EXPECT_LT(r.grid.geo().cell_size_x(), 0.01);  // still degrees (3 arc-seconds)
+  OGRSpatialReference srs;
+  srs.importFromWkt(r.grid.geo().crs_wkt.c_str());
+  EXPECT_TRUE(srs.IsGeographic());
+}
+
 TEST(Import, ResampleAndExaggerate) {
   ImportOptions o;
   o.resample_m = 60.0;
