@@ -155,13 +155,13 @@ SceneFile read_scene_file(const fs::path& path) {
     throw Error(path.string() + ":" + std::to_string(e.source().begin.line) +
                 ": TOML syntax error: " + std::string(e.description()));
   }
-  static const std::set<std::string> sections = {"terrain", "sun",    "sky",    "camera",
-                                                 "render",  "output", "objects"};
+  static const std::set<std::string> sections = {"terrain", "snow",   "ripples", "sun",    "sky",
+                                                 "camera",  "render", "output",  "objects"};
   for (const auto& [k, node] : root) {
     if (!sections.count(std::string(k.str()))) {
       throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
                   ": unknown section '" + std::string(k.str()) +
-                  "' (known: terrain, sun, sky, camera, objects, render, output)");
+                  "' (known: terrain, snow, ripples, sun, sky, camera, objects, render, output)");
     }
   }
   const fs::path base = path.parent_path();
@@ -171,10 +171,46 @@ SceneFile read_scene_file(const fs::path& path) {
   Section terrain(subtable(root, "terrain", path), "terrain", path);
   const auto raster = terrain.string("raster");
   if (!raster) throw Error(path.string() + ": '[terrain] raster' is required (a DEM GeoTIFF)");
-  scene.terrain_raster = fs::path(*raster).is_absolute() ? fs::path(*raster) : base / *raster;
+  auto resolve = [&](const std::string& p) {
+    return fs::path(p).is_absolute() ? fs::path(p) : base / p;
+  };
+  scene.terrain_raster = resolve(*raster);
   in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
-  in.terrain_albedo = terrain.color("color", in.terrain_albedo);
+  in.surface.ground.albedo = terrain.color("color", in.surface.ground.albedo);
+  in.surface.ground.roughness =
+      static_cast<float>(terrain.number("roughness", in.surface.ground.roughness, 0.0, 1.5));
   terrain.finish();
+
+  Section snow(subtable(root, "snow", path), "snow", path);
+  if (const auto cover = snow.string("cover")) scene.snow_cover = resolve(*cover);
+  if (const auto depth = snow.string("depth")) scene.snow_depth = resolve(*depth);
+  in.surface.snow.albedo = snow.color("color", in.surface.snow.albedo);
+  in.surface.snow.roughness =
+      static_cast<float>(snow.number("roughness", in.surface.snow.roughness, 0.0, 1.5));
+  snow.finish();
+
+  if (const toml::table* ripple_table = subtable(root, "ripples", path)) {
+    Section rip(ripple_table, "ripples", path);
+    const auto ripple_raster = rip.string("raster");
+    if (!ripple_raster)
+      throw Error(path.string() + ": [ripples] needs 'raster' (a tileable height field from " +
+                  "drift dunes --model ripples)");
+    scene.ripples = resolve(*ripple_raster);
+    render::RippleLayer layer;
+    const double cell = rip.number("cell", 0.0, 0.0, 100.0);
+    if (cell > 0.0) scene.ripple_texel_metres = cell;
+    layer.rotation_deg = rip.number("rotation", 0.0, -360.0, 360.0);
+    layer.strength = static_cast<float>(rip.number("strength", 1.0, 0.0, 100.0));
+    const auto fade = rip.vector<2>("fade_slope", 0.0, 90.0);
+    if (fade) {
+      if (!((*fade)[0] < (*fade)[1]))
+        throw Error(path.string() + ": 'ripples.fade_slope' must be [start, end] with start < end");
+      layer.fade_start_deg = static_cast<float>((*fade)[0]);
+      layer.fade_end_deg = static_cast<float>((*fade)[1]);
+    }
+    rip.finish();
+    in.surface.ripples = std::move(layer);
+  }
 
   Section sun(subtable(root, "sun", path), "sun", path);
   in.sun.azimuth_deg = sun.number("azimuth", in.sun.azimuth_deg, 0.0, 360.0);
@@ -263,15 +299,37 @@ SceneFile read_scene_file(const fs::path& path) {
   return scene;
 }
 
-void load_scene_terrain(SceneFile& scene) {
-  scene.input.terrain = terrain::read_raster(scene.terrain_raster);
-  const std::string& wkt = scene.input.terrain.geo().crs_wkt;
+namespace {
+// Reads a raster the scene places in metres; degrees are an error with the fix.
+terrain::HeightField read_metric_raster(const fs::path& file, const char* role) {
+  terrain::HeightField grid = terrain::read_raster(file);
+  const std::string& wkt = grid.geo().crs_wkt;
   if (!wkt.empty()) {
     OGRSpatialReference srs;
     if (srs.importFromWkt(wkt.c_str()) == OGRERR_NONE && srs.IsGeographic()) {
-      throw Error("terrain '" + scene.terrain_raster.string() +
+      throw Error(std::string(role) + " '" + file.string() +
                   "' is in degrees (geographic CRS); convert it to metres first: drift import " +
-                  scene.terrain_raster.string() + " -o DEM_metric.tif");
+                  file.string() + " -o DEM_metric.tif");
+    }
+  }
+  return grid;
+}
+}  // namespace
+
+void load_scene_terrain(SceneFile& scene) {
+  render::TerrainSurface& surface = scene.input.surface;
+  scene.input.terrain = read_metric_raster(scene.terrain_raster, "terrain");
+  if (!scene.snow_cover.empty())
+    surface.snow_cover = read_metric_raster(scene.snow_cover, "snow cover");
+  if (!scene.snow_depth.empty())
+    surface.snow_depth = read_metric_raster(scene.snow_depth, "snow depth");
+  if (!scene.ripples.empty() && surface.ripples) {
+    const terrain::HeightField tile = read_metric_raster(scene.ripples, "ripple raster");
+    const double texel = scene.ripple_texel_metres.value_or(tile.geo().cell_size_x());
+    try {
+      surface.ripples->slopes = render::SlopePyramid(tile, texel);
+    } catch (const Error& e) {
+      throw Error("ripple raster '" + scene.ripples.string() + "': " + e.what());
     }
   }
 }

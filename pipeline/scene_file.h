@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,10 @@ namespace drift::pipeline {
 
 struct SceneFile {
   std::filesystem::path terrain_raster;  // resolved against the scene file's folder
+  // Layer rasters ([snow] cover and depth, [ripples] raster), resolved likewise;
+  // empty when the scene has none.
+  std::filesystem::path snow_cover, snow_depth, ripples;
+  std::optional<double> ripple_texel_metres;  // default: the ripple raster's cell size
   render::SceneInput input;              // terrain not loaded yet (see load_scene_terrain)
   render::RenderSettings settings;
   std::vector<std::filesystem::path> outputs;  // resolved against the current directory
@@ -23,8 +28,8 @@ struct SceneFile {
 // Parses and validates; meshes are loaded, the terrain raster is not.
 SceneFile read_scene_file(const std::filesystem::path& path);
 
-// Reads the scene's terrain raster; a geographic (degree) raster is an error
-// telling the user to run `drift import` first.
+// Reads the scene's terrain raster and layer rasters; a geographic (degree)
+// raster is an error telling the user to run `drift import` first.
 void load_scene_terrain(SceneFile& scene);
 
 }  // namespace drift::pipeline

@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "render/surface.h"
 #include "terrain/grid.h"
 #include "terrain/mesh.h"
 
@@ -56,7 +57,7 @@ struct RenderSettings {
 struct SceneInput {
   terrain::HeightField terrain;  // metric CRS (or local), heights in metres
   double vertical_exaggeration = 1.0;
-  Eigen::Vector3f terrain_albedo{0.28f, 0.26f, 0.23f};
+  TerrainSurface surface;  // materials and the layers that place them
   std::vector<PlacedMesh> meshes;
   Sun sun;
   Sky sky;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "render/brdf.h"
 #include "render/random.h"
 #include "terrain/error.h"
 
@@ -62,6 +63,7 @@ struct PixelSample {
   float depth = 0.0f;
   Vector3f normal{0, 0, 0};
   Vector3f albedo{0, 0, 0};
+  float snow = 0.0f;
 };
 
 }  // namespace
@@ -129,7 +131,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   }
   Image image(settings.width, settings.height,
               {"R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G",
-               "albedo.B"});
+               "albedo.B", "coverage.snow"});
 
   const Pinhole pinhole = make_pinhole(scene, camera, settings.width, settings.height);
   const Vector3f eye = pinhole.eye;
@@ -147,10 +149,12 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
     Vector3f dir = pinhole.direction(static_cast<float>(px) + jx, static_cast<float>(py) + jy);
     Vector3f origin = eye;
     Vector3f throughput(1, 1, 1);
+    // Camera rays start as wide as a pixel's angle; see RayCone.
+    RayCone cone{0.0f, 2.0f * pinhole.tan_half / static_cast<float>(settings.height)};
     for (int depth = 0; depth < settings.max_depth; ++depth) {
       Hit hit;
       ++rays;
-      if (!scene.intersect(origin, dir, hit)) {
+      if (!scene.intersect(origin, dir, hit, cone)) {
         out.radiance += throughput.cwiseProduct(sky_radiance(input.sky, dir));
         break;
       }
@@ -158,7 +162,9 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         out.depth = hit.distance;
         out.normal = hit.normal;
         out.albedo = hit.albedo;
+        out.snow = hit.snow;
       }
+      const Vector3f wo = -dir;
       const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
       const Vector3f brdf = hit.albedo / kPi;  // Lambert
       // Next-event estimation of the sun: uniform in its cone, pdf 1/solid angle,
@@ -168,13 +174,18 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         const Vector3f l = cone_sample(sun_dir, sun_cos_max, u1, u2);
         const float cos_l = hit.normal.dot(l);
         if (cos_l > 0.0f && l.z() > -0.2f && (++rays, !scene.occluded(p, l, 1e30f))) {
-          out.radiance += throughput.cwiseProduct(brdf).cwiseProduct(sun_irradiance) * cos_l;
+          out.radiance += throughput.cwiseProduct(brdf).cwiseProduct(sun_irradiance) *
+                          (cos_l * oren_nayar_factor(hit.normal, l, wo, hit.roughness));
         }
       }
-      // Bounce: cosine-weighted, so the weight is the albedo.
+      // Bounce: cosine-weighted, so the weight is the albedo (times the
+      // Oren-Nayar factor for rough surfaces).
       dir = cosine_sample(hit.normal, rng.next(), rng.next());
       origin = p;
-      throughput = throughput.cwiseProduct(hit.albedo);
+      throughput = throughput.cwiseProduct(hit.albedo) *
+                   oren_nayar_factor(hit.normal, dir, wo, hit.roughness);
+      // A diffuse bounce spreads the footprint over about a radian.
+      cone = {cone.width + cone.spread * hit.distance, 1.0f};
       if (depth >= 2) {  // Russian roulette (unbiased)
         const float q = std::min(0.95f, throughput.maxCoeff());
         if (rng.next() >= q) break;
@@ -208,13 +219,14 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
           sum.depth += one.depth;
           sum.normal += one.normal;
           sum.albedo += one.albedo;
+          sum.snow += one.snow;
         }
-        const float values[10] = {sum.radiance.x() * inv_spp, sum.radiance.y() * inv_spp,
-                                  sum.radiance.z() * inv_spp, sum.depth * inv_spp,
-                                  sum.normal.x() * inv_spp,   sum.normal.y() * inv_spp,
-                                  sum.normal.z() * inv_spp,   sum.albedo.x() * inv_spp,
-                                  sum.albedo.y() * inv_spp,   sum.albedo.z() * inv_spp};
-        for (int c = 0; c < 10; ++c) image.at(x, y, c) = values[c];
+        const float values[11] = {
+            sum.radiance.x() * inv_spp, sum.radiance.y() * inv_spp, sum.radiance.z() * inv_spp,
+            sum.depth * inv_spp,        sum.normal.x() * inv_spp,   sum.normal.y() * inv_spp,
+            sum.normal.z() * inv_spp,   sum.albedo.x() * inv_spp,   sum.albedo.y() * inv_spp,
+            sum.albedo.z() * inv_spp,   sum.snow * inv_spp};
+        for (int c = 0; c < 11; ++c) image.at(x, y, c) = values[c];
       }
     }
     total_rays += tile_rays;  // integer sums: the same whatever the order

@@ -45,7 +45,12 @@ struct TerrainScene::Embree {
 };
 
 TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<Embree>()) {
-  const terrain::HeightField& dem = input.terrain;
+  // The surface traced is the ground plus any lying snow.
+  const std::optional<terrain::HeightField> snowy =
+      input.surface.snow_depth
+          ? std::optional(add_snow_depth(input.terrain, *input.surface.snow_depth))
+          : std::nullopt;
+  const terrain::HeightField& dem = snowy ? *snowy : input.terrain;
   if (dem.width() < 2 || dem.height() < 2) {
     throw Error("the terrain raster must be at least 2 x 2 cells, got " +
                 std::to_string(dem.width()) + " x " + std::to_string(dem.height()));
@@ -60,7 +65,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   if (!(dx_ > 0) || !(dy_ > 0)) {
     throw Error("the terrain raster's cell size must be positive (north-up, metres)");
   }
-  terrain_albedo_ = input.terrain_albedo;
+  surface_ = input.surface;
   const std::size_t n = dem.size();
   // Vertices, normals and Embree's own grid data (~17.5 B per vertex).
   require_memory(n * (4 + 12 + 12 + 20), "the terrain scene", "crop or resample the DEM");
@@ -130,7 +135,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   rtcAttachGeometryByID(embree_->scene, grid_geometry, 0);
   rtcReleaseGeometry(grid_geometry);
   terrain_geometries_ = 1;
-  mesh_albedo_.push_back(terrain_albedo_);
+  mesh_albedo_.push_back(surface_.ground.albedo);
 
   // Meshes: triangle geometry with their own (copied, shifted) buffers.
   for (const PlacedMesh& placed : input.meshes) {
@@ -176,7 +181,8 @@ float TerrainScene::height_at(float x, float y) const {
          tr * ((1 - tx) * h(x0, r0 + 1) + tx * h(x0 + 1, r0 + 1));
 }
 
-bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit) const {
+bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
+                             const RayCone& cone) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh{};
@@ -205,7 +211,13 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
     n = ((1 - tr) * ((1 - tx) * vn(x0, r0) + tx * vn(x0 + 1, r0)) +
          tr * ((1 - tx) * vn(x0, r0 + 1) + tx * vn(x0 + 1, r0 + 1)))
             .normalized();
-    hit.albedo = terrain_albedo_;
+    const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
+    const SurfacePoint surface =
+        shade_terrain(surface_, world.x(), world.y(), n, cone.width + cone.spread * hit.distance);
+    n = surface.normal;
+    hit.albedo = surface.material.albedo;
+    hit.roughness = surface.material.roughness;
+    hit.snow = surface.snow;
   } else {
     n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
     hit.albedo = mesh_albedo_[rh.hit.geomID];

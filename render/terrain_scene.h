@@ -20,6 +20,16 @@ struct Hit {
   Eigen::Vector3f position{0, 0, 0};  // local (origin-shifted) coordinates
   Eigen::Vector3f normal{0, 0, 1};    // unit shading normal, facing the ray
   Eigen::Vector3f albedo{0, 0, 0};
+  float roughness = 0.0f;  // Oren-Nayar sigma, radians
+  float snow = 0.0f;       // snow coverage of the surface, [0, 1]
+};
+
+// A ray's footprint as a cone (Akenine-Moller et al. 2019, "Texture level of
+// detail strategies for real-time ray tracing"): `width` metres at the origin,
+// growing by `spread` metres per metre travelled. It picks bump-map levels.
+struct RayCone {
+  float width = 0.0f;
+  float spread = 0.0f;
 };
 
 class TerrainScene {
@@ -31,7 +41,10 @@ class TerrainScene {
   TerrainScene(const TerrainScene&) = delete;
   TerrainScene& operator=(const TerrainScene&) = delete;
 
-  bool intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, Hit& hit) const;
+  // The nearest hit, with the surface's layers (snow, ripples) evaluated for a
+  // footprint given by `cone`.
+  bool intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, Hit& hit,
+                 const RayCone& cone = {}) const;
   // True if anything lies on the ray within (0, max_distance).
   bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
                 float max_distance) const;
@@ -57,7 +70,7 @@ class TerrainScene {
   std::vector<float> heights_;             // filled, exaggerated, row 0 = north
   std::vector<Eigen::Vector3f> vertices_;  // Embree's shared vertex buffer
   std::vector<Eigen::Vector3f> vertex_normals_;
-  Eigen::Vector3f terrain_albedo_{0.3f, 0.3f, 0.3f};
+  TerrainSurface surface_;
   std::vector<Eigen::Vector3f> mesh_albedo_;  // by Embree geometry id
   unsigned terrain_geometries_ = 0;           // geometry ids [0, n) are terrain grids
   Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};

@@ -149,3 +149,34 @@ TEST(SceneFile, ObjectsAreLoadedAndPlaced) {
   EXPECT_NEAR(v[1].z(), 0.0f, 1e-5f);
   EXPECT_EQ(s.input.meshes[0].position, Eigen::Vector3d(100, 200, 5));
 }
+
+TEST(SceneFile, ReadsSnowAndRippleLayers) {
+  const fs::path p = write_scene(
+      "layers.toml", std::string(kTerrain) +
+                         "roughness = 0.4\n"
+                         "[snow]\ncover = \"cover.tif\"\ndepth = \"/abs/depth.tif\"\n"
+                         "color = [0.9, 0.9, 0.95]\n"
+                         "[ripples]\nraster = \"ripples.tif\"\ncell = 0.05\nrotation = 30\n"
+                         "strength = 2\nfade_slope = [20, 30]\n");
+  const auto s = drift::pipeline::read_scene_file(p);
+  EXPECT_EQ(s.snow_cover, p.parent_path() / "cover.tif");
+  EXPECT_EQ(s.snow_depth, fs::path("/abs/depth.tif"));
+  EXPECT_EQ(s.ripples, p.parent_path() / "ripples.tif");
+  ASSERT_TRUE(s.ripple_texel_metres.has_value());
+  EXPECT_DOUBLE_EQ(*s.ripple_texel_metres, 0.05);
+  ASSERT_TRUE(s.input.surface.ripples.has_value());
+  EXPECT_DOUBLE_EQ(s.input.surface.ripples->rotation_deg, 30.0);
+  EXPECT_FLOAT_EQ(s.input.surface.ripples->fade_end_deg, 30.0f);
+  EXPECT_FLOAT_EQ(s.input.surface.ground.roughness, 0.4f);
+}
+
+TEST(SceneFile, BadLayerKeysAreErrors) {
+  EXPECT_NE(error_of(std::string(kTerrain) + "[ripples]\nstrength = 1\n").find("raster"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(std::string(kTerrain) + "[ripples]\nraster = \"r.tif\"\nfade_slope = [30, 20]\n")
+          .find("fade_slope"),
+      std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[snow]\ncovr = \"c.tif\"\n").find("snow.covr"),
+            std::string::npos);
+}

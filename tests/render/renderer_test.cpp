@@ -49,7 +49,7 @@ TEST(Renderer, CosineLawUnderTheSun) {
   // Flat Lambertian ground, black sky, one bounce: L = albedo/pi * E * sin(elevation).
   SceneInput in;
   in.terrain = make_dem(64, 10.0, [](double, double) { return 100.0; });
-  in.terrain_albedo = {0.5f, 0.5f, 0.5f};
+  in.surface.ground.albedo = {0.5f, 0.5f, 0.5f};
   in.sky.constant = true;
   in.sky.intensity = 0.0f;
   in.sun.color = {1, 1, 1};
@@ -75,7 +75,7 @@ TEST(Renderer, WhiteFurnace) {
   SceneInput in;
   in.terrain = make_dem(
       96, 5.0, [](double x, double y) { return 40.0 * std::sin(x / 30.0) * std::cos(y / 25.0); });
-  in.terrain_albedo = {1, 1, 1};
+  in.surface.ground.albedo = {1, 1, 1};
   in.sky.constant = true;
   in.sky.intensity = 1.0f;
   in.sun.irradiance = 0.0;
@@ -141,7 +141,7 @@ TEST(Renderer, MeshRoofShadowsTheGround) {
   // ground under the roof's centre is dark, open ground follows the cosine law.
   SceneInput in;
   in.terrain = make_dem(64, 10.0, [](double, double) { return 0.0; });
-  in.terrain_albedo = {0.5f, 0.5f, 0.5f};
+  in.surface.ground.albedo = {0.5f, 0.5f, 0.5f};
   in.sky.constant = true;
   in.sky.intensity = 0.0f;
   in.sun.elevation_deg = 90.0;

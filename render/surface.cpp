@@ -1,0 +1,82 @@
+#include "render/surface.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace drift::render {
+
+float sample_raster(const terrain::HeightField& raster, double x, double y, float outside) {
+  const auto& gt = raster.geo().geotransform;
+  // North-up rasters only (import makes them so): cell-centre coordinates.
+  const double fx = (x - gt[0]) / gt[1] - 0.5, fr = (y - gt[3]) / gt[5] - 0.5;
+  if (!(fx >= -0.5 && fr >= -0.5 && fx <= raster.width() - 0.5 && fr <= raster.height() - 0.5))
+    return outside;
+  const int x0 = static_cast<int>(std::floor(fx)), r0 = static_cast<int>(std::floor(fr));
+  const float tx = static_cast<float>(fx - x0), tr = static_cast<float>(fr - r0);
+  auto at = [&](int xx, int rr) {
+    const float v = raster.clamped(xx, rr);
+    return std::isnan(v) ? outside : v;
+  };
+  return (1 - tr) * ((1 - tx) * at(x0, r0) + tx * at(x0 + 1, r0)) +
+         tr * ((1 - tx) * at(x0, r0 + 1) + tx * at(x0 + 1, r0 + 1));
+}
+
+terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
+                                    const terrain::HeightField& depth) {
+  terrain::HeightField out = dem;
+  for (int row = 0; row < dem.height(); ++row) {
+    for (int x = 0; x < dem.width(); ++x) {
+      const auto c = dem.geo().cell_center(x, row);
+      out(x, row) += std::max(0.0f, sample_raster(depth, c[0], c[1], 0.0f));
+    }
+  }
+  return out;
+}
+
+namespace {
+
+Material mix(const Material& a, const Material& b, float t) {
+  return {a.albedo * (1 - t) + b.albedo * t, a.roughness * (1 - t) + b.roughness * t};
+}
+
+float smoothstep(float e0, float e1, float x) {
+  const float t = std::clamp((x - e0) / std::max(e1 - e0, 1e-6f), 0.0f, 1.0f);
+  return t * t * (3 - 2 * t);
+}
+
+}  // namespace
+
+SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
+                           const Eigen::Vector3f& normal, double footprint) {
+  SurfacePoint p;
+  p.normal = normal;
+  p.snow = surface.snow_cover
+               ? std::clamp(sample_raster(*surface.snow_cover, x, y, 0.0f), 0.0f, 1.0f)
+               : 0.0f;
+  p.material = mix(surface.ground, surface.snow, p.snow);
+
+  if (surface.ripples && normal.z() > 1e-3f) {
+    const RippleLayer& r = surface.ripples.value();
+    // Ripples live on sand: not under snow, not on slip faces.
+    const float slope_deg = std::acos(std::clamp(normal.z(), -1.0f, 1.0f)) *
+                            static_cast<float>(180.0 / std::numbers::pi);
+    const float keep =
+        (1.0f - p.snow) * (1.0f - smoothstep(r.fade_start_deg, r.fade_end_deg, slope_deg));
+    if (keep > 0.0f) {
+      // Ground (x, y) -> tile (u, v): turn by -rotation (the tile is turned clockwise).
+      const double a = r.rotation_deg * std::numbers::pi / 180.0;
+      const double c = std::cos(a), s = std::sin(a);
+      const double u = c * x - s * y, v = s * x + c * y;
+      const Eigen::Vector2f g_tile = r.slopes.sample(u, v, footprint) * (r.strength * keep);
+      // Slope back to ground axes (the inverse rotation).
+      const Eigen::Vector2f g(static_cast<float>(c * g_tile.x() + s * g_tile.y()),
+                              static_cast<float>(-s * g_tile.x() + c * g_tile.y()));
+      // Surface z = Z(x, y) + h(x, y): n ~ (-(Zx + hx), -(Zy + hy), 1).
+      const Eigen::Vector3f base = normal / normal.z();
+      p.normal = Eigen::Vector3f(base.x() - g.x(), base.y() - g.y(), 1.0f).normalized();
+    }
+  }
+  return p;
+}
+
+}  // namespace drift::render

@@ -1,0 +1,60 @@
+// What covers the terrain: materials and the stage products that place them.
+// Snow cover (drift snow cover) and snow depth (drift snow fall) are rasters in
+// the DEM's CRS; ripples (drift dunes --model ripples) are a tileable bump map.
+// Every raster is sampled by CRS coordinates, so it need not share the DEM's
+// grid, only its CRS.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "render/normal_map.h"
+#include "terrain/grid.h"
+
+namespace drift::render {
+
+// A rough diffuse material (Oren & Nayar 1994, qualitative model).
+struct Material {
+  Eigen::Vector3f albedo{0.28f, 0.26f, 0.23f};
+  float roughness = 0.0f;  // sigma of the facet slopes, radians; 0 is Lambert
+};
+
+// Wind ripples as bump mapping on the ground (paper 002, section 5).
+struct RippleLayer {
+  SlopePyramid slopes;           // of the periodic ripple height tile
+  double rotation_deg = 0.0;     // tile turned clockwise on the ground (e.g. to the wind)
+  float strength = 1.0f;         // scales the ripple slopes
+  float fade_start_deg = 24.0f;  // ripples fade out between these terrain
+  float fade_end_deg = 31.0f;    // slopes: they do not survive on slip faces
+};
+
+struct TerrainSurface {
+  Material ground;
+  Material snow{{0.90f, 0.92f, 0.95f}, 0.1f};
+  std::optional<terrain::HeightField> snow_cover;  // [0, 1]: snow's share of the surface
+  std::optional<terrain::HeightField> snow_depth;  // metres, raises the surface
+  std::optional<RippleLayer> ripples;
+};
+
+// The material at a terrain point, after layers.
+struct SurfacePoint {
+  Material material;
+  Eigen::Vector3f normal{0, 0, 1};  // unit shading normal (bumped)
+  float snow = 0.0f;                // snow coverage, for the AOV
+};
+
+// Bilinear sample of `raster` at CRS coordinates (x, y); cells outside or
+// nodata count as `outside`.
+float sample_raster(const terrain::HeightField& raster, double x, double y, float outside);
+
+// `dem` with `depth` (metres, sampled at each cell centre; outside and nodata
+// count as no snow) added to its valid cells.
+terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
+                                    const terrain::HeightField& depth);
+
+// Evaluates the layers at CRS point (x, y) with the smooth terrain normal
+// `normal` (unit, z up) and a ray footprint `footprint` metres wide.
+SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
+                           const Eigen::Vector3f& normal, double footprint);
+
+}  // namespace drift::render

@@ -1,0 +1,156 @@
+// Surface layers: the bump-map pyramid (level of detail), ripple orientation,
+// Oren-Nayar reflectance, and snow cover and depth as the renderer sees them.
+#include "render/surface.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "render/brdf.h"
+#include "render/renderer.h"
+#include "render/terrain_scene.h"
+#include "terrain/error.h"
+
+using namespace drift::render;
+using drift::terrain::HeightField;
+using drift::terrain::local_georeference;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// A periodic tile of `n` x `n` texels of `texel` metres: crests of wavelength
+// n*texel/k running north-south (height varies with u only).
+HeightField sine_tile(int n, double texel, int k, double amplitude) {
+  HeightField tile(n, n, 0.0f, local_georeference(texel));
+  for (int row = 0; row < n; ++row)
+    for (int x = 0; x < n; ++x)
+      tile(x, row) = static_cast<float>(amplitude * std::sin(2 * kPi * k * x / n));
+  return tile;
+}
+
+// Pseudo-random periodic tile.
+HeightField noise_tile(int w, int h) {
+  HeightField tile(w, h, 0.0f, local_georeference(1.0));
+  std::uint32_t s = 12345;
+  for (float& v : tile.values()) {
+    s = s * 1664525u + 1013904223u;
+    v = static_cast<float>(s >> 8) / static_cast<float>(1 << 24);
+  }
+  return tile;
+}
+
+}  // namespace
+
+TEST(SlopePyramid, EachLevelIsTheAverageOfTheFinerOne) {
+  for (auto [w, h] : {std::pair{64, 64}, std::pair{48, 20}, std::pair{7, 5}}) {
+    const SlopePyramid p(noise_tile(w, h), 1.0);
+    for (int i = 0; i + 1 < p.levels(); ++i) {
+      // Means agree level to level (box filters keep the mean exactly).
+      auto mean = [](const drift::terrain::Grid<Eigen::Vector2f>& g) {
+        Eigen::Vector2d s = Eigen::Vector2d::Zero();
+        for (const auto& v : g.values()) s += v.cast<double>();
+        return Eigen::Vector2d(s / static_cast<double>(g.size()));
+      };
+      EXPECT_NEAR((mean(p.level(i)) - mean(p.level(i + 1))).norm(), 0.0, 1e-6) << w << "x" << h;
+    }
+    if (w % 2 == 0 && h % 2 == 0) {
+      const auto& fine = p.level(0);
+      const auto& coarse = p.level(1);
+      for (int row = 0; row < coarse.height(); ++row)
+        for (int x = 0; x < coarse.width(); ++x) {
+          const Eigen::Vector2f avg =
+              0.25f * (fine(2 * x, 2 * row) + fine(2 * x + 1, 2 * row) + fine(2 * x, 2 * row + 1) +
+                       fine(2 * x + 1, 2 * row + 1));
+          EXPECT_NEAR((coarse(x, row) - avg).norm(), 0.0f, 1e-6f);
+        }
+    }
+    EXPECT_EQ(p.level(p.levels() - 1).size(), 1u);
+  }
+}
+
+TEST(SlopePyramid, FineLevelGivesTheAnalyticSlopeAndFarAwayTheMean) {
+  // h = A sin(2 pi u / L): dh/du = A 2 pi / L cos(...); central differences
+  // on 64 texels per wavelength are within 0.2 %.
+  const double texel = 0.05, amplitude = 0.02;
+  const SlopePyramid p(sine_tile(256, texel, 4, amplitude), texel);
+  const double wavelength = 256 * texel / 4;
+  for (double u : {0.1, 0.77, 1.5, 2.9}) {
+    const double texel_centre = (std::floor(u / texel) + 0.5) * texel;
+    const Eigen::Vector2f g = p.sample(texel_centre, -0.3 * texel, 0.0);
+    // Texel x holds the height at u = x * texel and is centred at (x + 0.5) * texel.
+    const double expected = amplitude * 2 * kPi / wavelength *
+                            std::cos(2 * kPi * (texel_centre - 0.5 * texel) / wavelength);
+    EXPECT_NEAR(g.x(), expected, 2e-3 * amplitude * 2 * kPi / wavelength);
+    EXPECT_NEAR(g.y(), 0.0f, 1e-7f);
+  }
+  // A footprint of a whole tile averages the slopes away: no shimmer far off.
+  EXPECT_NEAR(p.sample(0.3, 0.2, 1000.0).norm(), 0.0f, 1e-6f);
+  // The tile repeats, also at UTM-sized coordinates.
+  EXPECT_NEAR(
+      (p.sample(0.3, 0.2, 0.0) - p.sample(0.3 + 12.8 * 40000, 0.2 - 12.8 * 50000, 0.0)).norm(),
+      0.0f, 1e-5f);
+}
+
+TEST(SlopePyramid, RejectsBadTiles) {
+  HeightField bad = noise_tile(8, 8);
+  bad(3, 3) = NAN;
+  EXPECT_THROW(SlopePyramid(bad, 1.0), drift::Error);
+  EXPECT_THROW(SlopePyramid(noise_tile(8, 8), 0.0), drift::Error);
+  EXPECT_THROW(SlopePyramid(noise_tile(1, 8), 1.0), drift::Error);
+}
+
+TEST(Ripples, RotationTurnsTheBumpsAndSlipFacesLoseThem) {
+  TerrainSurface s;
+  RippleLayer layer;
+  layer.slopes = SlopePyramid(sine_tile(64, 0.1, 2, 0.05), 0.1);
+  s.ripples = layer;
+  const Eigen::Vector3f up(0, 0, 1);
+  // Unrotated: crests run north-south, so the normal tilts east-west only.
+  const Eigen::Vector3f n0 = shade_terrain(s, 0.05, -0.05, up, 0.0).normal;
+  EXPECT_GT(std::abs(n0.x()), 0.05f);
+  EXPECT_NEAR(n0.y(), 0.0f, 1e-6f);
+  // Turned 90 degrees: crests run east-west, the normal tilts north-south.
+  s.ripples->rotation_deg = 90.0;
+  const Eigen::Vector3f n90 = shade_terrain(s, 0.05, -0.05, up, 0.0).normal;
+  EXPECT_NEAR(n90.x(), 0.0f, 1e-5f);
+  EXPECT_GT(std::abs(n90.y()), 0.05f);
+  // On a 33-degree slip face the ripples are gone.
+  const float a = static_cast<float>(33.0 * kPi / 180.0);
+  const Eigen::Vector3f face(std::sin(a), 0.0f, std::cos(a));
+  EXPECT_NEAR((shade_terrain(s, 0.05, -0.05, face, 0.0).normal - face).norm(), 0.0f, 1e-6f);
+}
+
+TEST(OrenNayar, LambertAtZeroRoughnessReciprocalAndBackscattering) {
+  const Eigen::Vector3f n(0, 0, 1);
+  const Eigen::Vector3f wi = Eigen::Vector3f(0.6f, 0.1f, 0.5f).normalized();
+  const Eigen::Vector3f wo = Eigen::Vector3f(-0.3f, 0.4f, 0.7f).normalized();
+  EXPECT_EQ(oren_nayar_factor(n, wi, wo, 0.0f), 1.0f);
+  EXPECT_FLOAT_EQ(oren_nayar_factor(n, wi, wo, 0.4f), oren_nayar_factor(n, wo, wi, 0.4f));
+  // Rough surfaces look brighter towards the light (backscatter, the full moon).
+  EXPECT_GT(oren_nayar_factor(n, wi, wi, 0.5f), oren_nayar_factor(n, wi, wo, 0.5f));
+}
+
+TEST(Snow, CoverBlendsTheMaterialAndDepthRaisesTheSurface) {
+  SceneInput in;
+  in.terrain = HeightField(32, 32, 100.0f, local_georeference(1.0));
+  // Snow on the western half only; 2 m of it.
+  HeightField cover(32, 32, 0.0f, local_georeference(1.0));
+  HeightField depth(32, 32, 0.0f, local_georeference(1.0));
+  for (int row = 0; row < 32; ++row)
+    for (int x = 0; x < 16; ++x) cover(x, row) = 1.0f, depth(x, row) = 2.0f;
+  in.surface.snow_cover = cover;
+  in.surface.snow_depth = depth;
+  in.sky.constant = true;
+  const TerrainScene scene(in);
+  Hit west, east;
+  const Eigen::Vector3f down(0, 0, -1);
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(4.0, -16.0, 500.0)), down, west));
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(28.0, -16.0, 500.0)), down, east));
+  EXPECT_FLOAT_EQ(west.snow, 1.0f);
+  EXPECT_FLOAT_EQ(east.snow, 0.0f);
+  EXPECT_NEAR((west.albedo - in.surface.snow.albedo).norm(), 0.0f, 1e-6f);
+  EXPECT_NEAR((east.albedo - in.surface.ground.albedo).norm(), 0.0f, 1e-6f);
+  EXPECT_NEAR(east.distance - west.distance, 2.0f, 1e-3f);
+}
