@@ -10,6 +10,7 @@
 #include "pipeline/scene_file.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
+#include "render/tiles.h"
 #include "terrain/error.h"
 
 namespace drift::pipeline {
@@ -23,7 +24,7 @@ struct RenderOptions {
   std::vector<std::string> outputs;
   std::string terrain;
   unsigned long long seed = 0;
-  bool seed_given = false;
+  std::string tile;
 };
 
 void run_render(const RenderOptions& o, const CLI::App& sub) {
@@ -58,17 +59,33 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       throw Error("cannot write '" + f.string() + "': use a .png or .exr file name");
     }
   }
+  if (!o.tile.empty()) {
+    const auto [index, count] = render::parse_tile(o.tile);
+    const render::RowRange rows = render::tile_rows(scene.settings.height, index, count);
+    scene.settings.row_begin = rows.begin;
+    scene.settings.row_end = rows.end;
+    for (const auto& f : scene.outputs) {
+      if (f.extension() != ".exr") {
+        throw Error("a tile is written as EXR (it keeps its place in the frame); '" + f.string() +
+                    "' is not: give -o TILE.exr and join the tiles with drift merge");
+      }
+    }
+  }
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
   const render::TerrainScene embree_scene(scene.input);
   const render::Camera camera =
       scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
-  const render::Image image = render::render_image(embree_scene, scene.input, camera,
-                                                   scene.settings, terminal_progress("render"));
+  render::Image image = render::render_image(embree_scene, scene.input, camera, scene.settings,
+                                             terminal_progress("render"));
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The display settings ride along so that `drift merge` can write the PNG.
+  image.attributes = {
+      {"exposure", std::to_string(scene.display.exposure_ev)},
+      {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"}};
   for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
-  std::printf("rendered %dx%d at %d spp in %.1f s -> ", scene.settings.width, scene.settings.height,
+  std::printf("rendered %dx%d at %d spp in %.1f s -> ", image.width, image.height,
               scene.settings.samples_per_pixel, seconds);
   for (const auto& f : scene.outputs) std::printf("%s ", f.c_str());
   std::printf("\n");
@@ -91,6 +108,9 @@ void add_render_command(CLI::App& root) {
   sub->add_option("-o,--output", o->outputs,
                   "output file(s), .png and/or .exr (override the scene)");
   sub->add_option("--terrain", o->terrain, "terrain raster (overrides [terrain] raster)");
+  sub->add_option("--tile", o->tile,
+                  "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16) to EXR; "
+                  "join the bands with drift merge (docs/rendering.md)");
   add_seed_option(*sub, o->seed);
 }
 

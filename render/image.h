@@ -5,6 +5,7 @@
 
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace drift::render {
@@ -14,6 +15,21 @@ struct Image {
   int height = 0;
   std::vector<std::string> channels;  // e.g. {"R", "G", "B"}
   std::vector<float> pixels;          // (y * width + x) * channels.size() + c; row 0 at the top
+
+  // Where this image sits in a larger frame when it is one tile of it (EXR's
+  // data window inside its display window); full sizes 0: it is the frame.
+  struct Frame {
+    int x = 0, y = 0;
+    int full_width = 0, full_height = 0;
+  } frame;
+  // Named text attributes kept in EXR files as "drift:NAME" (e.g. the display
+  // settings a tile was rendered with, so `drift merge` can write the PNG).
+  std::vector<std::pair<std::string, std::string>> attributes;
+  const std::string* attribute(std::string_view name) const {
+    for (const auto& [k, v] : attributes)
+      if (k == name) return &v;
+    return nullptr;
+  }
 
   Image() = default;
   Image(int width, int height, std::vector<std::string> channel_names, float fill = 0.0f);

@@ -89,6 +89,16 @@ Image read_image(const std::filesystem::path& path) {
     }
     Image image(spec.width, spec.height, names);
     image.pixels = std::move(raw);
+    if (spec.x != 0 || spec.y != 0 || spec.full_width != spec.width ||
+        spec.full_height != spec.height) {
+      image.frame = {spec.x, spec.y, spec.full_width, spec.full_height};
+    }
+    for (const OIIO::ParamValue& p : spec.extra_attribs) {
+      const std::string name = p.name().string();
+      if (name.rfind("drift:", 0) == 0 && p.type() == OIIO::TypeDesc::STRING) {
+        image.attributes.emplace_back(name.substr(6), p.get_string());
+      }
+    }
     return image;
   }
 
@@ -126,6 +136,14 @@ void write_exr(const Image& image, const std::filesystem::path& path) {
   spec.channelnames = image.channels;
   spec.alpha_channel = image.channel_index("A");
   spec.attribute("compression", "zip");
+  if (image.frame.full_width > 0 && image.frame.full_height > 0) {
+    spec.x = image.frame.x;
+    spec.y = image.frame.y;
+    spec.full_x = spec.full_y = 0;
+    spec.full_width = image.frame.full_width;
+    spec.full_height = image.frame.full_height;
+  }
+  for (const auto& [name, value] : image.attributes) spec.attribute("drift:" + name, value);
   write_with_oiio(path, file.temp_path(), spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
   file.commit();
 }

@@ -52,6 +52,10 @@ struct RenderSettings {
   int samples_per_pixel = 64;
   int max_depth = 4;  // path vertices after the camera; >= 1
   std::uint64_t seed = 1;
+  // Render only rows [row_begin, row_end) of the frame (one tile of it); the
+  // pixels are the same bits as in a whole-frame render. row_end 0: to the end.
+  int row_begin = 0;
+  int row_end = 0;
 };
 
 struct SceneInput {

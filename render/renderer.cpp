@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "render/brdf.h"
 #include "render/random.h"
@@ -129,9 +130,18 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
       settings.max_depth < 1) {
     throw Error("render size, samples per pixel and max depth must all be at least 1");
   }
-  Image image(settings.width, settings.height,
+  const int row_begin = settings.row_begin;
+  const int row_end = settings.row_end > 0 ? settings.row_end : settings.height;
+  if (row_begin < 0 || row_begin >= row_end || row_end > settings.height) {
+    throw Error("rows [" + std::to_string(row_begin) + ", " + std::to_string(row_end) +
+                ") are not inside the " + std::to_string(settings.height) + "-row frame");
+  }
+  const int band = row_end - row_begin;
+  Image image(settings.width, band,
               {"R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G",
                "albedo.B", "coverage.snow"});
+
+  if (band != settings.height) image.frame = {0, row_begin, settings.width, settings.height};
 
   const Pinhole pinhole = make_pinhole(scene, camera, settings.width, settings.height);
   const Vector3f eye = pinhole.eye;
@@ -197,7 +207,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
 
   constexpr int kTile = 32;
   const int tiles_x = (settings.width + kTile - 1) / kTile;
-  const int tiles_y = (settings.height + kTile - 1) / kTile;
+  const int tiles_y = (band + kTile - 1) / kTile;
   const int tile_count = tiles_x * tiles_y;
   std::atomic<int> done{0};
   std::atomic<bool> cancelled{false};
@@ -206,9 +216,9 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const float inv_spp = 1.0f / static_cast<float>(settings.samples_per_pixel);
   tbb::parallel_for(0, tile_count, [&](int tile) {
     if (cancelled.load(std::memory_order_relaxed)) return;
-    const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+    const int x0 = (tile % tiles_x) * kTile, y0 = row_begin + (tile / tiles_x) * kTile;
     std::uint64_t tile_rays = 0;
-    for (int y = y0; y < std::min(y0 + kTile, settings.height); ++y) {
+    for (int y = y0; y < std::min(y0 + kTile, row_end); ++y) {
       for (int x = x0; x < std::min(x0 + kTile, settings.width); ++x) {
         PixelSample sum;
         const std::uint64_t pixel = static_cast<std::uint64_t>(y) * settings.width + x;
@@ -226,7 +236,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
             sum.depth * inv_spp,        sum.normal.x() * inv_spp,   sum.normal.y() * inv_spp,
             sum.normal.z() * inv_spp,   sum.albedo.x() * inv_spp,   sum.albedo.y() * inv_spp,
             sum.albedo.z() * inv_spp,   sum.snow * inv_spp};
-        for (int c = 0; c < 11; ++c) image.at(x, y, c) = values[c];
+        for (int c = 0; c < 11; ++c) image.at(x, y - row_begin, c) = values[c];
       }
     }
     total_rays += tile_rays;  // integer sums: the same whatever the order
@@ -235,7 +245,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   });
   if (cancelled) throw Cancelled();
   if (stats) {
-    stats->camera_rays = static_cast<std::uint64_t>(settings.width) * settings.height *
+    stats->camera_rays = static_cast<std::uint64_t>(settings.width) * band *
                          static_cast<std::uint64_t>(settings.samples_per_pixel);
     stats->rays = total_rays;
   }

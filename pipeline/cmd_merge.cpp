@@ -1,0 +1,66 @@
+// drift merge TILE.exr... -o FRAME.exr|png: join the bands of `drift render
+// --tile i/n` into the frame a single run gives, bit for bit.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+
+#include "pipeline/cli.h"
+#include "render/image_io.h"
+#include "render/tiles.h"
+#include "terrain/error.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+struct MergeOptions {
+  std::vector<std::string> tiles;
+  std::vector<std::string> outputs;
+  double exposure = 0.0;
+};
+
+// The display settings the tiles were rendered with, unless overridden.
+render::DisplayTransform display_of(const render::Image& frame, const CLI::App& sub,
+                                    double exposure) {
+  render::DisplayTransform d;
+  if (const std::string* e = frame.attribute("exposure")) d.exposure_ev = std::stod(*e);
+  if (const std::string* t = frame.attribute("tone"); t && *t == "clamp")
+    d.curve = render::ToneCurve::Clamp;
+  if (sub.count("--exposure")) d.exposure_ev = exposure;
+  return d;
+}
+
+void run_merge(const MergeOptions& o, const CLI::App& sub) {
+  std::vector<render::Image> tiles;
+  std::vector<std::filesystem::path> names;
+  for (const auto& t : o.tiles) {
+    names.emplace_back(t);
+    tiles.push_back(render::read_image(t));
+  }
+  const render::Image frame = render::merge_tiles(tiles, names);
+  tiles.clear();
+  const render::DisplayTransform display = display_of(frame, sub, o.exposure);
+  for (const auto& f : o.outputs) render::write_image(frame, f, display);
+  std::printf("merged %zu tiles into %dx%d -> ", names.size(), frame.width, frame.height);
+  for (const auto& f : o.outputs) std::printf("%s ", f.c_str());
+  std::printf("\n");
+}
+
+}  // namespace
+
+void add_merge_command(CLI::App& root) {
+  auto o = std::make_shared<MergeOptions>();
+  auto self = std::make_shared<CLI::App*>(nullptr);
+  CLI::App* sub =
+      add_subcommand(root, "merge", "join tiles of drift render --tile i/n into the whole frame",
+                     [o, self] { run_merge(*o, **self); });
+  *self = sub;
+  sub->add_option("tiles", o->tiles, "tile EXR files, in any order")->required();
+  sub->add_option("-o,--output", o->outputs, "output file(s), .exr and/or .png")->required();
+  sub->add_option("--exposure", o->exposure, "PNG exposure in EV (default: the render's)")
+      ->check(CLI::Range(-20.0, 20.0));
+}
+
+DRIFT_COMMAND(80, add_merge_command);
+
+}  // namespace drift::pipeline

@@ -1,0 +1,138 @@
+// Tiles across machines: bands rendered separately and merged are the same
+// bits as one render; a missing or doubled band is an error naming it.
+#include "render/tiles.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "render/image_io.h"
+#include "render/renderer.h"
+#include "render/terrain_scene.h"
+#include "terrain/error.h"
+#include "terrain/raster_io.h"
+
+using namespace drift::render;
+namespace fs = std::filesystem;
+
+namespace {
+
+SceneInput hills() {
+  SceneInput in;
+  in.terrain = drift::terrain::HeightField(48, 48, 0.0f, drift::terrain::local_georeference(5.0));
+  for (int r = 0; r < 48; ++r)
+    for (int x = 0; x < 48; ++x)
+      in.terrain(x, r) = static_cast<float>(30.0 * std::sin(x * 0.2) * std::cos(r * 0.15));
+  in.sun.elevation_deg = 20.0;
+  return in;
+}
+
+fs::path temp_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  auto dir = fs::temp_directory_path() / (std::string("drift_tiles_") + info->name());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST(Tiles, RowsCoverTheFrameOnce) {
+  for (int n : {1, 2, 3, 7, 90}) {
+    int next = 0;
+    for (int i = 0; i < n; ++i) {
+      const RowRange r = tile_rows(90, i, n);
+      EXPECT_EQ(r.begin, next);
+      EXPECT_GT(r.end, r.begin);
+      next = r.end;
+    }
+    EXPECT_EQ(next, 90);
+  }
+  EXPECT_THROW(tile_rows(90, 3, 3), drift::Error);
+  EXPECT_THROW(tile_rows(10, 0, 11), drift::Error);
+  EXPECT_THROW(parse_tile("3of4"), drift::Error);
+  EXPECT_EQ(parse_tile("3/16"), std::make_pair(3, 16));
+}
+
+TEST(Tiles, MergedBandsAreBitIdenticalToOneRender) {
+  const SceneInput in = hills();
+  const TerrainScene scene(in);
+  const Camera camera = default_camera(scene);
+  RenderSettings rs;
+  rs.width = 40;
+  rs.height = 30;
+  rs.samples_per_pixel = 4;
+  const fs::path dir = temp_dir();
+  // Through EXR files, as across machines (EXR sorts the channels by name).
+  write_exr(render_image(scene, in, camera, rs), dir / "whole.exr");
+  const Image whole = read_image(dir / "whole.exr");
+  std::vector<Image> tiles;
+  std::vector<fs::path> names;
+  for (int i : {2, 0, 1}) {  // any order
+    const RowRange rows = tile_rows(rs.height, i, 3);
+    RenderSettings part = rs;
+    part.row_begin = rows.begin;
+    part.row_end = rows.end;
+    Image tile = render_image(scene, in, camera, part);
+    tile.attributes = {{"exposure", "-1.5"}};
+    names.push_back(dir / ("tile" + std::to_string(i) + ".exr"));
+    write_exr(tile, names.back());
+    tiles.push_back(read_image(names.back()));
+    EXPECT_EQ(tiles.back().frame.y, rows.begin);
+    EXPECT_EQ(tiles.back().frame.full_height, rs.height);
+  }
+  const Image merged = merge_tiles(tiles, names);
+  ASSERT_EQ(merged.width, whole.width);
+  ASSERT_EQ(merged.height, whole.height);
+  ASSERT_EQ(merged.channels, whole.channels);
+  EXPECT_EQ(merged.pixels, whole.pixels);  // bit for bit
+  ASSERT_NE(merged.attribute("exposure"), nullptr);
+  EXPECT_EQ(*merged.attribute("exposure"), "-1.5");
+
+  // A missing band is named by its rows; a doubled one by its files.
+  try {
+    merge_tiles({tiles[0], tiles[2]}, {names[0], names[2]});
+    ADD_FAILURE() << "a missing tile must be an error";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("rows 0 to 9"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(merge_tiles({tiles[0], tiles[0], tiles[1], tiles[2]},
+                           {names[0], names[0], names[1], names[2]}),
+               drift::Error);
+  EXPECT_THROW(merge_tiles({whole}, {"whole.exr"}), drift::Error);
+  fs::remove_all(dir);
+}
+
+TEST(Tiles, CommandLineTilesMergeToTheSingleRun) {
+  const fs::path dir = temp_dir();
+  drift::terrain::write_geotiff(hills().terrain, dir / "dem.tif");
+  std::ofstream(dir / "s.toml") << "[terrain]\nraster = \"dem.tif\"\n"
+                                   "[render]\nwidth = 32\nheight = 20\nspp = 2\n";
+  const std::string drift = DRIFT_EXECUTABLE;
+  auto run = [&](const std::string& args) {
+    return std::system((drift + " " + args + " > /dev/null 2>&1").c_str());
+  };
+  const std::string scene = (dir / "s.toml").string();
+  ASSERT_EQ(run("render " + scene + " -o " + (dir / "whole.exr").string()), 0);
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_EQ(run("render " + scene + " --tile " + std::to_string(i) + "/4 -o " +
+                  (dir / ("t" + std::to_string(i) + ".exr")).string()),
+              0);
+  }
+  EXPECT_NE(run("render " + scene + " --tile 0/4 -o " + (dir / "t.png").string()), 0);
+  EXPECT_NE(run("render " + scene + " --tile 4/4 -o " + (dir / "t.exr").string()), 0);
+  const std::string tiles = (dir / "t0.exr").string() + " " + (dir / "t1.exr").string() + " " +
+                            (dir / "t2.exr").string() + " " + (dir / "t3.exr").string();
+  ASSERT_EQ(run("merge " + tiles + " -o " + (dir / "merged.exr").string() + " -o " +
+                (dir / "merged.png").string()),
+            0);
+  EXPECT_TRUE(fs::exists(dir / "merged.png"));
+  EXPECT_EQ(read_image(dir / "merged.exr").pixels, read_image(dir / "whole.exr").pixels);
+  // Without the last tile: exit 1, and no output written.
+  EXPECT_EQ(run("merge " + (dir / "t0.exr").string() + " -o " + (dir / "part.exr").string()), 256);
+  EXPECT_FALSE(fs::exists(dir / "part.exr"));
+  fs::remove_all(dir);
+}
