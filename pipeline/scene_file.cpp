@@ -6,7 +6,9 @@
 #include <cmath>
 #include <set>
 
+#include "render/surface.h"
 #include "terrain/error.h"
+#include "terrain/geodesy.h"
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
 
@@ -235,14 +237,34 @@ SceneFile read_scene_file(const fs::path& path) {
     render::Camera camera;
     const auto from = cam.vector<3>("from", -1e8, 1e8);
     const auto to = cam.vector<3>("to", -1e8, 1e8);
+    const auto from_lonlat = cam.vector<2>("from_lonlat", -180.0, 180.0);
+    const auto to_lonlat = cam.vector<2>("to_lonlat", -180.0, 180.0);
+    const double from_height = cam.number("from_height", 2.0, -1e4, 1e6);
+    const double to_height = cam.number("to_height", 0.0, -1e4, 1e6);
     camera.vertical_fov_deg = cam.number("fov", camera.vertical_fov_deg, 0.1, 179.0);
+    if (const double f = cam.number("focal_length", 0.0, 0.0, 1e5); f > 0.0)
+      camera.focal_length_mm = f;
+    camera.sensor_width_mm = cam.number("sensor_width", camera.sensor_width_mm, 0.1, 1000.0);
+    camera.f_number = cam.number("f_number", 0.0, 0.0, 1000.0);
+    if (const double d = cam.number("focus_distance", 0.0, 0.0, 1e8); d > 0.0)
+      camera.focus_distance = d;
     cam.finish();
-    if (!from || !to)
+    if (camera.f_number > 0.0 && !camera.focal_length_mm)
+      throw Error(path.string() + ": 'camera.f_number' needs 'camera.focal_length' (millimetres)");
+    if (from && from_lonlat)
+      throw Error(path.string() + ": [camera] has both 'from' and 'from_lonlat'; give one");
+    if (to && to_lonlat)
+      throw Error(path.string() + ": [camera] has both 'to' and 'to_lonlat'; give one");
+    if (!(from || from_lonlat) || !(to || to_lonlat))
       throw Error(path.string() +
-                  ": [camera] needs both 'from' and 'to' ([x, y, z] in the raster's CRS, metres)");
-    camera.from = *from;
-    camera.to = *to;
-    in.camera = camera;
+                  ": [camera] needs where it stands ('from' = [x, y, z] in the raster's CRS, or "
+                  "'from_lonlat' = [lon, lat]) and where it looks ('to' or 'to_lonlat')");
+    auto geo_point = [](const Eigen::Vector2d& ll, double h) { return GeoPoint{ll[0], ll[1], h}; };
+    if (from_lonlat) scene.camera_from_lonlat = geo_point(*from_lonlat, from_height);
+    if (to_lonlat) scene.camera_to_lonlat = geo_point(*to_lonlat, to_height);
+    if (from) camera.from = *from;
+    if (to) camera.to = *to;
+    in.camera = camera;  // lon/lat ends are placed by load_scene_terrain
   }
 
   if (const toml::node* objects = root.get("objects")) {
@@ -314,11 +336,34 @@ terrain::HeightField read_metric_raster(const fs::path& file, const char* role) 
   }
   return grid;
 }
+
+// Turns the camera's lon/lat ends into CRS points at their height above the
+// (exaggerated) ground, which must be inside the DEM.
+void place_lonlat_camera(SceneFile& scene) {
+  const terrain::HeightField& dem = scene.input.terrain;
+  auto place = [&](const GeoPoint& p, const char* key) {
+    const auto xy = terrain::from_lonlat(dem.geo().crs_wkt, p.lon, p.lat);
+    const float ground = render::sample_raster(dem, xy[0], xy[1], NAN);
+    if (std::isnan(ground)) {
+      throw Error("camera '" + std::string(key) + "' = [" + std::to_string(p.lon) + ", " +
+                  std::to_string(p.lat) + "] is not on the terrain '" +
+                  scene.terrain_raster.string() +
+                  "'; pick a point inside it (drift info shows its extent)");
+    }
+    return Eigen::Vector3d(xy[0], xy[1],
+                           ground * scene.input.vertical_exaggeration + p.above_ground);
+  };
+  if (scene.camera_from_lonlat)
+    scene.input.camera->from = place(*scene.camera_from_lonlat, "from_lonlat");
+  if (scene.camera_to_lonlat) scene.input.camera->to = place(*scene.camera_to_lonlat, "to_lonlat");
+}
+
 }  // namespace
 
 void load_scene_terrain(SceneFile& scene) {
   render::TerrainSurface& surface = scene.input.surface;
   scene.input.terrain = read_metric_raster(scene.terrain_raster, "terrain");
+  place_lonlat_camera(scene);
   if (!scene.snow_cover.empty())
     surface.snow_cover = read_metric_raster(scene.snow_cover, "snow cover");
   if (!scene.snow_depth.empty())

@@ -13,13 +13,23 @@
 
 namespace drift::pipeline {
 
+// A camera end given by longitude/latitude and a height above the ground,
+// placed once the terrain is loaded.
+struct GeoPoint {
+  double lon = 0.0, lat = 0.0;  // degrees, WGS 84
+  double above_ground = 0.0;    // metres
+};
+
 struct SceneFile {
   std::filesystem::path terrain_raster;  // resolved against the scene file's folder
   // Layer rasters ([snow] cover and depth, [ripples] raster), resolved likewise;
   // empty when the scene has none.
   std::filesystem::path snow_cover, snow_depth, ripples;
   std::optional<double> ripple_texel_metres;  // default: the ripple raster's cell size
-  render::SceneInput input;              // terrain not loaded yet (see load_scene_terrain)
+  // [camera] from_lonlat / to_lonlat: resolved into input.camera by
+  // load_scene_terrain.
+  std::optional<GeoPoint> camera_from_lonlat, camera_to_lonlat;
+  render::SceneInput input;  // terrain not loaded yet (see load_scene_terrain)
   render::RenderSettings settings;
   std::vector<std::filesystem::path> outputs;  // resolved against the current directory
   render::DisplayTransform display;

@@ -36,6 +36,15 @@ struct Camera {
   Eigen::Vector3d from{0, 0, 0};  // world metres (x east, y north, z up)
   Eigen::Vector3d to{0, 1, 0};
   double vertical_fov_deg = 40.0;  // (0, 180)
+  // A real lens instead of a field of view: the focal length gives the
+  // horizontal field of view over the sensor's width (36 mm: full frame).
+  std::optional<double> focal_length_mm;
+  double sensor_width_mm = 36.0;
+  // Depth of field: a thin lens of aperture diameter focal length / f_number,
+  // sharp at focus_distance metres (default: the distance from `from` to
+  // `to`). f_number 0 keeps a pinhole. Needs focal_length_mm.
+  double f_number = 0.0;
+  std::optional<double> focus_distance;
 };
 
 struct PlacedMesh {

@@ -101,8 +101,9 @@ Camera default_camera(const TerrainScene& scene) {
   return camera;
 }
 
-Pinhole make_pinhole(const TerrainScene& scene, const Camera& camera, int width, int height) {
-  Pinhole p;
+CameraRays make_camera_rays(const TerrainScene& scene, const Camera& camera, int width,
+                            int height) {
+  CameraRays p;
   p.eye = scene.to_local(camera.from);
   p.forward = scene.to_local(camera.to) - p.eye;
   if (!(p.forward.norm() > 0.0f)) throw Error("camera 'from' and 'to' are the same point");
@@ -111,17 +112,40 @@ Pinhole make_pinhole(const TerrainScene& scene, const Camera& camera, int width,
   if (p.right.norm() < 1e-6f) p.right = p.forward.cross(Vector3f::UnitY());
   p.right.normalize();
   p.up = p.right.cross(p.forward);
-  p.tan_half = static_cast<float>(std::tan(camera.vertical_fov_deg * std::numbers::pi / 360.0));
   p.aspect = static_cast<float>(width) / static_cast<float>(height);
+  if (camera.focal_length_mm) {
+    // Horizontal half-width of the sensor over the focal length.
+    p.tan_half =
+        static_cast<float>(camera.sensor_width_mm / (2.0 * *camera.focal_length_mm)) / p.aspect;
+    if (camera.f_number > 0.0) {
+      p.lens_radius = static_cast<float>(*camera.focal_length_mm / 1000.0 / camera.f_number / 2.0);
+      p.focus_distance =
+          static_cast<float>(camera.focus_distance.value_or((camera.to - camera.from).norm()));
+    }
+  } else {
+    p.tan_half = static_cast<float>(std::tan(camera.vertical_fov_deg * std::numbers::pi / 360.0));
+  }
   p.width = width;
   p.height = height;
   return p;
 }
 
-Vector3f Pinhole::direction(float x, float y) const {
+Vector3f CameraRays::direction(float x, float y) const {
   const float sx = (2.0f * x / static_cast<float>(width) - 1.0f) * tan_half * aspect;
   const float sy = (1.0f - 2.0f * y / static_cast<float>(height)) * tan_half;
   return (forward + right * sx + up * sy).normalized();
+}
+
+void CameraRays::ray(float x, float y, float u1, float u2, Vector3f& origin, Vector3f& dir) const {
+  dir = direction(x, y);
+  origin = eye;
+  if (lens_radius <= 0.0f) return;
+  // Uniform point on the lens disc; the ray aims at where the pinhole ray
+  // crosses the focal plane (distance focus_distance along `forward`).
+  const float r = lens_radius * std::sqrt(u1), phi = 2.0f * kPi * u2;
+  const Vector3f focus = eye + dir * (focus_distance / dir.dot(forward));
+  origin = eye + right * (r * std::cos(phi)) + up * (r * std::sin(phi));
+  dir = (focus - origin).normalized();
 }
 
 Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,
@@ -143,8 +167,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
 
   if (band != settings.height) image.frame = {0, row_begin, settings.width, settings.height};
 
-  const Pinhole pinhole = make_pinhole(scene, camera, settings.width, settings.height);
-  const Vector3f eye = pinhole.eye;
+  const CameraRays camera_rays = make_camera_rays(scene, camera, settings.width, settings.height);
 
   const Sun& sun = input.sun;
   const Vector3f sun_dir = direction_from_az_el(sun.azimuth_deg, sun.elevation_deg);
@@ -156,11 +179,14 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   auto trace = [&](int px, int py, SampleStream& rng, std::uint64_t& rays) {
     PixelSample out;
     const float jx = rng.next(), jy = rng.next();
-    Vector3f dir = pinhole.direction(static_cast<float>(px) + jx, static_cast<float>(py) + jy);
-    Vector3f origin = eye;
+    Vector3f origin, dir;
+    // Lens samples only for a thin lens, so pinhole renders keep their bits.
+    const float lu = camera_rays.lens_radius > 0.0f ? rng.next() : 0.0f;
+    const float lv = camera_rays.lens_radius > 0.0f ? rng.next() : 0.0f;
+    camera_rays.ray(static_cast<float>(px) + jx, static_cast<float>(py) + jy, lu, lv, origin, dir);
     Vector3f throughput(1, 1, 1);
     // Camera rays start as wide as a pixel's angle; see RayCone.
-    RayCone cone{0.0f, 2.0f * pinhole.tan_half / static_cast<float>(settings.height)};
+    RayCone cone{0.0f, 2.0f * camera_rays.tan_half / static_cast<float>(settings.height)};
     for (int depth = 0; depth < settings.max_depth; ++depth) {
       Hit hit;
       ++rays;

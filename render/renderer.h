@@ -17,16 +17,24 @@ namespace drift::render {
 // looking north at its highest point.
 Camera default_camera(const TerrainScene& scene);
 
-// A pinhole camera in the scene's local frame (z up; straight up or down keeps
-// north as "up" in the image).
-struct Pinhole {
+// The primary rays of a camera in the scene's local frame (z up; straight up
+// or down keeps north as "up" in the image): a pinhole, or a thin lens with
+// depth of field when lens_radius > 0 (Pharr et al., PBRT 3rd ed., 6.2.3).
+struct CameraRays {
   Eigen::Vector3f eye, forward, right, up;
-  float tan_half = 0.0f, aspect = 1.0f;
+  float tan_half = 0.0f, aspect = 1.0f;  // tan of half the vertical field of view
   int width = 1, height = 1;
-  // Unit direction through image position (x, y) in pixels, (0, 0) top left.
+  float lens_radius = 0.0f;     // metres
+  float focus_distance = 1.0f;  // metres along `forward`
+  // Unit direction of the pinhole ray through image position (x, y) in pixels,
+  // (0, 0) top left.
   Eigen::Vector3f direction(float x, float y) const;
+  // The ray through (x, y) from lens position (u1, u2) in [0, 1)^2 (ignored
+  // for a pinhole): all rays through one image point meet on the focal plane.
+  void ray(float x, float y, float u1, float u2, Eigen::Vector3f& origin,
+           Eigen::Vector3f& dir) const;
 };
-Pinhole make_pinhole(const TerrainScene& scene, const Camera& camera, int width, int height);
+CameraRays make_camera_rays(const TerrainScene& scene, const Camera& camera, int width, int height);
 
 // Radiance of the simple sky in direction `dir` (unit, world z up); the sun's
 // disc is not included (the sun is sampled explicitly).

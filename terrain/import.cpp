@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "terrain/error.h"
+#include "terrain/geodesy.h"
 #include "terrain/memory.h"
 #include "terrain/raster_io.h"
 
@@ -22,18 +23,6 @@ std::string fmt(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
-}
-
-// lon/lat (WGS 84) of a point given in `srs`.
-std::array<double, 2> to_lonlat(const OGRSpatialReference& srs, double x, double y) {
-  OGRSpatialReference wgs84;
-  wgs84.importFromEPSG(4326);
-  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  OGRSpatialReference src(srs);
-  src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&src, &wgs84));
-  if (!ct || !ct->Transform(1, &x, &y)) throw Error("cannot locate the DEM on the globe");
-  return {x, y};
 }
 
 }  // namespace
@@ -59,9 +48,7 @@ std::array<double, 2> cell_size_metres(const GeoReference& geo, int width, int h
     const double unit = srs.GetLinearUnits();
     return {dx * unit, dy * unit};
   }
-  const auto c = geo.cell_center(width / 2.0 - 0.5, height / 2.0 - 0.5);
-  const auto lonlat = to_lonlat(srs, c[0], c[1]);
-  const auto m = metres_per_degree(lonlat[1]);
+  const auto m = metres_per_degree(centre_lonlat(geo, width, height)[1]);
   return {dx * m[0], dy * m[1]};
 }
 
@@ -125,8 +112,7 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
                                    "bilinear", "-dstnodata", "nan", "-overwrite"};
   double cell = 0.0;
   if (reproject) {
-    const auto c = header.geo.cell_center(header.width / 2.0 - 0.5, header.height / 2.0 - 0.5);
-    const auto lonlat = to_lonlat(srs, c[0], c[1]);
+    const auto lonlat = centre_lonlat(header.geo, header.width, header.height);
     const int epsg = utm_epsg(lonlat[0], lonlat[1]);
     // Square cells near the source's finest metric spacing.
     const auto metric = cell_size_metres(header.geo, header.width, header.height);

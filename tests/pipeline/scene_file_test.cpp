@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
+#include "render/surface.h"
 #include "terrain/error.h"
 
 namespace fs = std::filesystem;
@@ -179,4 +181,54 @@ TEST(SceneFile, BadLayerKeysAreErrors) {
       std::string::npos);
   EXPECT_NE(error_of(std::string(kTerrain) + "[snow]\ncovr = \"c.tif\"\n").find("snow.covr"),
             std::string::npos);
+}
+
+TEST(SceneFile, CameraByLonLatStandsAboveTheGround) {
+  // Mount St Helens' crater rim, looking at the summit area from the north.
+  const std::string dem = std::string(DRIFT_SOURCE_DIR) + "/data/mount_st_helens_usgs_30m.dem";
+  const fs::path p =
+      write_scene("geo.toml", "[terrain]\nraster = \"" + dem +
+                                  "\"\nexaggeration = 1.0\n"
+                                  "[camera]\nfrom_lonlat = [-122.19, 46.215]\nfrom_height = 1.7\n"
+                                  "to_lonlat = [-122.18, 46.19]\nfocal_length = 35\n");
+  auto s = drift::pipeline::read_scene_file(p);
+  drift::pipeline::load_scene_terrain(s);
+  ASSERT_TRUE(s.input.camera.has_value());
+  const auto& cam = *s.input.camera;
+  // The heights under both ends, read back from the DEM, plus the heights asked for.
+  const float ground_from =
+      drift::render::sample_raster(s.input.terrain, cam.from.x(), cam.from.y(), NAN);
+  const float ground_to =
+      drift::render::sample_raster(s.input.terrain, cam.to.x(), cam.to.y(), NAN);
+  EXPECT_NEAR(cam.from.z(), ground_from + 1.7, 1e-3);
+  EXPECT_NEAR(cam.to.z(), ground_to, 1e-3);
+  EXPECT_GT(ground_from, 1000.0f);  // on the mountain, not at sea level
+  // 0.025 degrees of latitude apart: about 2.8 km north-south.
+  EXPECT_NEAR(cam.from.y() - cam.to.y(), 2780.0, 60.0);
+  ASSERT_TRUE(cam.focal_length_mm.has_value());
+  EXPECT_DOUBLE_EQ(*cam.focal_length_mm, 35.0);
+}
+
+TEST(SceneFile, CameraOffTheTerrainOrHalfGivenIsAnError) {
+  const std::string dem = std::string(DRIFT_SOURCE_DIR) + "/data/mount_st_helens_usgs_30m.dem";
+  const fs::path p =
+      write_scene("off.toml", "[terrain]\nraster = \"" + dem +
+                                  "\"\n[camera]\nfrom_lonlat = [10.0, 46.2]\nto = [0, 0, 0]\n");
+  auto s = drift::pipeline::read_scene_file(p);
+  try {
+    drift::pipeline::load_scene_terrain(s);
+    ADD_FAILURE() << "a camera off the terrain must be an error";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("from_lonlat"), std::string::npos) << e.what();
+  }
+  EXPECT_NE(error_of(std::string(kTerrain) + "[camera]\nfrom = [0, 0, 0]\n").find("to_lonlat"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) +
+                     "[camera]\nfrom = [0, 0, 0]\nfrom_lonlat = [1, 2]\nto = [1, 1, 1]\n")
+                .find("both"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of(std::string(kTerrain) + "[camera]\nfrom = [0, 0, 0]\nto = [1, 1, 1]\nf_number = 2\n")
+          .find("focal_length"),
+      std::string::npos);
 }

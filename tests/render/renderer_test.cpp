@@ -163,3 +163,44 @@ TEST(Renderer, MeshRoofShadowsTheGround) {
   EXPECT_TRUE(scene.occluded({0, 0, 0.01f}, {0, 0, 1}, 1e30f)) << "under the roof";
   EXPECT_FALSE(scene.occluded({60, 0, 0.01f}, {0, 0, 1}, 1e30f)) << "open ground";
 }
+
+TEST(Camera, FocalLengthGivesTheFieldOfViewOverTheSensor) {
+  SceneInput in;
+  in.terrain = make_dem(8, 10.0, [](double, double) { return 0.0; });
+  const TerrainScene scene(in);
+  Camera c;
+  c.from = scene.origin() + Eigen::Vector3d(0, 0, 10);
+  c.to = scene.origin() + Eigen::Vector3d(0, 100, 10);
+  c.focal_length_mm = 50.0;  // on 36 mm: 39.6 degrees across
+  const CameraRays rays = make_camera_rays(scene, c, 160, 90);
+  const Eigen::Vector3f edge = rays.direction(160.0f, 45.0f);
+  EXPECT_NEAR(std::atan2(edge.x(), edge.y()), std::atan(18.0 / 50.0), 1e-5);
+}
+
+TEST(Camera, ThinLensRaysMeetOnTheFocalPlane) {
+  SceneInput in;
+  in.terrain = make_dem(8, 10.0, [](double, double) { return 0.0; });
+  const TerrainScene scene(in);
+  Camera c;
+  c.from = scene.origin() + Eigen::Vector3d(0, 0, 10);
+  c.to = scene.origin() + Eigen::Vector3d(0, 100, 10);
+  c.focal_length_mm = 100.0;
+  c.f_number = 2.0;  // 50 mm aperture: 25 mm lens radius
+  c.focus_distance = 40.0;
+  const CameraRays rays = make_camera_rays(scene, c, 64, 48);
+  EXPECT_FLOAT_EQ(rays.lens_radius, 0.025f);
+  Eigen::Vector3f o0, d0;
+  rays.ray(10.3f, 30.7f, 0.0f, 0.0f, o0, d0);  // lens centre: the pinhole ray
+  const Eigen::Vector3f focus = o0 + d0 * (40.0f / d0.dot(rays.forward));
+  float spread = 0.0f;
+  for (float u : {0.1f, 0.5f, 0.9f}) {
+    for (float v : {0.2f, 0.7f}) {
+      Eigen::Vector3f o, d;
+      rays.ray(10.3f, 30.7f, u, v, o, d);
+      spread = std::max(spread, (o - rays.eye).norm());
+      const float t = (focus - o).dot(rays.forward) / d.dot(rays.forward);
+      EXPECT_NEAR((o + d * t - focus).norm(), 0.0f, 1e-4f);  // sharp at 40 m
+    }
+  }
+  EXPECT_GT(spread, 0.01f);  // rays do leave from across the lens
+}
