@@ -1,0 +1,84 @@
+// Nishimori-Ouchi sand transport on a periodic height field (paper 002, sec. 2,
+// after Nishimori & Ouchi 1993, PRL 71:197): wind ripples and dunes from
+// saltation and creep, plus avalanching to the angle of repose (SPEC 2).
+//
+// Frames and units. The model runs in the wind's frame: the wind blows along
+// +x (columns), so every row saltates independently. Flight lengths are in
+// cells and heights in the model's dimensionless unit, as in the paper; one
+// model unit is `height_unit` metres and one cell `cell_m` metres, which fixes
+// the physical slopes that avalanching limits. simulate() turns the result to
+// the wind's azimuth and into metres.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include "terrain/grid.h"
+#include "terrain/progress.h"
+
+namespace drift::dunes {
+
+enum class Model {
+  Ripples,  // L = L0 + b H,            q constant                (paper eq. 1)
+  Dunes,    // L = L0 - b tanh(dH/dx),  q = q0 + b' tanh(dH/dx)   (paper eqs. 2-3)
+};
+
+struct SandOptions {
+  Model model = Model::Ripples;
+  int size = 256;              // cells per side of the periodic square grid, [8, 16384]
+  double cell_m = 0.015;       // metres per cell (ripples 1-2 cm, dunes 0.5-2 m)
+  double height_unit = 0.0025;  // metres per model height unit
+  int steps = 500;             // time steps: saltation, creep, avalanching
+  std::uint64_t seed = 1;
+  double wind_from_deg = 270.0;    // where the wind comes FROM, clockwise from north
+  double L0 = 5.0;                 // base flight length, cells
+  double b = 2.0;                  // ripples: cells per height unit; dunes: tanh coefficient
+  double q = 0.1;                  // height units lifted per cell and step (dunes: q0)
+  double b_prime = 0.0;            // dunes: extra lift on windward slopes
+  double creep = 0.25;             // D in H += D * (mean of 4 neighbours - H) * 4 / 4
+  double initial_amplitude = 1.0;  // random start: uniform in [0, amplitude) height units
+  double repose_deg = 34.0;        // angle of repose of dry sand
+  // Dunes: the lee of a crest below this angle is out of the wind (Werner
+  // 1995; beyond paper 002, which has no wind shadow): no lift there, and
+  // grains flying into it are caught. 0 turns it off.
+  double shadow_deg = 15.0;
+};
+
+// The defaults of each model (documented in `drift dunes --help`).
+SandOptions default_options(Model model);
+
+// Throws drift::Error naming the option, its value and its range.
+void validate(const SandOptions& options);
+
+// The seeded random start in the wind's frame (model units).
+terrain::HeightField initial_field(const SandOptions& options);
+
+// Saltation along +x (paper eq. 1 or eqs. 2-3): every cell lifts q and drops it
+// L cells downwind, a non-integer landing shared linearly between the two
+// cells around it. Row by row in double precision: exact mass bookkeeping and
+// the same bits for any thread count.
+void saltate(terrain::HeightField& h, const SandOptions& options);
+
+// Creep: H += D/4 * (sum of the 4 neighbours - 4 H) (the paper's diffusion),
+// as antisymmetric fluxes across edges, so mass is conserved.
+void creep(terrain::HeightField& h, double coefficient);
+
+// One time step: saltate, creep, then `avalanche_sweeps` relaxation sweeps.
+void step(terrain::HeightField& h, const SandOptions& options);
+
+// The whole run in the wind's frame, in model units (for tests and snapshots).
+// `snapshot(k, field)` is called after every `snapshot_every` steps if > 0.
+using SnapshotFn = std::function<void(int step, const terrain::HeightField& model_field)>;
+terrain::HeightField run(const SandOptions& options, const ProgressFn& progress = no_progress,
+                         int snapshot_every = 0, const SnapshotFn& snapshot = nullptr);
+
+// Model field (wind frame, model units) -> ground field: turned to the wind's
+// azimuth (north up) and in metres with a local georeference of cell_m.
+// Multiples of 90 degrees are exact and tileable; other azimuths resample the
+// periodic field bilinearly and are not tileable.
+terrain::HeightField to_ground(const terrain::HeightField& model_field, const SandOptions& options);
+
+// run() then to_ground().
+terrain::HeightField simulate(const SandOptions& options, const ProgressFn& progress = no_progress);
+
+}  // namespace drift::dunes
