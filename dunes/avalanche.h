@@ -13,8 +13,8 @@ namespace drift::dunes {
 // (so that no cell, with at most 4 downhill edges, overshoots its neighbours);
 // sweeps are Jacobi updates of antisymmetric edge fluxes, so mass is
 // conserved and the result is the same for any thread count. Stops when no
-// edge exceeds max_drop by more than `tolerance` or after `max_sweeps`;
-// returns the sweeps done.
+// edge exceeds max_drop by more than `tolerance` (checked every 8 sweeps) or
+// after `max_sweeps`; returns the sweeps done.
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance = 1e-4);
 
 // The steepest edge drop of the field (periodic), in its height unit.

@@ -25,10 +25,10 @@ enum class Model {
 
 struct SandOptions {
   Model model = Model::Ripples;
-  int size = 256;              // cells per side of the periodic square grid, [8, 16384]
-  double cell_m = 0.015;       // metres per cell (ripples 1-2 cm, dunes 0.5-2 m)
+  int size = 256;               // cells per side of the periodic square grid, [8, 16384]
+  double cell_m = 0.015;        // metres per cell (ripples 1-2 cm, dunes 0.5-2 m)
   double height_unit = 0.0025;  // metres per model height unit
-  int steps = 500;             // time steps: saltation, creep, avalanching
+  int steps = 500;              // time steps: saltation, creep, avalanching
   std::uint64_t seed = 1;
   double wind_from_deg = 270.0;    // where the wind comes FROM, clockwise from north
   double L0 = 5.0;                 // base flight length, cells
