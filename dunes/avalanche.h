@@ -9,15 +9,20 @@ namespace drift::dunes {
 
 // `max_drop` is the largest height difference allowed between edge
 // neighbours, in the field's height unit (tan(repose) * cell / height unit).
-// Each sweep moves, across every edge steeper than that, a fifth of the excess
-// (so that no cell, with at most 4 downhill edges, overshoots its neighbours);
+// Edges join the 8 neighbours (diagonals sqrt(2) cells long, so the slope in
+// any direction is limited, within 8 %, not only its east and north parts).
+// Each sweep moves, across every edge steeper than its limit, a ninth of the
+// excess (so that no cell, with at most 8 downhill edges, overshoots);
 // sweeps are Jacobi updates of antisymmetric edge fluxes, so mass is
 // conserved and the result is the same for any thread count. Stops when no
 // edge exceeds max_drop by more than `tolerance` (checked every 8 sweeps) or
 // after `max_sweeps`; returns the sweeps done.
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance = 1e-4);
 
-// The steepest edge drop of the field (periodic), in its height unit.
+// The steepest east-west or north-south edge drop of the field (periodic).
 double max_edge_drop(const terrain::HeightField& h);
+
+// How far the steepest edge (of 8 neighbours) exceeds its limit (<= 0: none).
+double max_excess(const terrain::HeightField& h, double max_drop);
 
 }  // namespace drift::dunes

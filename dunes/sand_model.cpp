@@ -78,9 +78,9 @@ SandOptions default_options(Model model) {
     o.cell_m = 1.0;
     o.height_unit = 0.25;
     o.L0 = 20.0;
-    o.b = 3.0;
+    o.b = 1.0;
     o.q = 0.2;
-    o.b_prime = 0.03;
+    o.b_prime = 0.02;
     o.creep = 0.25;
     o.initial_amplitude = 2.0;
     o.steps = 3000;

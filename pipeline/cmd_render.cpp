@@ -22,7 +22,7 @@ struct RenderOptions {
   int spp = 0;
   std::string size;
   std::vector<std::string> outputs;
-  std::string terrain;
+  std::string terrain, snow_cover, snow_depth, ripples;
   unsigned long long seed = 0;
   std::string tile;
 };
@@ -44,6 +44,15 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   }
   if (sub.count("--seed")) scene.settings.seed = o.seed;
   if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
+  if (!o.snow_cover.empty()) scene.snow_cover = o.snow_cover;
+  if (!o.snow_depth.empty()) scene.snow_depth = o.snow_depth;
+  if (!o.ripples.empty()) {
+    if (!scene.input.surface.ripples) {
+      throw Error("--ripples needs a [ripples] section in '" + o.scene +
+                  "' (scale, rotation, strength); see docs/rendering.md");
+    }
+    scene.ripples = o.ripples;
+  }
   if (!o.outputs.empty()) {
     scene.outputs.clear();
     for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
@@ -108,6 +117,9 @@ void add_render_command(CLI::App& root) {
   sub->add_option("-o,--output", o->outputs,
                   "output file(s), .png and/or .exr (override the scene)");
   sub->add_option("--terrain", o->terrain, "terrain raster (overrides [terrain] raster)");
+  sub->add_option("--snow-cover", o->snow_cover, "snow cover raster (overrides [snow] cover)");
+  sub->add_option("--snow-depth", o->snow_depth, "snow depth raster (overrides [snow] depth)");
+  sub->add_option("--ripples", o->ripples, "ripple height tile (overrides [ripples] raster)");
   sub->add_option("--tile", o->tile,
                   "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16) to EXR; "
                   "join the bands with drift merge (docs/rendering.md)");

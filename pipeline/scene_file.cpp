@@ -178,6 +178,10 @@ SceneFile read_scene_file(const fs::path& path) {
   };
   scene.terrain_raster = resolve(*raster);
   in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
+  scene.terrain_repeat = terrain.integer("repeat", 1, 1, 9);
+  if (scene.terrain_repeat % 2 == 0) {
+    throw Error(path.string() + ": 'terrain.repeat' must be odd (the raster stays in the middle)");
+  }
   in.surface.ground.albedo = terrain.color("color", in.surface.ground.albedo);
   in.surface.ground.roughness =
       static_cast<float>(terrain.number("roughness", in.surface.ground.roughness, 0.0, 1.5));
@@ -363,14 +367,23 @@ void place_lonlat_camera(SceneFile& scene) {
 void load_scene_terrain(SceneFile& scene) {
   render::TerrainSurface& surface = scene.input.surface;
   scene.input.terrain = read_metric_raster(scene.terrain_raster, "terrain");
+  if (scene.terrain_repeat > 1) {
+    scene.input.terrain = terrain::repeat_periodic(scene.input.terrain, scene.terrain_repeat);
+  }
   place_lonlat_camera(scene);
   if (!scene.snow_cover.empty())
     surface.snow_cover = read_metric_raster(scene.snow_cover, "snow cover");
   if (!scene.snow_depth.empty())
     surface.snow_depth = read_metric_raster(scene.snow_depth, "snow depth");
   if (!scene.ripples.empty() && surface.ripples) {
-    const terrain::HeightField tile = read_metric_raster(scene.ripples, "ripple raster");
-    const double texel = scene.ripple_texel_metres.value_or(tile.geo().cell_size_x());
+    terrain::HeightField tile = read_metric_raster(scene.ripples, "ripple raster");
+    const double native = tile.geo().cell_size_x();
+    const double texel = scene.ripple_texel_metres.value_or(native);
+    // A ripple field scaled to another cell size is scaled as a whole, heights
+    // too, so its slopes (what shading sees) stay those simulated.
+    if (native > 0.0 && texel != native) {
+      for (float& v : tile.values()) v = static_cast<float>(v * (texel / native));
+    }
     try {
       surface.ripples->slopes = render::SlopePyramid(tile, texel);
     } catch (const Error& e) {

@@ -26,6 +26,7 @@ struct SceneFile {
   // empty when the scene has none.
   std::filesystem::path snow_cover, snow_depth, ripples;
   std::optional<double> ripple_texel_metres;  // default: the ripple raster's cell size
+  int terrain_repeat = 1;  // [terrain] repeat: a tileable terrain laid out n x n (odd)
   // [camera] from_lonlat / to_lonlat: resolved into input.camera by
   // load_scene_terrain.
   std::optional<GeoPoint> camera_from_lonlat, camera_to_lonlat;

@@ -45,7 +45,9 @@ class Grid {
  public:
   Grid() = default;
   Grid(int width, int height, T fill = T{}, GeoReference geo = {})
-      : width_(width), height_(height), data_(checked_size(width, height), fill),
+      : width_(width),
+        height_(height),
+        data_(checked_size(width, height), fill),
         geo_(std::move(geo)) {}
 
   int width() const { return width_; }
@@ -91,5 +93,20 @@ class Grid {
 };
 
 using HeightField = Grid<float>;
+
+// A periodic (tileable) north-up grid repeated `times` x `times` around itself:
+// the original keeps its georeference in the middle tile (`times` odd).
+template <class T>
+Grid<T> repeat_periodic(const Grid<T>& tile, int times) {
+  assert(times >= 1 && times % 2 == 1);
+  GeoReference geo = tile.geo();
+  const int half = times / 2;
+  geo.geotransform[0] -= half * tile.width() * geo.geotransform[1];
+  geo.geotransform[3] -= half * tile.height() * geo.geotransform[5];
+  Grid<T> out(tile.width() * times, tile.height() * times, T{}, geo);
+  for (int row = 0; row < out.height(); ++row)
+    for (int x = 0; x < out.width(); ++x) out(x, row) = tile(x % tile.width(), row % tile.height());
+  return out;
+}
 
 }  // namespace drift::terrain

@@ -5,8 +5,11 @@
 # update:      render straight into the reference (written atomically by drift).
 # expect-fail: render with EXTRA arguments (a deliberate change) and require
 #              the comparison to FAIL: proves the tolerance is tight enough.
-# The scene may use @DRIFT_SOURCE_DIR@ in paths; it is substituted here, so
-# scenes work whatever directory the renderer resolves relative paths against.
+# The scene may use @DRIFT_SOURCE_DIR@ and @WORK@ in paths; they are substituted
+# here, so scenes work whatever directory the renderer resolves relative paths
+# against. A scene whose inputs are made by other stages lists those drift
+# commands, one per line, in <name>.prepare next to it (same substitutions);
+# they run first, so the golden image guards those stages too.
 cmake_minimum_required(VERSION 3.25)
 include(${CMAKE_CURRENT_LIST_DIR}/golden_settings.cmake)
 foreach(var DRIFT SCENE WORK REFERENCE)
@@ -22,6 +25,22 @@ get_filename_component(source_dir ${CMAKE_CURRENT_LIST_DIR}/../.. ABSOLUTE)
 set(DRIFT_SOURCE_DIR ${source_dir})
 
 file(MAKE_DIRECTORY ${WORK})
+get_filename_component(scene_dir ${SCENE} DIRECTORY)
+if(EXISTS ${scene_dir}/${name}.prepare)
+  file(STRINGS ${scene_dir}/${name}.prepare prepare_lines)
+  foreach(line ${prepare_lines})
+    if(line MATCHES "^[ \t]*(#|$)")
+      continue()
+    endif()
+    string(CONFIGURE "${line}" line @ONLY)
+    separate_arguments(args UNIX_COMMAND "${line}")
+    message(STATUS "golden ${name}: prepare: drift ${line}")
+    execute_process(COMMAND ${DRIFT} ${args} RESULT_VARIABLE rc OUTPUT_QUIET)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "golden ${name}: 'drift ${line}' failed (exit ${rc})")
+    endif()
+  endforeach()
+endif()
 file(READ ${SCENE} scene_text)
 string(CONFIGURE "${scene_text}" scene_text @ONLY)
 set(scene ${WORK}/${name}.toml)
