@@ -65,7 +65,10 @@ namespace {
 template <class T, class Fn>
 Grid<T> per_cell(const HeightField& dem, Fn cell) {
   require_metric_cells(dem);
-  Grid<T> out(dem.width(), dem.height(), T{}, dem.geo());
+  // Eigen vectors are not zeroed by T{}: start from a real zero.
+  T zero{};
+  if constexpr (requires { T::Zero(); }) zero = T::Zero();
+  Grid<T> out(dem.width(), dem.height(), zero, dem.geo());
   tbb::parallel_for(0, dem.height(), [&](int row) {
     for (int x = 0; x < dem.width(); ++x) out(x, row) = cell(x, row);
   });
