@@ -13,8 +13,9 @@ namespace {
 // Transforms one point from `from` to `to` (traditional x = lon/east order).
 std::array<double, 2> transform(const std::string& from_wkt, bool from_wgs84, double x, double y) {
   if (!from_wgs84 && from_wkt.empty())
-    throw Error("the raster has no CRS, so it cannot be placed on the globe; "
-                "give it one (gdal_edit.py -a_srs) or use CRS coordinates");
+    throw Error(
+        "the raster has no CRS, so it cannot be placed on the globe; "
+        "give it one (gdal_edit.py -a_srs) or use CRS coordinates");
   OGRSpatialReference crs, wgs84;
   wgs84.importFromEPSG(4326);
   if (crs.importFromWkt(from_wkt.c_str()) != OGRERR_NONE)
@@ -39,6 +40,12 @@ std::array<double, 2> to_lonlat(const std::string& crs_wkt, double x, double y) 
 std::array<double, 2> from_lonlat(const std::string& crs_wkt, double lon, double lat) {
   if (crs_wkt.empty()) return transform(crs_wkt, false, lon, lat);  // the same error
   return transform(crs_wkt, true, lon, lat);
+}
+
+bool is_geographic(const std::string& crs_wkt) {
+  if (crs_wkt.empty()) return false;
+  OGRSpatialReference crs;
+  return crs.importFromWkt(crs_wkt.c_str()) == OGRERR_NONE && crs.IsGeographic();
 }
 
 std::array<double, 2> centre_lonlat(const GeoReference& geo, int width, int height) {

@@ -16,6 +16,10 @@ std::array<double, 2> to_lonlat(const std::string& crs_wkt, double x, double y);
 // (x, y) in the CRS given as WKT of lon/lat (WGS 84, degrees); throws likewise.
 std::array<double, 2> from_lonlat(const std::string& crs_wkt, double lon, double lat);
 
+// True if the CRS given as WKT is geographic (degrees); false for projected
+// CRSs and for an empty WKT (a local grid in metres).
+bool is_geographic(const std::string& crs_wkt);
+
 // lon/lat of the centre of a raster with this georeference and size.
 std::array<double, 2> centre_lonlat(const GeoReference& geo, int width, int height);
 

@@ -1,0 +1,104 @@
+// drift snow cover DEM.tif -o COVER.tif: the snow-cover descriptor of paper 001
+// (Tangent Sphere Accessibility of the smoothed DEM, altitude, sun aspect).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+
+#include "pipeline/cli.h"
+#include "pipeline/progress_bar.h"
+#include "snow/snow_cover.h"
+#include "terrain/error.h"
+#include "terrain/raster_io.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+struct CoverCommand {
+  std::string dem, output, accessibility, descriptor, hemisphere = "auto";
+  double snow_line = 0.0;
+  snow::CoverOptions options;
+};
+
+void run_cover(CoverCommand& c, const CLI::App& sub) {
+  snow::CoverOptions o = c.options;
+  if (sub.count("--radius") && sub.count("--radius-cells")) {
+    usage_error("give --radius (metres) or --radius-cells, not both");
+  }
+  if (sub.count("--snow-line")) o.snow_line_m = c.snow_line;
+  if (sub.count("--band") && !sub.count("--snow-line")) usage_error("--band needs --snow-line");
+  o.hemisphere = c.hemisphere == "north"   ? snow::Hemisphere::North
+                 : c.hemisphere == "south" ? snow::Hemisphere::South
+                                           : snow::Hemisphere::Auto;
+  const terrain::HeightField dem = terrain::read_raster(c.dem);
+  snow::CoverResult r;
+  try {
+    r = snow::snow_cover(dem, o, terminal_progress("snow cover"));
+  } catch (const Error& e) {
+    throw Error(c.dem + ": " + e.what());
+  }
+  // The cover is what the renderer's [snow] cover takes: snow's share, 1 - t.
+  terrain::HeightField cover = r.descriptor;
+  for (float& v : cover.values()) v = 1.0f - v;
+  terrain::write_geotiff(cover, c.output, {"snow cover (1 - t)", ""});
+  if (!c.descriptor.empty())
+    terrain::write_geotiff(r.descriptor, c.descriptor, {"snow descriptor t (0 snow, 1 rock)", ""});
+  if (!c.accessibility.empty())
+    terrain::write_geotiff(r.accessibility, c.accessibility, {"tangent sphere accessibility", "m"});
+  double mean = 0;
+  for (float v : cover.values()) mean += v;
+  std::printf("snow cover: %d x %d cells, mean cover %.3f, sun from the %s -> %s\n", cover.width(),
+              cover.height(), mean / static_cast<double>(cover.size()),
+              r.southern ? "north (southern hemisphere)" : "south (northern hemisphere)",
+              c.output.c_str());
+}
+
+}  // namespace
+
+void add_snow_cover_command(CLI::App& root) {
+  CLI::App& group = command_group(root, "snow", "snow stages: cover (descriptor), fall");
+  auto c = std::make_shared<CoverCommand>();
+  auto self = std::make_shared<CLI::App*>(nullptr);
+  CLI::App* sub = add_subcommand(group, "cover",
+                                 "snow-cover descriptor of a DEM (tangent sphere accessibility, "
+                                 "altitude, sun aspect; paper 001)",
+                                 [c, self] { run_cover(*c, **self); });
+  *self = sub;
+  snow::CoverOptions& o = c->options;
+  sub->add_option("dem", c->dem, "DEM GeoTIFF in metres (drift import)")->required();
+  sub->add_option("-o,--output", c->output, "snow cover GeoTIFF, 1 - t in [0, 1]")->required();
+  sub->add_option("--region", o.region, "smoothing region n, cells (diamond of 4n + 2n(n-1))")
+      ->check(CLI::Range(1, 32))
+      ->capture_default_str();
+  sub->add_option("--iterations", o.iterations, "smoothing passes k")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
+  sub->add_option("--radius", o.radius_m, "probe radius r in metres (default: 55 cells)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--radius-cells", o.radius_cells,
+                  "probe radius in cells (the paper's 5.5 at its 0.1 spacing = 55)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--floor", o.floor, "b: rock showing where TSA is 0, [0, 1]")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  sub->add_option("--sun-range", o.sun_range_deg,
+                  "theta1: slopes facing within this many degrees of the sun lose snow (0: off)")
+      ->check(CLI::Range(0.0, 90.0))
+      ->capture_default_str();
+  sub->add_option("--snow-line", c->snow_line,
+                  "snow line in metres: no snow below, full above (default: (z/zmax)^2)");
+  sub->add_option("--band", o.band_m, "width of the snow line's transition, metres")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--hemisphere", c->hemisphere,
+                  "where the sun stands: auto (from the DEM's CRS), north or south")
+      ->check(CLI::IsMember({"auto", "north", "south"}))
+      ->capture_default_str();
+  sub->add_option("--descriptor", c->descriptor, "also write t (0 snow, 1 rock)");
+  sub->add_option("--accessibility", c->accessibility, "also write the TSA in metres");
+}
+
+DRIFT_COMMAND(40, add_snow_cover_command);
+
+}  // namespace drift::pipeline
