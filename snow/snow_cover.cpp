@@ -210,8 +210,11 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
   if (o.sun_range_deg > 0.0) {
     const float dx = static_cast<float>(dem.geo().cell_size_x());
     const float dy = static_cast<float>(dem.geo().cell_size_y());
-    const float sun_side = southern ? 0.0f : 180.0f;  // compass azimuth faced by sunny slopes
-    const float theta1 = static_cast<float>(o.sun_range_deg);
+    // Horizontal unit vector towards the sun's side: south (0, -1) in the
+    // northern hemisphere, north (0, 1) in the southern.
+    const float sun_y = southern ? 1.0f : -1.0f;
+    const float theta1 = static_cast<float>(o.sun_range_deg * std::numbers::pi / 180.0);
+    const float cos_theta1 = std::cos(theta1);
     HeightField corrected = t;
     for_rows(dem.height(), [&](int row) {
       for (int x = 0; x < dem.width(); ++x) {
@@ -220,14 +223,14 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
         for (const auto& tri : kTriangles) {
           const Vector3f a = position(smoothed, x + tri[0], row + tri[1], dx, dy) - X;
           const Vector3f c = position(smoothed, x + tri[2], row + tri[3], dx, dy) - X;
-          Vector3f m = a.cross(c);
-          if (m.z() < 0.0f) m = -m;
-          float phi = 1.0f;
-          if (std::hypot(m.x(), m.y()) > 1e-6f * m.norm()) {
-            const float aspect =
-                std::atan2(m.x(), m.y()) * static_cast<float>(180.0 / std::numbers::pi);
-            float off = std::fabs(std::remainder(aspect - sun_side, 360.0f));
-            if (off <= theta1) phi = off / theta1;
+          const Vector3f m = a.cross(c);  // the face normal, up or down (sign below)
+          const float h2 = m.x() * m.x() + m.y() * m.y();
+          float phi = 1.0f;  // 1: no effect (outside the range, or flat)
+          if (h2 > 1e-12f * m.squaredNorm()) {
+            // Cosine of the angle between the face's aspect and the sun's side.
+            const float sign = m.z() < 0.0f ? -1.0f : 1.0f;
+            const float cos_off = sign * m.y() * sun_y / std::sqrt(h2);
+            if (cos_off >= cos_theta1) phi = std::acos(std::min(cos_off, 1.0f)) / theta1;
           }
           phi_sum += phi;
         }
