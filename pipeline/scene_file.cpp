@@ -228,6 +228,17 @@ SceneFile read_scene_file(const fs::path& path) {
   sun.finish();
 
   Section sky(subtable(root, "sky", path), "sky", path);
+  if (const auto model = sky.string("model")) {
+    if (*model == "physical") {
+      in.sky.model = render::SkyModel::Physical;
+    } else if (*model == "simple") {
+      in.sky.model = render::SkyModel::Simple;
+    } else {
+      throw Error(path.string() + ": 'sky.model' is '" + *model +
+                  "'; use \"physical\" (an Earth atmosphere) or \"simple\" (a gradient)");
+    }
+  }
+  in.sky.haze = static_cast<float>(sky.number("haze", in.sky.haze, 0.0, 50.0));
   in.sky.zenith = sky.color("zenith", in.sky.zenith);
   in.sky.horizon = sky.color("horizon", in.sky.horizon);
   in.sky.intensity = static_cast<float>(sky.number("intensity", in.sky.intensity, 0.0, 1e6));

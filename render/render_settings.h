@@ -21,10 +21,17 @@ struct Sun {
   Eigen::Vector3f color{1.0f, 0.95f, 0.88f};  // linear RGB tint
 };
 
-// A simple analytic sky (the physical atmosphere replaces it, issue 7): radiance
-// blends from `horizon` to `zenith` with the sine of the elevation; below the
-// horizon it is `horizon` * ground_factor.
+// The sky. Physical (the default): an Earth atmosphere (render/atmosphere.h)
+// lights the scene, colours the sun and fills the air between the camera and
+// the ground (aerial perspective); `haze` scales its aerosols. Simple: an
+// analytic gradient from `horizon` to `zenith` with the sine of the elevation
+// (below the horizon `horizon` * ground_factor) and no air. `constant`: the
+// same radiance `intensity` everywhere (white-furnace tests).
+enum class SkyModel { Physical, Simple };
+
 struct Sky {
+  SkyModel model = SkyModel::Physical;
+  float haze = 1.0f;  // aerosol density relative to Bruneton 2017's (visibility ~ 1/haze)
   Eigen::Vector3f zenith{0.25f, 0.42f, 0.80f};
   Eigen::Vector3f horizon{0.70f, 0.78f, 0.90f};
   float intensity = 1.0f;      // multiplies both

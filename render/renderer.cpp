@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <string>
 
 #include "render/brdf.h"
+#include "render/physical_sky.h"
 #include "render/random.h"
 #include "terrain/error.h"
 
@@ -176,6 +178,24 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const Vector3f sun_irradiance = sun.color * static_cast<float>(sun.irradiance);
   const bool sun_up = sun.irradiance > 0.0 && sun_dir.z() > -0.2f;
 
+  // The physical atmosphere, precomputed for this camera and sun.
+  std::unique_ptr<Atmosphere> atmosphere;
+  std::unique_ptr<PhysicalSky> air;
+  if (input.sky.model == SkyModel::Physical && !input.sky.constant) {
+    AtmosphereParameters parameters;
+    parameters.aerosol_scale = input.sky.haze;
+    atmosphere = std::make_unique<Atmosphere>(parameters);
+    const double camera_altitude = scene.origin().z() + camera_rays.eye.z();
+    const double reach = camera_rays.eye.head<2>().norm() + scene.extent().norm();
+    air = std::make_unique<PhysicalSky>(*atmosphere, camera_altitude, sun_dir.cast<double>(),
+                                        static_cast<float>(sun.irradiance),
+                                        reach);
+  }
+  const float base_altitude = static_cast<float>(scene.origin().z());
+  auto sky_light = [&](const Vector3f& d) {
+    return air ? air->sky(d) : sky_radiance(input.sky, d);
+  };
+
   auto trace = [&](int px, int py, SampleStream& rng, std::uint64_t& rays) {
     PixelSample out;
     const float jx = rng.next(), jy = rng.next();
@@ -191,8 +211,18 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
       Hit hit;
       ++rays;
       if (!scene.intersect(origin, dir, hit, cone)) {
-        out.radiance += throughput.cwiseProduct(sky_radiance(input.sky, dir));
+        out.radiance += throughput.cwiseProduct(sky_light(dir));
         break;
+      }
+      if (air) {
+        // The air between the ray's start and the hit: in-scattered light
+        // added, the light from behind attenuated (aerial perspective).
+        const AirSegment seg =
+            depth == 0 ? air->from_camera(dir, hit.distance)
+                       : air->segment(base_altitude + 0.5f * (origin.z() + hit.position.z()), dir,
+                                      hit.distance);
+        out.radiance += throughput.cwiseProduct(seg.inscatter);
+        throughput = throughput.cwiseProduct(seg.transmittance);
       }
       if (depth == 0) {
         out.depth = hit.distance;
@@ -210,7 +240,9 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         const Vector3f l = cone_sample(sun_dir, sun_cos_max, u1, u2);
         const float cos_l = hit.normal.dot(l);
         if (cos_l > 0.0f && l.z() > -0.2f && (++rays, !scene.occluded(p, l, 1e30f))) {
-          out.radiance += throughput.cwiseProduct(brdf).cwiseProduct(sun_irradiance) *
+          const Vector3f e =
+              air ? air->sun_irradiance(base_altitude + hit.position.z()) : sun_irradiance;
+          out.radiance += throughput.cwiseProduct(brdf).cwiseProduct(e) *
                           (cos_l * oren_nayar_factor(hit.normal, l, wo, hit.roughness));
         }
       }
