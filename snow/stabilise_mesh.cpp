@@ -1,0 +1,131 @@
+#include "snow/stabilise_mesh.h"
+
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "terrain/error.h"
+
+namespace drift::snow {
+
+namespace {
+constexpr double kNoFootprint = 1e-12;  // m^2: below this a vertex holds no snow
+}
+
+std::vector<double> vertex_footprints(const terrain::Mesh& mesh) {
+  std::vector<double> a(mesh.vertex_count(), 0.0);
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d p0 = mesh.positions[t[0]].cast<double>();
+    const Eigen::Vector3d n =
+        (mesh.positions[t[1]].cast<double>() - p0).cross(mesh.positions[t[2]].cast<double>() - p0);
+    const double horizontal = 0.5 * n.z();  // signed projected area: > 0 faces up
+    if (horizontal <= 0.0) continue;
+    for (int k = 0; k < 3; ++k) a[t[k]] += horizontal / 3.0;
+  }
+  return a;
+}
+
+MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<double>& footprint,
+                                   std::vector<double>& volume, const StabiliseOptions& options) {
+  if (!(options.repose_deg > 0.0 && options.repose_deg < 90.0))
+    throw Error("the angle of repose of snow must lie in (0, 90) degrees");
+  const std::size_t n = mesh.vertex_count();
+  const double tan_r = std::tan(options.repose_deg * std::numbers::pi / 180.0);
+  auto holds = [&](std::size_t i) { return footprint[i] > kNoFootprint; };
+
+  // Edges with the number of triangles using them (1: open border).
+  std::map<std::pair<int, int>, int> edge_use;
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      ++edge_use[{std::min(a, b), std::max(a, b)}];
+    }
+  // CSR of holding neighbours of holding vertices; which vertices border the holding region.
+  std::vector<std::vector<int>> adj(n);
+  std::vector<unsigned char> edge_vertex(n, 0);
+  for (const auto& [e, uses] : edge_use) {
+    const auto [a, b] = e;
+    if (holds(a) && holds(b)) {
+      adj[a].push_back(b);
+      adj[b].push_back(a);
+    }
+    if (uses == 1 || !holds(a) || !holds(b)) edge_vertex[a] = edge_vertex[b] = 1;
+  }
+  std::vector<std::size_t> start(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] = start[i] + adj[i].size();
+  std::vector<int> to(start[n]);
+  std::vector<std::size_t> reverse(start[n]);
+  std::vector<double> reach(start[n]);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::sort(adj[i].begin(), adj[i].end());
+    for (std::size_t k = 0; k < adj[i].size(); ++k) {
+      const int j = adj[i][k];
+      to[start[i] + k] = j;
+      const Eigen::Vector3f d = mesh.positions[j] - mesh.positions[i];
+      reach[start[i] + k] = tan_r * std::hypot(static_cast<double>(d.x()), d.y());
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t e = start[i]; e < start[i + 1]; ++e) {
+      const auto& nb = adj[to[e]];
+      reverse[e] = start[to[e]] + (std::lower_bound(nb.begin(), nb.end(), static_cast<int>(i)) -
+                                   nb.begin());
+    }
+
+  MeshStabiliseReport report;
+  report.shed.assign(n, 0.0);
+  if (n == 0) {
+    report.converged = true;
+    return report;
+  }
+  std::vector<double> flow(start[n]), shed_now(n), next(n);
+  for (int it = 0; it < options.max_iterations; ++it) {
+    // Flows out of each vertex from the current state: the paper's three cases, with
+    // the virtual "falls off" neighbour of border vertices among the candidates.
+    std::vector<double> largest(n, 0.0);
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      shed_now[i] = 0.0;
+      for (std::size_t e = start[i]; e < start[i + 1]; ++e) flow[e] = 0.0;
+      if (!holds(i) || volume[i] <= 0.0) return;
+      const double a = footprint[i], hi = mesh.positions[i].z() + volume[i] / a;
+      double sum = 0.0, steepest = 0.0;
+      for (std::size_t e = start[i]; e < start[i + 1]; ++e) {
+        const int j = to[e];
+        const double ex = hi - (mesh.positions[j].z() + volume[j] / footprint[j]) - reach[e];
+        if (ex <= 0.0) continue;
+        const double q = ex / (1.0 / a + 1.0 / footprint[j]);
+        flow[e] = q, sum += q, steepest = std::max(steepest, q);
+      }
+      double shed = 0.0;
+      if (edge_vertex[i]) {
+        const double ex = volume[i] / a - tan_r * 0.5 * std::sqrt(a);
+        if (ex > 0.0) shed = ex * a, sum += shed, steepest = std::max(steepest, shed);
+      }
+      if (sum == 0.0) return;
+      const double out = std::min(volume[i], steepest);
+      const double scale = out / sum;
+      for (std::size_t e = start[i]; e < start[i + 1]; ++e) flow[e] *= scale;
+      shed_now[i] = shed * scale;
+      largest[i] = out / a;
+    });
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      double v = volume[i] - shed_now[i];
+      for (std::size_t e = start[i]; e < start[i + 1]; ++e) v += flow[reverse[e]] - flow[e];
+      next[i] = v;
+    });
+    volume.swap(next);
+    for (std::size_t i = 0; i < n; ++i) report.shed[i] += shed_now[i];
+    report.iterations = it + 1;
+    if (*std::max_element(largest.begin(), largest.end()) <= options.tolerance) {
+      report.converged = true;
+      break;
+    }
+  }
+  return report;
+}
+
+}  // namespace drift::snow
