@@ -77,11 +77,11 @@ void run_snowfall(SnowfallCommand& c) {
 void add_snowfall_command(CLI::App& root) {
   CLI::App& group = command_group(root, "snow", "snow: snowfall (fall) and snow cover (cover)");
   auto c = std::make_shared<SnowfallCommand>();
-  CLI::App* sub = add_subcommand(
-      group, "fall",
-      "snowfall on a DEM and objects: occlusion by depth maps, jittered directions, "
-      "stabilisation (paper 003)",
-      [c] { run_snowfall(*c); });
+  CLI::App* sub =
+      add_subcommand(group, "fall",
+                     "snowfall on a DEM and objects: occlusion by depth maps, jittered directions, "
+                     "stabilisation (paper 003)",
+                     [c] { run_snowfall(*c); });
   snow::SnowfallOptions& o = c->options;
   sub->add_option("ground", c->ground, "ground heights, a metric GeoTIFF (see drift import)")
       ->required();

@@ -31,8 +31,8 @@ std::vector<render::PlacedMesh> read_objects(const toml::table& root, const fs::
       render::PlacedMesh placed;
       placed.albedo = obj.color("color", placed.albedo);
       obj.finish();
-      const fs::path mp =
-          fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path) : file.parent_path() / *mesh_path;
+      const fs::path mp = fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path)
+                                                             : file.parent_path() / *mesh_path;
       placed.mesh = terrain::read_obj(mp, y_up);
       const double a = rotate * M_PI / 180.0;
       placed.position = position ? *position : Eigen::Vector3d::Zero();

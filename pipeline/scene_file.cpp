@@ -5,9 +5,9 @@
 #include <cmath>
 #include <set>
 
-#include "terrain/error.h"
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
+#include "terrain/error.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {

@@ -19,10 +19,10 @@
 namespace drift::snow {
 
 struct CoverageOptions {
-  double thin_depth = 0.03;       // m: snow thinner than this is a speckle, (0, 10]
-  double adhesion = 0.6;          // coverage of stuck flakes on a wall facing the snow, [0, 1]
-  double adhesion_min_slope = 60; // degrees from horizontal where flakes start to stick, [0, 90)
-  double adhesion_depth = 0.05;   // m of snowfall that makes 63 % of the full adhesion, > 0
+  double thin_depth = 0.03;        // m: snow thinner than this is a speckle, (0, 10]
+  double adhesion = 0.6;           // coverage of stuck flakes on a wall facing the snow, [0, 1]
+  double adhesion_min_slope = 60;  // degrees from horizontal where flakes start to stick, [0, 90)
+  double adhesion_depth = 0.05;    // m of snowfall that makes 63 % of the full adhesion, > 0
 };
 
 // Coverage from depth alone (thin-snow speckle).

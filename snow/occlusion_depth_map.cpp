@@ -34,10 +34,14 @@ double depth_bias(double texel, double cos_phi) {
 bool DepthMap::lit(const Eigen::Vector3d& p, const Eigen::Vector3d& n) const {
   const double cos_phi = n.dot(frame.w);
   if (cos_phi <= 0.0) return false;
+  return lit_biased(p, depth_bias(texel, cos_phi));
+}
+
+bool DepthMap::lit_biased(const Eigen::Vector3d& p, double bias) const {
   const Eigen::Vector3d q = frame.project(p);
   const float top = top_at(q.x(), q.y());
   if (top == kEmpty) return true;
-  return q.z() - c_ref >= static_cast<double>(top) - depth_bias(texel, cos_phi);
+  return q.z() - c_ref >= static_cast<double>(top) - bias;
 }
 
 }  // namespace drift::snow

@@ -24,7 +24,7 @@ struct DepthMap {
   double a0 = 0, b0 = 0;  // light-space corner of texel (0, 0)
   double texel = 1;       // metres
   int width = 0, height = 0;
-  double c_ref = 0;  // depths are stored relative to it (float precision)
+  double c_ref = 0;        // depths are stored relative to it (float precision)
   std::vector<float> top;  // per texel: largest c - c_ref (surface nearest the source); -inf empty
 
   static constexpr float kEmpty = -std::numeric_limits<float>::infinity();
@@ -41,6 +41,9 @@ struct DepthMap {
   // acne), while occluders farther than that keep their shadow (no peter-panning
   // beyond one texel). Faces turned away from the source (n.w <= 0) are unlit.
   bool lit(const Eigen::Vector3d& p, const Eigen::Vector3d& n) const;
+  // With a bias (m) chosen by the caller, e.g. from the steepest of several normals
+  // where surfaces meet at a concave kink.
+  bool lit_biased(const Eigen::Vector3d& p, double bias) const;
 };
 
 // Slope-scaled bias for a surface whose unit normal makes cos_phi with w.

@@ -14,7 +14,7 @@
 namespace drift::snow {
 
 namespace {
-constexpr int kTile = 4096;      // texels a side per draw (64 MiB of float depth)
+constexpr int kTile = 4096;       // texels a side per draw (64 MiB of float depth)
 constexpr int kGroundChunk = 64;  // rows of the height field per draw call
 
 void check_gl(const char* what) {
@@ -97,7 +97,8 @@ void OsmesaDepthRenderer::render(DepthMap& map, double c_lo, double c_hi,
       const int r1 = std::min(r0 + kGroundChunk, h.height() - 1);
       double lo = 1e300, hi = -1e300;
       for (int r = r0; r <= r1; ++r)
-        for (int x = 0; x < h.width(); ++x) lo = std::min<double>(lo, h(x, r)), hi = std::max<double>(hi, h(x, r));
+        for (int x = 0; x < h.width(); ++x)
+          lo = std::min<double>(lo, h(x, r)), hi = std::max<double>(hi, h(x, r));
       chunks.push_back({r0, r1, lo, hi});
     }
   }
@@ -122,7 +123,8 @@ void OsmesaDepthRenderer::render(DepthMap& map, double c_lo, double c_hi,
           for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh->positions[i][k];
         indices.resize(mesh->triangles.size() * 3);
         for (std::size_t t = 0; t < mesh->triangles.size(); ++t)
-          for (int k = 0; k < 3; ++k) indices[3 * t + k] = static_cast<GLuint>(mesh->triangles[t][k]);
+          for (int k = 0; k < 3; ++k)
+            indices[3 * t + k] = static_cast<GLuint>(mesh->triangles[t][k]);
         glVertexPointer(3, GL_FLOAT, 0, vertices.data());
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices.size()), GL_UNSIGNED_INT,
                        indices.data());

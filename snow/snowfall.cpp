@@ -47,8 +47,8 @@ void SnowfallOptions::validate() const {
   check(coverage.thin_depth > 0 && coverage.thin_depth <= 10, "thin_depth", coverage.thin_depth,
         "(0, 10] m");
   check(coverage.adhesion >= 0 && coverage.adhesion <= 1, "adhesion", coverage.adhesion, "[0, 1]");
-  check(coverage.adhesion_min_slope >= 0 && coverage.adhesion_min_slope < 90,
-        "adhesion_min_slope", coverage.adhesion_min_slope, "[0, 90)");
+  check(coverage.adhesion_min_slope >= 0 && coverage.adhesion_min_slope < 90, "adhesion_min_slope",
+        coverage.adhesion_min_slope, "[0, 90)");
   check(coverage.adhesion_depth > 0, "adhesion_depth", coverage.adhesion_depth, "(0, inf) m");
   check(tolerance > 0, "tolerance", tolerance, "(0, inf) m");
   check(max_iterations >= 1, "max_iterations", max_iterations, "[1, inf)");
@@ -96,8 +96,8 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
       const Eigen::Vector3d cross =
           (m.positions[tri[1]].cast<double>() - p0).cross(m.positions[tri[2]].cast<double>() - p0);
       const double horizontal = std::max(0.0, 0.5 * cross.z());
-      const Eigen::Vector3d n = cross.norm() > 0 ? Eigen::Vector3d(cross.normalized())
-                                                 : Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d n =
+          cross.norm() > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::UnitZ();
       const double adhesion = adhesion_coverage(n, prob.facing[o][t], amount, options.coverage);
       for (int k = 0; k < 3; ++k) {
         volume[tri[k]] += horizontal / 3.0 * prob.faces[o][t] * amount;
@@ -111,7 +111,7 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
       if (face_count[i] > 0) os.adhesion[i] /= face_count[i];
       // Paper 2.3(2): a vertex's probability is the mean of its faces'; where the
       // vertex holds snow, weighted by the footprint each face gives it.
-      os.probability[i] = footprint[i] > 0 ? volume[i] / (footprint[i] * amount)
+      os.probability[i] = footprint[i] > 0    ? volume[i] / (footprint[i] * amount)
                           : face_count[i] > 0 ? os.probability[i] / face_count[i]
                                               : 0.0;
     }
@@ -154,16 +154,17 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
         continue;
       }
       const double d = snow(col, row);
-      result.depth(col, row) = static_cast<float>(d);
-      const double stuck = adhesion_coverage(scene.ground_normal(col, row),
-                                             prob.ground_facing(col, row), amount, options.coverage);
+      result.depth(col, row) = static_cast<float>(std::max(d, 0.0));  // -1e-16 from rounding
+      const double stuck = adhesion_coverage(
+          scene.ground_normal(col, row), prob.ground_facing(col, row), amount, options.coverage);
       result.coverage(col, row) =
           static_cast<float>(std::max(thin_coverage(d, options.coverage), stuck));
     }
   });
 
   // One mesh of all objects, raised by their snow, relative to a whole-metre origin.
-  result.mesh_origin = Eigen::Vector3d(std::round(scene.origin.x()), std::round(scene.origin.y()), 0.0);
+  result.mesh_origin =
+      Eigen::Vector3d(std::round(scene.origin.x()), std::round(scene.origin.y()), 0.0);
   const Eigen::Vector3d shift = scene.origin - result.mesh_origin;
   std::vector<float> a_depth, a_prob, a_cover, a_adhesion;
   for (std::size_t o = 0; o < scene.meshes.size(); ++o) {
@@ -180,7 +181,8 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
       a_cover.push_back(static_cast<float>(
           std::max(thin_coverage(os.depth[i], options.coverage), os.adhesion[i])));
     }
-    for (auto t : m.triangles) result.objects.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    for (auto t : m.triangles)
+      result.objects.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   }
   result.objects.vertex_attributes = {{"snow_depth", std::move(a_depth)},
                                       {"snow_probability", std::move(a_prob)},

@@ -69,8 +69,7 @@ struct SnowfallResult {
   terrain::Mesh objects;
   Eigen::Vector3d mesh_origin{0, 0, 0};
   // Bookkeeping (m^3): fallen = on ground + on objects + lost off the raster's edge.
-  double fallen_volume = 0, ground_volume = 0, object_volume = 0, shed_volume = 0,
-         lost_volume = 0;
+  double fallen_volume = 0, ground_volume = 0, object_volume = 0, shed_volume = 0, lost_volume = 0;
   int ground_iterations = 0, object_iterations = 0;
   bool converged = true;
 };

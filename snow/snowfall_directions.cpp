@@ -43,9 +43,9 @@ std::vector<FallDirection> jittered_directions(double azimuth_deg, double elevat
       // Equal-area strata in the disc of angles: radius^2 uniform in stratum k.
       const double alpha = cone * std::sqrt((k + uniform(seed, 1 + k)) / maps);
       const double phi = rotation + golden * k;
-      const Eigen::Vector3d d = (std::cos(alpha) * mean +
-                                 std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2))
-                                    .normalized();
+      const Eigen::Vector3d d =
+          (std::cos(alpha) * mean + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2))
+              .normalized();
       raw[k] = std::exp(-alpha * alpha / (2.0 * sigma * sigma));
       out[k].toward_source = d;
       out[k].angle_rad = alpha;

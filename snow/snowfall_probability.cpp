@@ -89,7 +89,16 @@ class TerrainOccluder {
 
   bool cell_lit(int col, int row, const Vector3d& n) const {
     if (n.dot(w_) <= 0.0) return false;
-    if (map_) return map_->lit(scene_.cell_point(col, row), n);
+    if (map_) {
+      // The texel nearest a cell centre may hold a neighbouring facet: bias for the
+      // steepest facet around the cell, or a lit concave kink shows acne.
+      double cos_phi = n.dot(w_);
+      const int W = scene_.ground.width(), H = scene_.ground.height();
+      for (auto [i, j] : {std::pair{col - 1, row}, {col + 1, row}, {col, row - 1}, {col, row + 1}})
+        if (i >= 0 && j >= 0 && i < W && j < H)
+          cos_phi = std::min(cos_phi, scene_.ground_normal(i, j).dot(w_));
+      return map_->lit_biased(scene_.cell_point(col, row), depth_bias(map_->texel, cos_phi));
+    }
     return shadow_(col, row) <= scene_.ground(col, row);
   }
 
@@ -150,8 +159,7 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
 
   float total_weight = 0.0f;
   for (std::size_t k = 0; k < dirs.size(); ++k) {
-    if (!progress(static_cast<double>(k) / dirs.size(), "snowfall depth maps"))
-      throw Cancelled();
+    if (!progress(static_cast<double>(k) / dirs.size(), "snowfall depth maps")) throw Cancelled();
     const Vector3d w = dirs[k].toward_source;
     const float weight = dirs[k].weight;
     total_weight += weight;

@@ -30,10 +30,10 @@ struct ProbabilityOptions {
 };
 
 struct SnowProbability {
-  terrain::Grid<float> ground;                 // [0, 1] per cell
-  std::vector<std::vector<float>> faces;       // per object, per triangle: [0, 1]
-  std::vector<std::vector<float>> facing;      // per object, per triangle: sum w lit (n . d)
-  terrain::Grid<float> ground_facing;          // per cell: sum w lit (n . d)
+  terrain::Grid<float> ground;             // [0, 1] per cell
+  std::vector<std::vector<float>> faces;   // per object, per triangle: [0, 1]
+  std::vector<std::vector<float>> facing;  // per object, per triangle: sum w lit (n . d)
+  terrain::Grid<float> ground_facing;      // per cell: sum w lit (n . d)
 };
 
 SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallDirection>& dirs,

@@ -17,12 +17,13 @@ Eigen::Vector3d SnowScene::ground_normal(int col, int row) const {
   return Eigen::Vector3d(-dzdx, -dzdy, 1.0).normalized();
 }
 
-SnowScene make_snow_scene(const terrain::HeightField& ground, const std::vector<SnowObject>& objects,
-                          double max_edge) {
+SnowScene make_snow_scene(const terrain::HeightField& ground,
+                          const std::vector<SnowObject>& objects, double max_edge) {
   const auto& geo = ground.geo();
   if (!geo.north_up() || geo.cell_size_x() <= 0 || geo.cell_size_y() <= 0) {
-    throw Error("the ground raster must be north-up with positive cell sizes in metres "
-                "(run drift import on it first)");
+    throw Error(
+        "the ground raster must be north-up with positive cell sizes in metres "
+        "(run drift import on it first)");
   }
   if (ground.width() < 2 || ground.height() < 2) {
     throw Error("the ground raster must be at least 2 x 2 cells");

@@ -19,9 +19,9 @@ struct SnowObject {
 };
 
 struct SnowScene {
-  terrain::Grid<float> ground;  // local heights; nodata filled with the lowest height
-  double x0 = 0, y0 = 0;        // local position of the centre of cell (0, 0)
-  double dx = 1, dy = 1;        // cell sizes (m); columns run east, rows south
+  terrain::Grid<float> ground;        // local heights; nodata filled with the lowest height
+  double x0 = 0, y0 = 0;              // local position of the centre of cell (0, 0)
+  double dx = 1, dy = 1;              // cell sizes (m); columns run east, rows south
   Eigen::Vector3d origin{0, 0, 0};    // CRS position of the local origin
   std::vector<terrain::Mesh> meshes;  // objects in the local frame, refined
   float ground_lo = 0, ground_hi = 0;
@@ -38,7 +38,7 @@ struct SnowScene {
 // Throws drift::Error for a raster that is not north-up with positive cell sizes,
 // smaller than 2 x 2, or all nodata. Object meshes are refined to max_edge (m;
 // 0 keeps them).
-SnowScene make_snow_scene(const terrain::HeightField& ground, const std::vector<SnowObject>& objects,
-                          double max_edge);
+SnowScene make_snow_scene(const terrain::HeightField& ground,
+                          const std::vector<SnowObject>& objects, double max_edge);
 
 }  // namespace drift::snow

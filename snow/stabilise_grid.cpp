@@ -25,6 +25,7 @@ struct Field {
   const terrain::Grid<double>& snow;
   int w, h;
   std::array<double, 4> reach;  // tan(repose) * distance to each neighbour
+  double omega = 1.0;           // over-relaxation of the amount given
 
   double surface(int x, int y) const { return ground(x, y) + snow(x, y); }
 
@@ -42,7 +43,7 @@ struct Field {
       if (e > 0.0) f[d] = e, sum += e, steepest = std::max(steepest, e);
     }
     if (sum == 0.0) return f;  // case (1)
-    const double out = std::min(s, 0.5 * steepest);
+    const double out = std::min(s, omega * 0.5 * steepest);
     for (double& v : f) v = v * (out / sum);  // case (2): one term; case (3): shared
     return f;
   }
@@ -55,6 +56,8 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
                                const ProgressFn& progress) {
   if (!(options.repose_deg > 0.0 && options.repose_deg < 90.0))
     throw Error("the angle of repose of snow must lie in (0, 90) degrees");
+  if (!(options.relaxation >= 1.0 && options.relaxation <= 1.95))
+    throw Error("the stabilisation's over-relaxation must lie in [1, 1.95]");
   const int w = ground.width(), h = ground.height();
   const double t = std::tan(options.repose_deg * std::numbers::pi / 180.0);
   const int tw = (w + kTile - 1) / kTile, th = (h + kTile - 1) / kTile;
@@ -62,13 +65,18 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
   // active: may give snow; processed: active or next to an active tile (may receive).
   std::vector<unsigned char> active(tiles, 1), processed(tiles, 1);
   std::vector<int> written(tiles, -2);
-  std::vector<double> tile_max(tiles, 0.0);
+  std::vector<double> tile_max(tiles, 0.0), tile_before(tiles, 0.0);
   terrain::Grid<double> next(w, h, 0.0);
   StabiliseReport report;
   auto tile_of = [&](int x, int y) { return static_cast<std::size_t>(y / kTile) * tw + x / kTile; };
 
   for (int it = 0; it < options.max_iterations; ++it) {
-    const Field field{ground, snow, w, h, {t * dx, t * dx, t * dy, t * dy}};
+    // Red-black: in even passes cells with x + y even give, in odd passes the others,
+    // so a cell never gives and receives in the same pass (Gauss-Seidel order,
+    // parallel and independent of the thread count).
+    const int colour = it & 1;
+    Field field{ground, snow, w, h, {t * dx, t * dx, t * dy, t * dy}};
+    field.omega = options.relaxation;
     tbb::parallel_for(std::size_t{0}, tiles, [&](std::size_t tile) {
       const int x0 = static_cast<int>(tile % tw) * kTile, y0 = static_cast<int>(tile / tw) * kTile;
       const int x1 = std::min(x0 + kTile, w), y1 = std::min(y0 + kTile, h);
@@ -84,12 +92,14 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
       const bool gives = active[tile];
       for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
-          const auto out = gives ? field.flows(x, y) : std::array<double, 4>{0, 0, 0, 0};
+          const bool my_turn = ((x + y) & 1) == colour;
+          const auto out = gives && my_turn ? field.flows(x, y) : std::array<double, 4>{0, 0, 0, 0};
           double v = snow(x, y) - ((out[0] + out[1]) + (out[2] + out[3]));
           largest = std::max(largest, (out[0] + out[1]) + (out[2] + out[3]));
           for (int d = 0; d < 4; ++d) {
             const int nx = x + kDx[d], ny = y + kDy[d];
-            if (nx < 0 || ny < 0 || nx >= w || ny >= h || !active[tile_of(nx, ny)]) continue;
+            if (my_turn || nx < 0 || ny < 0 || nx >= w || ny >= h || !active[tile_of(nx, ny)])
+              continue;
             v += field.flows(nx, ny)[kOpposite[d]];
           }
           next(x, y) = v;
@@ -106,10 +116,13 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
         bool moving = false;
         for (int j = std::max(ty - 1, 0); j <= std::min(ty + 1, th - 1) && !moving; ++j)
           for (int i = std::max(tx - 1, 0); i <= std::min(tx + 1, tw - 1); ++i)
-            if (tile_max[static_cast<std::size_t>(j) * tw + i] > options.tolerance) moving = true;
+            if (std::max(tile_max[static_cast<std::size_t>(j) * tw + i],
+                         tile_before[static_cast<std::size_t>(j) * tw + i]) > options.tolerance)
+              moving = true;
         active[static_cast<std::size_t>(ty) * tw + tx] = moving;
         awake += moving;
       }
+    tile_before = tile_max;  // a tile sleeps only after both colours had nothing to give
     if (awake == 0) {
       report.converged = true;
       break;

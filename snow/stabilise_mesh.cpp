@@ -1,7 +1,5 @@
 #include "snow/stabilise_mesh.h"
 
-#include <tbb/parallel_for.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -58,7 +56,6 @@ MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<
   std::vector<std::size_t> start(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) start[i + 1] = start[i] + adj[i].size();
   std::vector<int> to(start[n]);
-  std::vector<std::size_t> reverse(start[n]);
   std::vector<double> reach(start[n]);
   for (std::size_t i = 0; i < n; ++i) {
     std::sort(adj[i].begin(), adj[i].end());
@@ -69,31 +66,27 @@ MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<
       reach[start[i] + k] = tan_r * std::hypot(static_cast<double>(d.x()), d.y());
     }
   }
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t e = start[i]; e < start[i + 1]; ++e) {
-      const auto& nb = adj[to[e]];
-      reverse[e] = start[to[e]] + (std::lower_bound(nb.begin(), nb.end(), static_cast<int>(i)) -
-                                   nb.begin());
-    }
-
   MeshStabiliseReport report;
   report.shed.assign(n, 0.0);
   if (n == 0) {
     report.converged = true;
     return report;
   }
-  std::vector<double> flow(start[n]), shed_now(n), next(n);
+  std::vector<double> flow(start[n]);
   for (int it = 0; it < options.max_iterations; ++it) {
-    // Flows out of each vertex from the current state: the paper's three cases, with
-    // the virtual "falls off" neighbour of border vertices among the candidates.
-    std::vector<double> largest(n, 0.0);
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      shed_now[i] = 0.0;
-      for (std::size_t e = start[i]; e < start[i + 1]; ++e) flow[e] = 0.0;
-      if (!holds(i) || volume[i] <= 0.0) return;
+    // Vertex by vertex in index order, each seeing what the ones before it moved
+    // (Gauss-Seidel): footprints differ a lot between vertices of a refined mesh, and
+    // simultaneous (Jacobi) transfers into a small vertex from several large ones
+    // overshoot. Sequential, hence independent of the thread count.
+    double largest = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!holds(i) || volume[i] <= 0.0) continue;
+      // The paper's three cases, with the virtual "falls off" neighbour of border
+      // vertices among the candidates.
       const double a = footprint[i], hi = mesh.positions[i].z() + volume[i] / a;
       double sum = 0.0, steepest = 0.0;
       for (std::size_t e = start[i]; e < start[i + 1]; ++e) {
+        flow[e] = 0.0;
         const int j = to[e];
         const double ex = hi - (mesh.positions[j].z() + volume[j] / footprint[j]) - reach[e];
         if (ex <= 0.0) continue;
@@ -105,22 +98,19 @@ MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<
         const double ex = volume[i] / a - tan_r * 0.5 * std::sqrt(a);
         if (ex > 0.0) shed = ex * a, sum += shed, steepest = std::max(steepest, shed);
       }
-      if (sum == 0.0) return;
-      const double out = std::min(volume[i], steepest);
-      const double scale = out / sum;
-      for (std::size_t e = start[i]; e < start[i + 1]; ++e) flow[e] *= scale;
-      shed_now[i] = shed * scale;
-      largest[i] = out / a;
-    });
-    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-      double v = volume[i] - shed_now[i];
-      for (std::size_t e = start[i]; e < start[i + 1]; ++e) v += flow[reverse[e]] - flow[e];
-      next[i] = v;
-    });
-    volume.swap(next);
-    for (std::size_t i = 0; i < n; ++i) report.shed[i] += shed_now[i];
+      if (sum == 0.0) continue;
+      const double out = std::min(volume[i], steepest), scale = out / sum;
+      for (std::size_t e = start[i]; e < start[i + 1]; ++e) {
+        if (flow[e] <= 0.0) continue;
+        volume[to[e]] += flow[e] * scale;
+        volume[i] -= flow[e] * scale;
+      }
+      volume[i] -= shed * scale;
+      report.shed[i] += shed * scale;
+      largest = std::max(largest, out / a);
+    }
     report.iterations = it + 1;
-    if (*std::max_element(largest.begin(), largest.end()) <= options.tolerance) {
+    if (largest <= options.tolerance) {
       report.converged = true;
       break;
     }

@@ -35,7 +35,8 @@ struct MeshStabiliseReport {
 };
 
 // volume: snow per vertex (m^3), updated in place; footprint from vertex_footprints.
-// Mass: sum(volume) + sum(shed) is conserved to double rounding.
+// Mass: sum(volume) + sum(shed) is conserved to double rounding. Sequential
+// (Gauss-Seidel in vertex order): deterministic.
 MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<double>& footprint,
                                    std::vector<double>& volume,
                                    const StabiliseOptions& options = {});
