@@ -55,31 +55,34 @@ void sweep(const float* h, float* s, int lines, int n, bool forward, double shif
 
 }  // namespace
 
-terrain::Grid<float> horizon_shadow_surface(const terrain::Grid<float>& heights, double dx,
-                                            double dy, const Eigen::Vector3d& toward_source) {
-  const int w = heights.width(), h = heights.height();
-  terrain::Grid<float> s(w, h, 0.0f, heights.geo());
+ShadowSurface HorizonSweeper::shadow(const Eigen::Vector3d& toward_source) {
+  const int w = heights_.width(), h = heights_.height();
+  ShadowSurface out;
   const double horizontal = std::hypot(toward_source.x(), toward_source.y());
   if (horizontal < 1e-9 || w == 0 || h == 0) {
-    s.values() = heights.values();
-    return s;
+    out.s = heights_;
+    return out;
   }
   const double tan_el = toward_source.z() / horizontal;
   // Grid steps per metre along the horizontal direction to the source.
-  const double dcol = toward_source.x() / horizontal / dx;
-  const double drow = -toward_source.y() / horizontal / dy;
+  const double dcol = toward_source.x() / horizontal / dx_;
+  const double drow = -toward_source.y() / horizontal / dy_;
   if (std::abs(drow) >= std::abs(dcol)) {
     // Lines are rows (contiguous): one row upstream per step.
     const double metres = 1.0 / std::abs(drow);
-    sweep(heights.data(), s.data(), h, w, drow > 0 ? false : true, dcol * metres, metres * tan_el);
+    out.s = terrain::Grid<float>(w, h);
+    sweep(heights_.data(), out.s.data(), h, w, drow <= 0, dcol * metres, metres * tan_el);
   } else {
     const double metres = 1.0 / std::abs(dcol);
-    std::vector<float> ht(heights.size()), st(heights.size());
-    transpose(heights.data(), ht.data(), w, h);
-    sweep(ht.data(), st.data(), w, h, dcol > 0 ? false : true, drow * metres, metres * tan_el);
-    transpose(st.data(), s.data(), h, w);
+    if (transposed_.empty()) {
+      transposed_ = terrain::Grid<float>(h, w);
+      transpose(heights_.data(), transposed_.data(), w, h);
+    }
+    out.s = terrain::Grid<float>(h, w);
+    out.transposed = true;
+    sweep(transposed_.data(), out.s.data(), w, h, dcol <= 0, drow * metres, metres * tan_el);
   }
-  return s;
+  return out;
 }
 
 float bilinear(const terrain::Grid<float>& g, double col, double row) {

@@ -15,12 +15,35 @@
 
 namespace drift::snow {
 
-// heights: local frame (m); dx, dy: cell sizes (m), columns east, rows south.
-// toward_source: unit, z > 0. Straight-down fall gives S = heights.
-terrain::Grid<float> horizon_shadow_surface(const terrain::Grid<float>& heights, double dx,
-                                            double dy, const Eigen::Vector3d& toward_source);
-
-// Bilinear S at fractional (col, row) clamped to the grid.
+// Bilinear value at fractional (col, row) clamped to the grid.
 float bilinear(const terrain::Grid<float>& g, double col, double row);
+
+// S for one direction. When the sweep runs along columns the surface is kept
+// transposed (width = the ground's rows), saving a transposition per direction;
+// read it through at() and bilinear().
+struct ShadowSurface {
+  terrain::Grid<float> s;
+  bool transposed = false;
+  float at(int col, int row) const { return transposed ? s(row, col) : s(col, row); }
+  float bilinear_at(double col, double row) const {
+    return transposed ? bilinear(s, row, col) : bilinear(s, col, row);
+  }
+};
+
+// Sweeps one height field for many directions; the transposed heights, needed for
+// directions closer to east-west than north-south, are made once.
+class HorizonSweeper {
+ public:
+  // heights: local frame (m); dx, dy: cell sizes (m), columns east, rows south.
+  HorizonSweeper(const terrain::Grid<float>& heights, double dx, double dy)
+      : heights_(heights), dx_(dx), dy_(dy) {}
+  // toward_source: unit, z > 0. Straight-down fall gives S = heights.
+  ShadowSurface shadow(const Eigen::Vector3d& toward_source);
+
+ private:
+  const terrain::Grid<float>& heights_;
+  double dx_, dy_;
+  terrain::Grid<float> transposed_;
+};
 
 }  // namespace drift::snow

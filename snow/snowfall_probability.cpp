@@ -1,6 +1,7 @@
 #include "snow/snowfall_probability.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
@@ -70,10 +71,10 @@ void frame_map(DepthMap& map, const Rect& r, double texel) {
 class TerrainOccluder {
  public:
   TerrainOccluder(const SnowScene& scene, const Vector3d& w, TerrainOcclusion mode,
-                  OsmesaDepthRenderer* renderer)
+                  OsmesaDepthRenderer* renderer, HorizonSweeper& sweeper)
       : scene_(scene), w_(w) {
     if (mode == TerrainOcclusion::Sweep) {
-      shadow_ = horizon_shadow_surface(scene.ground, scene.dx, scene.dy, w);
+      shadow_ = sweeper.shadow(w);
       return;
     }
     map_.emplace();
@@ -87,19 +88,19 @@ class TerrainOccluder {
     renderer->render(*map_, r.c_lo, r.c_hi, {}, &g);
   }
 
-  bool cell_lit(int col, int row, const Vector3d& n) const {
-    if (n.dot(w_) <= 0.0) return false;
+  // cos_phi: the cell's normal . w.
+  bool cell_lit(int col, int row, double cos_phi) const {
+    if (cos_phi <= 0.0) return false;
     if (map_) {
       // The texel nearest a cell centre may hold a neighbouring facet: bias for the
       // steepest facet around the cell, or a lit concave kink shows acne.
-      double cos_phi = n.dot(w_);
       const int W = scene_.ground.width(), H = scene_.ground.height();
       for (auto [i, j] : {std::pair{col - 1, row}, {col + 1, row}, {col, row - 1}, {col, row + 1}})
         if (i >= 0 && j >= 0 && i < W && j < H)
           cos_phi = std::min(cos_phi, scene_.ground_normal(i, j).dot(w_));
       return map_->lit_biased(scene_.cell_point(col, row), depth_bias(map_->texel, cos_phi));
     }
-    return shadow_(col, row) <= scene_.ground(col, row);
+    return shadow_.at(col, row) <= scene_.ground(col, row);
   }
 
   bool point_lit(const Vector3d& p, const Vector3d& n) const {
@@ -110,13 +111,13 @@ class TerrainOccluder {
     // S >= h everywhere, equal where lit: compare with the interpolated S, allowing for
     // float rounding only.
     const double tolerance = 1e-5 * (1.0 + std::abs(p.z()));
-    return p.z() >= bilinear(shadow_, col, row) - tolerance;
+    return p.z() >= shadow_.bilinear_at(col, row) - tolerance;
   }
 
  private:
   const SnowScene& scene_;
   Vector3d w_;
-  terrain::Grid<float> shadow_;
+  ShadowSurface shadow_;
   std::optional<DepthMap> map_;
 };
 
@@ -156,6 +157,7 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
   if (n_objects > 0 || options.terrain == TerrainOcclusion::OpenGL)
     renderer = std::make_unique<OsmesaDepthRenderer>();
   const double cell = std::min(scene.dx, scene.dy);
+  HorizonSweeper sweeper(scene.ground, scene.dx, scene.dy);
 
   float total_weight = 0.0f;
   for (std::size_t k = 0; k < dirs.size(); ++k) {
@@ -164,7 +166,7 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
     const float weight = dirs[k].weight;
     total_weight += weight;
     const LightFrame frame = LightFrame::toward(w);
-    const TerrainOccluder terrain_occluder(scene, w, options.terrain, renderer.get());
+    const TerrainOccluder terrain_occluder(scene, w, options.terrain, renderer.get(), sweeper);
 
     // Object maps: one around each object, holding every object that overlaps it.
     std::vector<DepthMap> maps(n_objects);
@@ -222,32 +224,52 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
                       ? std::clamp(options.ground_samples, 1, 16)
                       : std::clamp(static_cast<int>(std::ceil(cell / (2.0 * finest))), 1, 8);
 
-    tbb::parallel_for(tbb::blocked_range<int>(0, H), [&](const tbb::blocked_range<int>& rows) {
-      for (int row = rows.begin(); row < rows.end(); ++row)
-        for (int col = 0; col < W; ++col) {
-          const Vector3d n = scene.ground_normal(col, row);
-          float lit = 0.0f;
-          if (!near_object(col, row)) {
-            lit = terrain_occluder.cell_lit(col, row, n) ? 1.0f : 0.0f;
-          } else {
-            int count = 0;
-            for (int j = 0; j < K; ++j)
-              for (int i = 0; i < K; ++i) {
-                const double c = std::clamp(col + (i + 0.5) / K - 0.5, 0.0, W - 1.0);
-                const double r = std::clamp(row + (j + 0.5) / K - 0.5, 0.0, H - 1.0);
-                const Vector3d p(scene.x0 + c * scene.dx, scene.y0 - r * scene.dy,
-                                 bilinear(scene.ground, c, r));
-                const bool seen = (i * 2 + 1 == K && j * 2 + 1 == K)
-                                      ? terrain_occluder.cell_lit(col, row, n)
-                                      : n.dot(w) > 0 && terrain_occluder.point_lit(p, n);
-                count += seen && objects_lit(p, n);
-              }
-            lit = static_cast<float>(count) / static_cast<float>(K * K);
-          }
-          acc(col, row) += weight * lit;
-          acc_facing(col, row) += weight * lit * static_cast<float>(std::max(0.0, n.dot(w)));
-        }
-    });
+    // Cells in 64 x 64 blocks: a transposed shadow surface reads well within a block.
+    constexpr int B = 64;
+    const float* hgt = scene.ground.data();
+    const double gx_scale = 1.0 / (2.0 * scene.dx), gy_scale = 1.0 / (2.0 * scene.dy);
+    tbb::parallel_for(
+        tbb::blocked_range2d<int>(0, (H + B - 1) / B, 0, (W + B - 1) / B),
+        [&](const tbb::blocked_range2d<int>& blocks) {
+          for (int by = blocks.rows().begin(); by < blocks.rows().end(); ++by)
+            for (int bx = blocks.cols().begin(); bx < blocks.cols().end(); ++bx)
+              for (int row = by * B; row < std::min(H, (by + 1) * B); ++row)
+                for (int col = bx * B; col < std::min(W, (bx + 1) * B); ++col) {
+                  float lit = 0.0f;
+                  double cos_phi;
+                  if (!near_object(col, row)) {
+                    // n . w from central differences (the interior case of ground_normal).
+                    if (col > 0 && row > 0 && col < W - 1 && row < H - 1) {
+                      const std::size_t i = static_cast<std::size_t>(row) * W + col;
+                      const double gx = (hgt[i + 1] - hgt[i - 1]) * gx_scale;
+                      const double gy = (hgt[i - W] - hgt[i + W]) * gy_scale;
+                      cos_phi =
+                          (w.z() - gx * w.x() - gy * w.y()) / std::sqrt(1.0 + gx * gx + gy * gy);
+                    } else {
+                      cos_phi = scene.ground_normal(col, row).dot(w);
+                    }
+                    lit = terrain_occluder.cell_lit(col, row, cos_phi) ? 1.0f : 0.0f;
+                  } else {
+                    const Vector3d n = scene.ground_normal(col, row);
+                    cos_phi = n.dot(w);
+                    int count = 0;
+                    for (int j = 0; j < K; ++j)
+                      for (int i = 0; i < K; ++i) {
+                        const double c = std::clamp(col + (i + 0.5) / K - 0.5, 0.0, W - 1.0);
+                        const double r = std::clamp(row + (j + 0.5) / K - 0.5, 0.0, H - 1.0);
+                        const Vector3d p(scene.x0 + c * scene.dx, scene.y0 - r * scene.dy,
+                                         bilinear(scene.ground, c, r));
+                        const bool seen = (i * 2 + 1 == K && j * 2 + 1 == K)
+                                              ? terrain_occluder.cell_lit(col, row, cos_phi)
+                                              : cos_phi > 0 && terrain_occluder.point_lit(p, n);
+                        count += seen && objects_lit(p, n);
+                      }
+                    lit = static_cast<float>(count) / static_cast<float>(K * K);
+                  }
+                  acc(col, row) += weight * lit;
+                  acc_facing(col, row) += weight * lit * static_cast<float>(std::max(0.0, cos_phi));
+                }
+        });
 
     for (std::size_t o = 0; o < n_objects; ++o) {
       const terrain::Mesh& m = scene.meshes[o];
