@@ -33,7 +33,15 @@ MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<
     throw Error("the angle of repose of snow must lie in (0, 90) degrees");
   const std::size_t n = mesh.vertex_count();
   const double tan_r = std::tan(options.repose_deg * std::numbers::pi / 180.0);
-  auto holds = [&](std::size_t i) { return footprint[i] > kNoFootprint; };
+  // Slivers hold nothing: a footprint a million times below the mean would make
+  // tiny volumes tall and keep them moving for ever.
+  double mean = 0.0;
+  std::size_t holding = 0;
+  for (double a : footprint)
+    if (a > kNoFootprint) mean += a, ++holding;
+  mean = holding ? mean / holding : 0.0;
+  const double threshold = std::max(kNoFootprint, 1e-6 * mean);
+  auto holds = [&](std::size_t i) { return footprint[i] > threshold; };
 
   // Edges with the number of triangles using them (1: open border).
   std::map<std::pair<int, int>, int> edge_use;
@@ -80,7 +88,13 @@ MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<
     // overshoot. Sequential, hence independent of the thread count.
     double largest = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      if (!holds(i) || volume[i] <= 0.0) continue;
+      if (volume[i] <= 0.0) continue;
+      if (!holds(i)) {  // snow given to a sliver cannot stay there
+        report.shed[i] += volume[i];
+        largest = std::max(largest, volume[i]);
+        volume[i] = 0.0;
+        continue;
+      }
       // The paper's three cases, with the virtual "falls off" neighbour of border
       // vertices among the candidates.
       const double a = footprint[i], hi = mesh.positions[i].z() + volume[i] / a;
@@ -107,10 +121,10 @@ MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<
       }
       volume[i] -= shed * scale;
       report.shed[i] += shed * scale;
-      largest = std::max(largest, out / a);
+      largest = std::max(largest, out);
     }
     report.iterations = it + 1;
-    if (largest <= options.tolerance) {
+    if (largest <= options.tolerance * mean) {  // volume of `tolerance` m on a typical vertex
       report.converged = true;
       break;
     }
