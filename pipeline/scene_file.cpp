@@ -1,15 +1,15 @@
 #include "pipeline/scene_file.h"
 
-#include <ogr_spatialref.h>
 #include <toml++/toml.h>
 
 #include <cmath>
 #include <set>
 
+#include "pipeline/object_list.h"
+#include "pipeline/toml_section.h"
 #include "render/surface.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
-#include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -17,123 +17,6 @@ namespace drift::pipeline {
 namespace fs = std::filesystem;
 
 namespace {
-
-// Reads one table's keys, remembering which were used, so that anything left
-// over is reported as unknown (like pbrt's ReportUnused).
-class Section {
- public:
-  Section(const toml::table* table, std::string name, const fs::path& file)
-      : table_(table), name_(std::move(name)), file_(file) {}
-
-  double number(const char* key, double fallback, double lo, double hi) {
-    const toml::node* node = take(key);
-    if (!node) return fallback;
-    std::optional<double> v = node->value<double>();
-    if (!v || node->is_boolean()) fail(key, *node, "must be a number");
-    if (!std::isfinite(*v) || *v < lo || *v > hi) {
-      fail(key, *node, "is " + fmt(*v) + "; it must lie in [" + fmt(lo) + ", " + fmt(hi) + "]");
-    }
-    return *v;
-  }
-  int integer(const char* key, int fallback, long lo, long hi) {
-    const toml::node* node = take(key);
-    if (!node) return fallback;
-    std::optional<std::int64_t> v = node->as_integer() ? node->value<std::int64_t>() : std::nullopt;
-    if (!v) fail(key, *node, "must be an integer");
-    if (*v < lo || *v > hi) {
-      fail(key, *node,
-           "is " + std::to_string(*v) + "; it must lie in [" + std::to_string(lo) + ", " +
-               std::to_string(hi) + "]");
-    }
-    return static_cast<int>(*v);
-  }
-  bool boolean(const char* key, bool fallback) {
-    const toml::node* node = take(key);
-    if (!node) return fallback;
-    if (!node->is_boolean()) fail(key, *node, "must be true or false");
-    return *node->value<bool>();
-  }
-  std::optional<std::string> string(const char* key) {
-    const toml::node* node = take(key);
-    if (!node) return std::nullopt;
-    if (!node->is_string()) fail(key, *node, "must be a string");
-    return *node->value<std::string>();
-  }
-  std::vector<std::string> strings(const char* key) {
-    const toml::node* node = take(key);
-    if (!node) return {};
-    if (node->is_string()) return {*node->value<std::string>()};
-    const toml::array* a = node->as_array();
-    std::vector<std::string> out;
-    if (!a) fail(key, *node, "must be a string or an array of strings");
-    for (const toml::node& e : *a) {
-      if (!e.is_string()) fail(key, *node, "must be a string or an array of strings");
-      out.push_back(*e.value<std::string>());
-    }
-    return out;
-  }
-  // An array of exactly N numbers, each in [lo, hi].
-  template <int N>
-  std::optional<Eigen::Matrix<double, N, 1>> vector(const char* key, double lo, double hi) {
-    const toml::node* node = take(key);
-    if (!node) return std::nullopt;
-    const toml::array* a = node->as_array();
-    if (!a || a->size() != N) {
-      fail(key, *node, "must be an array of " + std::to_string(N) + " numbers");
-    }
-    Eigen::Matrix<double, N, 1> v;
-    for (int i = 0; i < N; ++i) {
-      const toml::node& e = *a->get(static_cast<std::size_t>(i));
-      std::optional<double> d = e.value<double>();
-      if (!d || e.is_boolean() || !std::isfinite(*d) || *d < lo || *d > hi) {
-        fail(key, *node,
-             "must hold " + std::to_string(N) + " finite numbers in [" + fmt(lo) + ", " + fmt(hi) +
-                 "]");
-      }
-      v[i] = *d;
-    }
-    return v;
-  }
-  Eigen::Vector3f color(const char* key, const Eigen::Vector3f& fallback) {
-    auto v = vector<3>(key, 0.0, 1.0);
-    return v ? v->cast<float>() : fallback;
-  }
-
-  // Call last: any key not taken is unknown.
-  void finish() const {
-    if (!table_) return;
-    for (const auto& [k, node] : *table_) {
-      if (!used_.count(std::string(k.str()))) {
-        throw Error(where(node) + ": unknown key '" + name_ + "." + std::string(k.str()) +
-                    "' (see docs/rendering.md for the keys of [" + name_ + "])");
-      }
-    }
-  }
-
- private:
-  const toml::node* take(const char* key) {
-    used_.insert(key);
-    return table_ ? table_->get(key) : nullptr;
-  }
-  std::string where(const toml::node& node) const {
-    std::string s = file_.string();
-    if (node.source().begin.line > 0) s += ":" + std::to_string(node.source().begin.line);
-    return s;
-  }
-  [[noreturn]] void fail(const char* key, const toml::node& node, const std::string& what) const {
-    throw Error(where(node) + ": '" + name_ + "." + key + "' " + what);
-  }
-  static std::string fmt(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-  }
-
-  const toml::table* table_;
-  std::string name_;
-  fs::path file_;
-  std::set<std::string> used_;
-};
 
 const toml::table* subtable(const toml::table& root, const char* name, const fs::path& file) {
   const toml::node* node = root.get(name);
@@ -282,37 +165,7 @@ SceneFile read_scene_file(const fs::path& path) {
     in.camera = camera;  // lon/lat ends are placed by load_scene_terrain
   }
 
-  if (const toml::node* objects = root.get("objects")) {
-    const toml::array* list = objects->as_array();
-    if (!list) throw Error(path.string() + ": 'objects' must be an array of tables ([[objects]])");
-    for (const toml::node& entry : *list) {
-      if (!entry.is_table())
-        throw Error(path.string() + ": every [[objects]] entry must be a table");
-      Section obj(entry.as_table(), "objects", path);
-      const auto mesh_path = obj.string("mesh");
-      if (!mesh_path)
-        throw Error(path.string() + ": an [[objects]] entry needs 'mesh' (an OBJ file)");
-      const bool y_up = obj.boolean("y_up", false);
-      const auto position = obj.vector<3>("position", -1e8, 1e8);
-      const double scale = obj.number("scale", 1.0, 1e-6, 1e6);
-      const double rotate = obj.number("rotate_z", 0.0, -360.0, 360.0);
-      render::PlacedMesh placed;
-      placed.albedo = obj.color("color", placed.albedo);
-      obj.finish();
-      const fs::path mp =
-          fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path) : base / *mesh_path;
-      placed.mesh = terrain::read_obj(mp, y_up);
-      const double a = rotate * M_PI / 180.0;
-      placed.position = position ? *position : Eigen::Vector3d::Zero();
-      for (auto& p : placed.mesh.positions) {
-        const double x = p.x() * scale, y = p.y() * scale, z = p.z() * scale;
-        p = Eigen::Vector3f(static_cast<float>(std::cos(a) * x - std::sin(a) * y),
-                            static_cast<float>(std::sin(a) * x + std::cos(a) * y),
-                            static_cast<float>(z));
-      }
-      in.meshes.push_back(std::move(placed));
-    }
-  }
+  in.meshes = read_objects(root, path);
 
   Section rs(subtable(root, "render", path), "render", path);
   scene.settings.width = rs.integer("width", scene.settings.width, 1, 16384);
@@ -338,17 +191,9 @@ SceneFile read_scene_file(const fs::path& path) {
 
 namespace {
 // Reads a raster the scene places in metres; degrees are an error with the fix.
-terrain::HeightField read_metric_raster(const fs::path& file, const char* role) {
+terrain::HeightField read_metric_raster(const fs::path& file) {
   terrain::HeightField grid = terrain::read_raster(file);
-  const std::string& wkt = grid.geo().crs_wkt;
-  if (!wkt.empty()) {
-    OGRSpatialReference srs;
-    if (srs.importFromWkt(wkt.c_str()) == OGRERR_NONE && srs.IsGeographic()) {
-      throw Error(std::string(role) + " '" + file.string() +
-                  "' is in degrees (geographic CRS); convert it to metres first: drift import " +
-                  file.string() + " -o DEM_metric.tif");
-    }
-  }
+  require_metric_crs(grid, file);
   return grid;
 }
 
@@ -377,17 +222,17 @@ void place_lonlat_camera(SceneFile& scene) {
 
 void load_scene_terrain(SceneFile& scene) {
   render::TerrainSurface& surface = scene.input.surface;
-  scene.input.terrain = read_metric_raster(scene.terrain_raster, "terrain");
+  scene.input.terrain = read_metric_raster(scene.terrain_raster);
   if (scene.terrain_repeat > 1) {
     scene.input.terrain = terrain::repeat_periodic(scene.input.terrain, scene.terrain_repeat);
   }
   place_lonlat_camera(scene);
   if (!scene.snow_cover.empty())
-    surface.snow_cover = read_metric_raster(scene.snow_cover, "snow cover");
+    surface.snow_cover = read_metric_raster(scene.snow_cover);
   if (!scene.snow_depth.empty())
-    surface.snow_depth = read_metric_raster(scene.snow_depth, "snow depth");
+    surface.snow_depth = read_metric_raster(scene.snow_depth);
   if (!scene.ripples.empty() && surface.ripples) {
-    terrain::HeightField tile = read_metric_raster(scene.ripples, "ripple raster");
+    terrain::HeightField tile = read_metric_raster(scene.ripples);
     const double native = tile.geo().cell_size_x();
     const double texel = scene.ripple_texel_metres.value_or(native);
     // A ripple field scaled to another cell size is scaled as a whole, heights

@@ -1,0 +1,130 @@
+// drift snow fall GROUND.tif -o DEPTH.tif: snowfall with occlusion by the
+// ground and objects, irregular motion and stabilisation (paper 003, snow/snowfall.h).
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "pipeline/cli.h"
+#include "pipeline/object_list.h"
+#include "pipeline/progress_bar.h"
+#include "snow/snowfall.h"
+#include "terrain/error.h"
+#include "terrain/mesh_io.h"
+#include "terrain/raster_io.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+struct SnowfallCommand {
+  std::string ground, objects, output, cover, mesh_out;
+  std::vector<double> direction{0.0, 90.0};
+  std::string occlusion = "sweep";
+  unsigned long long seed = 1;
+  snow::SnowfallOptions options;
+};
+
+void run_snowfall(SnowfallCommand& c) {
+  if (c.direction.size() != 2) usage_error("--direction takes AZ,EL (degrees)");
+  snow::SnowfallOptions o = c.options;
+  o.azimuth_deg = c.direction[0];
+  o.elevation_deg = c.direction[1];
+  o.seed = c.seed;
+  o.occlusion.terrain =
+      c.occlusion == "opengl" ? snow::TerrainOcclusion::OpenGL : snow::TerrainOcclusion::Sweep;
+  if (!c.mesh_out.empty() && c.objects.empty())
+    usage_error("--mesh-out needs --objects (there are no objects to write)");
+  try {
+    o.validate();  // before reading anything large
+  } catch (const Error& e) {
+    usage_error(e.what());
+  }
+
+  const terrain::HeightField ground = terrain::read_raster(c.ground);
+  require_metric_crs(ground, c.ground);
+  std::vector<snow::SnowObject> objects;
+  if (!c.objects.empty()) {
+    for (auto& placed : read_objects_file(c.objects))
+      objects.push_back({std::move(placed.mesh), placed.position});
+  }
+  const snow::SnowfallResult r =
+      snow::simulate_snowfall(ground, objects, o, terminal_progress("snow fall"));
+
+  terrain::write_geotiff(r.depth, c.output, {"snow depth (m)", "m"});
+  std::printf("snow fall: wrote %s\n", c.output.c_str());
+  if (!c.cover.empty()) {
+    terrain::write_geotiff(r.coverage, c.cover, {"snow coverage (0..1)", ""});
+    std::printf("snow fall: wrote %s\n", c.cover.c_str());
+  }
+  if (!c.mesh_out.empty()) {
+    terrain::write_ply(r.objects, c.mesh_out);
+    std::printf("snow fall: wrote %s (%zu triangles; place it at position = [%.0f, %.0f, 0])\n",
+                c.mesh_out.c_str(), r.objects.triangle_count(), r.mesh_origin.x(),
+                r.mesh_origin.y());
+  }
+  std::printf(
+      "snow fall: %.6g m3 fell: %.6g on the ground, %.6g on objects, %.6g shed by objects onto "
+      "the ground, %.6g off the raster\n",
+      r.fallen_volume, r.ground_volume, r.object_volume, r.shed_volume, r.lost_volume);
+  std::printf("snow fall: stabilised in %d passes on the ground, %d on objects%s\n",
+              r.ground_iterations, r.object_iterations,
+              r.converged ? "" : " (NOT converged: raise --max-iterations)");
+}
+
+}  // namespace
+
+void add_snowfall_command(CLI::App& root) {
+  CLI::App& group = command_group(root, "snow", "snow: snowfall (fall) and snow cover (cover)");
+  auto c = std::make_shared<SnowfallCommand>();
+  CLI::App* sub =
+      add_subcommand(group, "fall",
+                     "snowfall on a DEM and objects: occlusion by depth maps, jittered directions, "
+                     "stabilisation (paper 003)",
+                     [c] { run_snowfall(*c); });
+  snow::SnowfallOptions& o = c->options;
+  sub->add_option("ground", c->ground, "ground heights, a metric GeoTIFF (see drift import)")
+      ->required();
+  sub->add_option("--objects", c->objects, "TOML file of [[objects]] (mesh, position, ...)");
+  sub->add_option("-o,--output", c->output, "snow depth GeoTIFF (m)")->required();
+  sub->add_option("--cover", c->cover, "snow coverage GeoTIFF (0..1)");
+  sub->add_option("--mesh-out", c->mesh_out,
+                  "PLY of the objects raised by their snow, with per-vertex snow_depth, "
+                  "snow_probability, snow_coverage, snow_adhesion");
+  sub->add_option("--direction", c->direction,
+                  "AZ,EL where the snow comes from (degrees, like a sun position; 0,90 = "
+                  "straight down)")
+      ->expected(2)
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--spread", o.spread_deg, "std. deviation of the direction jitter (deg)")
+      ->capture_default_str();
+  sub->add_option("--maps", o.maps, "number of jittered depth maps")->capture_default_str();
+  sub->add_option("--rate", o.rate_m_per_h, "fresh snow on open flat ground (m per hour)")
+      ->capture_default_str();
+  sub->add_option("--hours", o.hours, "duration of the snowfall (h)")->capture_default_str();
+  sub->add_option("--repose", o.repose_deg, "angle of repose of snow (deg)")->capture_default_str();
+  sub->add_option("--mesh-edge", o.mesh_max_edge,
+                  "split object edges longer than this (m); 0 keeps the meshes")
+      ->capture_default_str();
+  sub->add_option("--object-texel", o.occlusion.object_texel,
+                  "texel of the object depth maps (m); 0 = automatic")
+      ->capture_default_str();
+  sub->add_option("--occlusion", c->occlusion,
+                  "how the ground occludes: sweep (horizon sweep) or opengl (OSMesa depth map)")
+      ->check(CLI::IsMember({"sweep", "opengl"}))
+      ->capture_default_str();
+  sub->add_option("--thin-depth", o.coverage.thin_depth,
+                  "snow thinner than this (m) shows as scattered flakes")
+      ->capture_default_str();
+  sub->add_option("--adhesion", o.coverage.adhesion,
+                  "coverage of flakes stuck on walls facing the snow (0..1)")
+      ->capture_default_str();
+  sub->add_option("--max-iterations", o.max_iterations, "limit on stabilisation passes")
+      ->capture_default_str();
+  add_seed_option(*sub, c->seed);
+}
+
+DRIFT_COMMAND(41, add_snowfall_command);
+
+}  // namespace drift::pipeline

@@ -1,0 +1,83 @@
+#include "pipeline/object_list.h"
+
+#include <ogr_spatialref.h>
+
+#include <cmath>
+
+#include "pipeline/toml_section.h"
+#include "terrain/error.h"
+#include "terrain/mesh_io.h"
+
+namespace drift::pipeline {
+
+namespace fs = std::filesystem;
+
+std::vector<render::PlacedMesh> read_objects(const toml::table& root, const fs::path& file) {
+  std::vector<render::PlacedMesh> out;
+  if (const toml::node* objects = root.get("objects")) {
+    const toml::array* list = objects->as_array();
+    if (!list) throw Error(file.string() + ": 'objects' must be an array of tables ([[objects]])");
+    for (const toml::node& entry : *list) {
+      if (!entry.is_table())
+        throw Error(file.string() + ": every [[objects]] entry must be a table");
+      Section obj(entry.as_table(), "objects", file);
+      const auto mesh_path = obj.string("mesh");
+      if (!mesh_path)
+        throw Error(file.string() + ": an [[objects]] entry needs 'mesh' (an OBJ file)");
+      const bool y_up = obj.boolean("y_up", false);
+      const auto position = obj.vector<3>("position", -1e8, 1e8);
+      const double scale = obj.number("scale", 1.0, 1e-6, 1e6);
+      const double rotate = obj.number("rotate_z", 0.0, -360.0, 360.0);
+      render::PlacedMesh placed;
+      placed.albedo = obj.color("color", placed.albedo);
+      obj.finish();
+      const fs::path mp = fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path)
+                                                             : file.parent_path() / *mesh_path;
+      placed.mesh = terrain::read_obj(mp, y_up);
+      const double a = rotate * M_PI / 180.0;
+      placed.position = position ? *position : Eigen::Vector3d::Zero();
+      for (auto& p : placed.mesh.positions) {
+        const double x = p.x() * scale, y = p.y() * scale, z = p.z() * scale;
+        p = Eigen::Vector3f(static_cast<float>(std::cos(a) * x - std::sin(a) * y),
+                            static_cast<float>(std::sin(a) * x + std::cos(a) * y),
+                            static_cast<float>(z));
+      }
+      out.push_back(std::move(placed));
+    }
+  }
+  return out;
+}
+
+std::vector<render::PlacedMesh> read_objects_file(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw Error("cannot read objects file '" + path.string() + "': no such file");
+  toml::table root;
+  try {
+    root = toml::parse_file(path.string());
+  } catch (const toml::parse_error& e) {
+    throw Error(path.string() + ":" + std::to_string(e.source().begin.line) +
+                ": TOML syntax error: " + std::string(e.description()));
+  }
+  for (const auto& [k, node] : root) {
+    if (k.str() != "objects") {
+      throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
+                  ": unknown section '" + std::string(k.str()) +
+                  "' (an objects file holds only [[objects]] entries)");
+    }
+  }
+  return read_objects(root, path);
+}
+
+void require_metric_crs(const terrain::HeightField& raster, const fs::path& path) {
+  const std::string& wkt = raster.geo().crs_wkt;
+  if (wkt.empty()) return;
+  OGRSpatialReference srs;
+  if (srs.importFromWkt(wkt.c_str()) == OGRERR_NONE && srs.IsGeographic()) {
+    throw Error("raster '" + path.string() +
+                "' is in degrees (geographic CRS); convert it to metres first: drift import " +
+                path.string() + " -o DEM_metric.tif");
+  }
+}
+
+}  // namespace drift::pipeline

@@ -1,0 +1,139 @@
+// Strict reading of one TOML table for the pipeline's files (scene files,
+// object lists): typed getters with ranges, and finish() reporting any key
+// that was not asked for (like pbrt's ReportUnused).
+#pragma once
+
+#include <toml++/toml.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "terrain/error.h"
+
+namespace drift::pipeline {
+
+// Reads one table's keys, remembering which were used, so that anything left
+// over is reported as unknown (like pbrt's ReportUnused).
+class Section {
+ public:
+  Section(const toml::table* table, std::string name, const std::filesystem::path& file)
+      : table_(table), name_(std::move(name)), file_(file) {}
+
+  double number(const char* key, double fallback, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return fallback;
+    std::optional<double> v = node->value<double>();
+    if (!v || node->is_boolean()) fail(key, *node, "must be a number");
+    if (!std::isfinite(*v) || *v < lo || *v > hi) {
+      fail(key, *node, "is " + fmt(*v) + "; it must lie in [" + fmt(lo) + ", " + fmt(hi) + "]");
+    }
+    return *v;
+  }
+  int integer(const char* key, int fallback, long lo, long hi) {
+    const toml::node* node = take(key);
+    if (!node) return fallback;
+    std::optional<std::int64_t> v = node->as_integer() ? node->value<std::int64_t>() : std::nullopt;
+    if (!v) fail(key, *node, "must be an integer");
+    if (*v < lo || *v > hi) {
+      fail(key, *node,
+           "is " + std::to_string(*v) + "; it must lie in [" + std::to_string(lo) + ", " +
+               std::to_string(hi) + "]");
+    }
+    return static_cast<int>(*v);
+  }
+  bool boolean(const char* key, bool fallback) {
+    const toml::node* node = take(key);
+    if (!node) return fallback;
+    if (!node->is_boolean()) fail(key, *node, "must be true or false");
+    return *node->value<bool>();
+  }
+  std::optional<std::string> string(const char* key) {
+    const toml::node* node = take(key);
+    if (!node) return std::nullopt;
+    if (!node->is_string()) fail(key, *node, "must be a string");
+    return *node->value<std::string>();
+  }
+  std::vector<std::string> strings(const char* key) {
+    const toml::node* node = take(key);
+    if (!node) return {};
+    if (node->is_string()) return {*node->value<std::string>()};
+    const toml::array* a = node->as_array();
+    std::vector<std::string> out;
+    if (!a) fail(key, *node, "must be a string or an array of strings");
+    for (const toml::node& e : *a) {
+      if (!e.is_string()) fail(key, *node, "must be a string or an array of strings");
+      out.push_back(*e.value<std::string>());
+    }
+    return out;
+  }
+  // An array of exactly N numbers, each in [lo, hi].
+  template <int N>
+  std::optional<Eigen::Matrix<double, N, 1>> vector(const char* key, double lo, double hi) {
+    const toml::node* node = take(key);
+    if (!node) return std::nullopt;
+    const toml::array* a = node->as_array();
+    if (!a || a->size() != N) {
+      fail(key, *node, "must be an array of " + std::to_string(N) + " numbers");
+    }
+    Eigen::Matrix<double, N, 1> v;
+    for (int i = 0; i < N; ++i) {
+      const toml::node& e = *a->get(static_cast<std::size_t>(i));
+      std::optional<double> d = e.value<double>();
+      if (!d || e.is_boolean() || !std::isfinite(*d) || *d < lo || *d > hi) {
+        fail(key, *node,
+             "must hold " + std::to_string(N) + " finite numbers in [" + fmt(lo) + ", " + fmt(hi) +
+                 "]");
+      }
+      v[i] = *d;
+    }
+    return v;
+  }
+  Eigen::Vector3f color(const char* key, const Eigen::Vector3f& fallback) {
+    auto v = vector<3>(key, 0.0, 1.0);
+    return v ? v->cast<float>() : fallback;
+  }
+
+  // Call last: any key not taken is unknown.
+  void finish() const {
+    if (!table_) return;
+    for (const auto& [k, node] : *table_) {
+      if (!used_.count(std::string(k.str()))) {
+        throw Error(where(node) + ": unknown key '" + name_ + "." + std::string(k.str()) +
+                    "' (see docs/rendering.md for the keys of [" + name_ + "])");
+      }
+    }
+  }
+
+ private:
+  const toml::node* take(const char* key) {
+    used_.insert(key);
+    return table_ ? table_->get(key) : nullptr;
+  }
+  std::string where(const toml::node& node) const {
+    std::string s = file_.string();
+    if (node.source().begin.line > 0) s += ":" + std::to_string(node.source().begin.line);
+    return s;
+  }
+  [[noreturn]] void fail(const char* key, const toml::node& node, const std::string& what) const {
+    throw Error(where(node) + ": '" + name_ + "." + key + "' " + what);
+  }
+  static std::string fmt(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+  }
+
+  const toml::table* table_;
+  std::string name_;
+  std::filesystem::path file_;
+  std::set<std::string> used_;
+};
+
+}  // namespace drift::pipeline

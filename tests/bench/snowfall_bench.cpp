@@ -1,0 +1,126 @@
+// Snowfall (paper 003) per stage on synthetic mountains with 1 m cells: the depth
+// maps and probability (horizon sweep or OSMesa for the ground; OSMesa for the
+// objects), ground stabilisation, and the whole stage with ~10k object triangles.
+// Counters: seconds per depth map, peak resident memory.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "snow/snowfall.h"
+#include "snow/snowfall_directions.h"
+#include "snow/stabilise_grid.h"
+#include "terrain/mesh_io.h"
+#include "tests/bench/peak_memory.h"
+
+namespace {
+
+using namespace drift::snow;
+
+drift::terrain::HeightField mountains(int n) {
+  drift::terrain::HeightField g(n, n, 0.0f, drift::terrain::local_georeference(1.0));
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      g(x, y) = static_cast<float>(200 * std::sin(x / 300.0) * std::cos(y / 450.0) +
+                                   60 * std::sin(x / 70.0 + y / 90.0) +
+                                   10 * std::sin(x / 13.0) * std::cos(y / 17.0));
+  return g;
+}
+
+// Hut, bench, tree and eight rocks near the middle, standing on the ground
+// (same formula as mountains(), y north = -row): ~11k triangles.
+std::vector<SnowObject> objects(int n) {
+  std::vector<SnowObject> out;
+  auto put = [&](const char* name, double x, double y) {
+    const double z = 200 * std::sin(x / 300.0) * std::cos(-y / 450.0) +
+                     60 * std::sin(x / 70.0 - y / 90.0) +
+                     10 * std::sin(x / 13.0) * std::cos(-y / 17.0);
+    out.push_back({drift::terrain::read_obj(std::string(DRIFT_SOURCE_DIR "/data/objects/") + name),
+                   Eigen::Vector3d(x, y, z)});
+  };
+  const double c = n / 2.0;
+  put("hut.obj", c, -c);
+  put("bench.obj", c + 8, -c + 3);
+  put("tree.obj", c - 9, -c - 6);
+  for (int k = 0; k < 4; ++k) {
+    put("rock_a.obj", c + 15 + 5 * k, -c + 10);
+    put("rock_b.obj", c - 15 - 4 * k, -c - 12);
+  }
+  return out;
+}
+
+void BM_SnowProbability(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0)), maps = static_cast<int>(state.range(1));
+  const bool gl = state.range(2) != 0;
+  const SnowScene scene = make_snow_scene(mountains(n), {}, 0.0);
+  const auto dirs = jittered_directions(300.0, 55.0, 8.0, maps, 1);
+  ProbabilityOptions o;
+  o.terrain = gl ? TerrainOcclusion::OpenGL : TerrainOcclusion::Sweep;
+  for (auto _ : state) benchmark::DoNotOptimize(snow_probability(scene, dirs, o).ground.data());
+  state.counters["s/map"] =
+      benchmark::Counter(static_cast<double>(maps) * state.iterations(),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
+}
+// Ground only; args: size, maps, 0 = horizon sweep / 1 = OSMesa.
+BENCHMARK(BM_SnowProbability)
+    ->Args({1024, 16, 0})
+    ->Args({1024, 16, 1})
+    ->Args({4096, 16, 0})
+    ->Args({4096, 2, 1})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+void BM_StabiliseGround(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const SnowScene scene = make_snow_scene(mountains(n), {}, 0.0);
+  const auto p = snow_probability(scene, jittered_directions(300.0, 55.0, 8.0, 4, 1)).ground;
+  int iterations = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    drift::terrain::Grid<double> snow(n, n, 0.0);
+    for (std::size_t i = 0; i < snow.size(); ++i) snow.values()[i] = p.values()[i] * 0.5;
+    state.ResumeTiming();
+    iterations = stabilise_grid(scene.ground, snow, 1.0, 1.0).iterations;
+  }
+  state.counters["passes"] = iterations;
+  state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
+}
+BENCHMARK(BM_StabiliseGround)
+    ->Arg(1024)
+    ->Arg(4096)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+void BM_SnowfallWithObjects(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const auto ground = mountains(n);
+  const auto objs = objects(n);
+  std::size_t triangles = 0;
+  for (const auto& o : objs) triangles += o.mesh.triangle_count();
+  SnowfallOptions o;
+  o.azimuth_deg = 300.0;
+  o.elevation_deg = 55.0;
+  o.spread_deg = 8.0;
+  o.maps = 16;
+  o.rate_m_per_h = 0.02;
+  o.hours = 25.0;
+  o.mesh_max_edge = 0.0;
+  SnowfallResult r;
+  for (auto _ : state) r = simulate_snowfall(ground, objs, o);
+  state.counters["triangles"] = static_cast<double>(triangles);
+  state.counters["ground_passes"] = r.ground_iterations;
+  state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
+}
+BENCHMARK(BM_SnowfallWithObjects)
+    ->Arg(1024)
+    ->Arg(4096)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
