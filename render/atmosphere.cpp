@@ -126,27 +126,6 @@ double Atmosphere::rayleigh_coefficient(double nm) {
   return 1.24062e-6 / (um * um * um * um);  // Bruneton 2017: kRayleigh / lambda^4
 }
 
-double Atmosphere::optical_depth_to_space(double nm, double h, double mu) const {
-  const double r = kBottomRadius + std::clamp(h, 0.0, kTableTop);
-  if (distance_to_ground(r, mu) >= 0.0) return std::numeric_limits<double>::infinity();
-  const double length = distance_to_top(r, mu);
-  const double rayleigh = rayleigh_coefficient(nm),
-               ozone = ozone_cross_section(nm) * kMaxOzoneDensity;
-  const double mie = kMieExtinction * parameters_.aerosol_scale;
-  // Midpoint rule on t = L s^2: dense where the air is (near the start).
-  constexpr int kSteps = 200;
-  double depth = 0.0;
-  for (int k = 0; k < kSteps; ++k) {
-    const double s0 = static_cast<double>(k) / kSteps, s1 = static_cast<double>(k + 1) / kSteps;
-    const double t0 = length * s0 * s0, t1 = length * s1 * s1, tm = 0.5 * (t0 + t1);
-    const double hm = std::sqrt(r * r + tm * tm + 2.0 * r * mu * tm) - kBottomRadius;
-    depth += (rayleigh * std::exp(-hm / kRayleighScaleHeight) +
-              mie * std::exp(-hm / kMieScaleHeight) + ozone * ozone_density(hm)) *
-             (t1 - t0);
-  }
-  return depth;
-}
-
 Spectrum Atmosphere::rayleigh_scattering(double h) const {
   Spectrum s{};
   const double density = std::exp(-std::max(h, 0.0) / kRayleighScaleHeight);
@@ -177,10 +156,49 @@ Spectrum Atmosphere::extinction(double h) const {
   return s;
 }
 
+// Optical depths from altitude h along mu to the top for n wavelengths given
+// by their Rayleigh coefficients and ozone cross sections; the densities are
+// evaluated once per step for all of them. Infinite if the ground is in the way.
+void Atmosphere::optical_depths(double h, double mu, const double* rayleigh, const double* ozone,
+                                int n, double* depth) const {
+  const double r = kBottomRadius + std::clamp(h, 0.0, kTableTop);
+  if (distance_to_ground(r, mu) >= 0.0) {
+    std::fill(depth, depth + n, std::numeric_limits<double>::infinity());
+    return;
+  }
+  const double length = distance_to_top(r, mu);
+  const double mie = kMieExtinction * parameters_.aerosol_scale;
+  std::fill(depth, depth + n, 0.0);
+  // Midpoint rule on t = L s^2: dense where the air is (near the start).
+  constexpr int kSteps = 200;
+  for (int k = 0; k < kSteps; ++k) {
+    const double s0 = static_cast<double>(k) / kSteps, s1 = static_cast<double>(k + 1) / kSteps;
+    const double t0 = length * s0 * s0, t1 = length * s1 * s1, tm = 0.5 * (t0 + t1);
+    const double hm = std::sqrt(r * r + tm * tm + 2.0 * r * mu * tm) - kBottomRadius;
+    const double dt = t1 - t0;
+    const double rho_r = std::exp(-hm / kRayleighScaleHeight) * dt;
+    const double rho_m = mie * std::exp(-hm / kMieScaleHeight) * dt;
+    const double rho_o = kMaxOzoneDensity * ozone_density(hm) * dt;
+    for (int i = 0; i < n; ++i) depth[i] += rayleigh[i] * rho_r + rho_m + ozone[i] * rho_o;
+  }
+}
+
+double Atmosphere::optical_depth_to_space(double nm, double h, double mu) const {
+  const double rayleigh = rayleigh_coefficient(nm), ozone = ozone_cross_section(nm);
+  double depth = 0.0;
+  optical_depths(h, mu, &rayleigh, &ozone, 1, &depth);
+  return depth;
+}
+
 Spectrum Atmosphere::transmittance_to_space_exact(double h, double mu) const {
+  double rayleigh[kBands], ozone[kBands], depth[kBands];
+  for (int b = 0; b < kBands; ++b) {
+    rayleigh[b] = rayleigh_coefficient(wavelength_nm(b));
+    ozone[b] = ozone_cross_section(wavelength_nm(b));
+  }
+  optical_depths(h, mu, rayleigh, ozone, kBands, depth);
   Spectrum t{};
-  for (int b = 0; b < kBands; ++b)
-    t[b] = static_cast<float>(std::exp(-optical_depth_to_space(wavelength_nm(b), h, mu)));
+  for (int b = 0; b < kBands; ++b) t[b] = static_cast<float>(std::exp(-depth[b]));
   return t;
 }
 

@@ -84,6 +84,9 @@ class Atmosphere {
   static constexpr double kTopRadius = 6420e3;
 
  private:
+  void optical_depths(double h, double mu, const double* rayleigh, const double* ozone, int n,
+                      double* depth) const;
+
   AtmosphereParameters parameters_;
   // Tables over altitude [0, 60 km] (sqrt spacing) and mu in [-1, 1].
   static constexpr int kAltitudes = 64, kMus = 128, kMsMus = 32, kMsAltitudes = 32;
