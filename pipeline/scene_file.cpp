@@ -62,6 +62,10 @@ SceneFile read_scene_file(const fs::path& path) {
   scene.terrain_raster = resolve(*raster);
   in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
   scene.terrain_repeat = terrain.integer("repeat", 1, 1, 9);
+  // Objects standing on the terrain from an objects file (as `drift snow fall
+  // --objects` reads), in addition to any [[objects]] here.
+  std::optional<fs::path> objects_file;
+  if (const auto file = terrain.string("objects")) objects_file = resolve(*file);
   if (scene.terrain_repeat % 2 == 0) {
     throw Error(path.string() + ": 'terrain.repeat' must be odd (the raster stays in the middle)");
   }
@@ -166,6 +170,9 @@ SceneFile read_scene_file(const fs::path& path) {
   }
 
   in.meshes = read_objects(root, path);
+  if (objects_file) {
+    for (auto& placed : read_objects_file(*objects_file)) in.meshes.push_back(std::move(placed));
+  }
 
   Section rs(subtable(root, "render", path), "render", path);
   scene.settings.width = rs.integer("width", scene.settings.width, 1, 16384);
