@@ -84,6 +84,7 @@ SandOptions default_options(Model model) {
     o.creep = 0.25;
     o.initial_amplitude = 2.0;
     o.steps = 3000;
+    o.shadow_deg = 15.0;
   }
   return o;
 }
@@ -151,7 +152,7 @@ void wind_shadow(const float* line, int n, double drop_per_cell, std::vector<cha
 void saltate(terrain::HeightField& h, const SandOptions& o) {
   const int n = h.width();
   const double max_flight = n - 1.0;
-  const bool shadows = o.model == Model::Dunes && o.shadow_deg > 0.0;
+  const bool shadows = o.shadow_deg > 0.0;
   const double shadow_drop =
       std::tan(o.shadow_deg * std::numbers::pi / 180.0) * o.cell_m / o.height_unit;
   for_rows(h.height(), [&](int row) {

@@ -38,10 +38,13 @@ struct SandOptions {
   double creep = 0.25;             // D in H += D * (mean of 4 neighbours - H) * 4 / 4
   double initial_amplitude = 1.0;  // random start: uniform in [0, amplitude) height units
   double repose_deg = 34.0;        // angle of repose of dry sand
-  // Dunes: the lee of a crest below this angle is out of the wind (Werner
-  // 1995; beyond paper 002, which has no wind shadow): no lift there, and
-  // grains flying into it are caught. 0 turns it off.
-  double shadow_deg = 15.0;
+  // The lee of a crest below this angle is out of the wind (Werner 1995;
+  // beyond paper 002, which has no wind shadow): no lift there, and grains
+  // flying into it are caught. Dunes 15. Ripples 0 by default: a shadow of
+  // 5-8 degrees (grains arrive at shallow angles and miss ripple lee faces,
+  // Anderson 1987) makes them migrate downwind, but their crests come out
+  // shorter and less regular than without. 0 turns it off.
+  double shadow_deg = 0.0;
 };
 
 // The defaults of each model (documented in `drift dunes --help`).

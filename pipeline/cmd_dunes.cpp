@@ -76,7 +76,7 @@ void add_dunes_command(CLI::App& root) {
   sub->footer(
       "Defaults (ripples | dunes): --cell 0.015 | 1 m, --height-unit 0.0025 | 0.25 m, --steps "
       "500 | 3000,\n--L0 5 | 20, --b 2 | 1, --q 0.1 | 0.2, --b-prime - | 0.02, --creep 0.25, "
-      "--amplitude 1 | 2, --shadow - | 15.\nRipples: L = L0 + b H (cells, H in height units); "
+      "--amplitude 1 | 2, --shadow 0 | 15.\nRipples: L = L0 + b H (cells, H in height units); "
       "dunes: L = L0 - b "
       "tanh(dH/dx),\nq = q0 + b' tanh(dH/dx). Ripples form at about L0 + 1 cells; see "
       "docs/dunes.md.");
@@ -100,7 +100,7 @@ void add_dunes_command(CLI::App& root) {
   sub->add_option("--amplitude", o.initial_amplitude, "random start amplitude, height units");
   sub->add_option("--repose", o.repose_deg, "angle of repose of dry sand, degrees (34)");
   sub->add_option("--shadow", o.shadow_deg,
-                  "dunes: wind-shadow angle behind crests, degrees (15; 0 = none)");
+                  "wind-shadow angle behind crests, degrees (ripples 0, dunes 15; 0 = none)");
   sub->add_option("--snapshot-every", c->snapshot_every,
                   "also write OUT_<step>.tif every K steps (for animations)")
       ->check(CLI::Range(1, 10000000));
