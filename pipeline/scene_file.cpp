@@ -234,10 +234,8 @@ void load_scene_terrain(SceneFile& scene) {
     scene.input.terrain = terrain::repeat_periodic(scene.input.terrain, scene.terrain_repeat);
   }
   place_lonlat_camera(scene);
-  if (!scene.snow_cover.empty())
-    surface.snow_cover = read_metric_raster(scene.snow_cover);
-  if (!scene.snow_depth.empty())
-    surface.snow_depth = read_metric_raster(scene.snow_depth);
+  if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);
+  if (!scene.snow_depth.empty()) surface.snow_depth = read_metric_raster(scene.snow_depth);
   if (!scene.ripples.empty() && surface.ripples) {
     terrain::HeightField tile = read_metric_raster(scene.ripples);
     const double native = tile.geo().cell_size_x();

@@ -188,8 +188,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
     const double camera_altitude = scene.origin().z() + camera_rays.eye.z();
     const double reach = camera_rays.eye.head<2>().norm() + scene.extent().norm();
     air = std::make_unique<PhysicalSky>(*atmosphere, camera_altitude, sun_dir.cast<double>(),
-                                        static_cast<float>(sun.irradiance),
-                                        reach);
+                                        static_cast<float>(sun.irradiance), reach);
   }
   const float base_altitude = static_cast<float>(scene.origin().z());
   auto sky_light = [&](const Vector3f& d) {

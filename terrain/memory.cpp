@@ -24,8 +24,8 @@ std::uint64_t meminfo_available() {
 }
 
 std::uint64_t cgroup_limit() {
-  for (const char* path : {"/sys/fs/cgroup/memory.max",
-                           "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+  for (const char* path :
+       {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
     std::ifstream in(path);
     std::string s;
     if (in >> s && s != "max") {
@@ -40,9 +40,7 @@ std::uint64_t cgroup_limit() {
 
 }  // namespace
 
-std::uint64_t available_memory_bytes() {
-  return std::min(meminfo_available(), cgroup_limit());
-}
+std::uint64_t available_memory_bytes() { return std::min(meminfo_available(), cgroup_limit()); }
 
 std::string human_bytes(std::uint64_t bytes) {
   const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};

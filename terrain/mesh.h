@@ -10,9 +10,9 @@
 namespace drift::terrain {
 
 struct Mesh {
-  std::vector<Eigen::Vector3f> positions;            // metres, x east, y north, z up
-  std::vector<std::array<int, 3>> triangles;         // counter-clockwise seen from outside
-  std::vector<Eigen::Vector3f> normals;              // per vertex, optional (empty or = positions)
+  std::vector<Eigen::Vector3f> positions;     // metres, x east, y north, z up
+  std::vector<std::array<int, 3>> triangles;  // counter-clockwise seen from outside
+  std::vector<Eigen::Vector3f> normals;       // per vertex, optional (empty or = positions)
   // Named per-vertex scalar attributes (e.g. "snow_depth", "snow_coverage").
   std::vector<std::pair<std::string, std::vector<float>>> vertex_attributes;
 

@@ -42,13 +42,11 @@ Mesh read_obj(const fs::path& path, bool y_up) {
   for (const tinyobj::shape_t& shape : reader.GetShapes()) {
     const auto& idx = shape.mesh.indices;
     for (std::size_t f = 0; f + 2 < idx.size(); f += 3) {
-      std::array<int, 3> tri{idx[f].vertex_index, idx[f + 1].vertex_index,
-                             idx[f + 2].vertex_index};
+      std::array<int, 3> tri{idx[f].vertex_index, idx[f + 1].vertex_index, idx[f + 2].vertex_index};
       for (int v : tri) {
         if (v < 0 || static_cast<std::size_t>(v) >= n) {
-          throw Error("mesh '" + path.string() + "': shape '" + shape.name +
-                      "' refers to vertex " + std::to_string(v + 1) + " of " +
-                      std::to_string(n));
+          throw Error("mesh '" + path.string() + "': shape '" + shape.name + "' refers to vertex " +
+                      std::to_string(v + 1) + " of " + std::to_string(n));
         }
       }
       mesh.triangles.push_back(tri);
@@ -65,8 +63,8 @@ void write_ply(const Mesh& mesh, const fs::path& path) {
   const bool with_normals = mesh.normals.size() == mesh.positions.size();
   for (const auto& [name, values] : mesh.vertex_attributes) {
     if (values.size() != mesh.positions.size()) {
-      throw Error("internal: attribute '" + name + "' has the wrong length for '" +
-                  path.string() + "'");
+      throw Error("internal: attribute '" + name + "' has the wrong length for '" + path.string() +
+                  "'");
     }
   }
   AtomicFile out(path);

@@ -45,8 +45,8 @@ DatasetPtr open_raster(const fs::path& path) {
   auto* ds = static_cast<GDALDataset*>(
       GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
   if (!ds) {
-    std::string why = g_last_gdal_message.empty() ? "not a raster format GDAL can read"
-                                                  : g_last_gdal_message;
+    std::string why =
+        g_last_gdal_message.empty() ? "not a raster format GDAL can read" : g_last_gdal_message;
     throw Error("cannot read '" + path.string() + "' as a raster: " + why +
                 " (check the file is a DEM such as GeoTIFF, .hgt, DTED or ASCII grid)");
   }
@@ -113,10 +113,9 @@ HeightField read_raster(const fs::path& path, const ReadOptions& options) {
     if (win.width < 1 || win.height < 1 || win.x_off < 0 || win.y_off < 0 ||
         win.x_off + win.width > ds->GetRasterXSize() ||
         win.y_off + win.height > ds->GetRasterYSize()) {
-      throw Error("window " + std::to_string(win.width) + "x" + std::to_string(win.height) +
-                  "+" + std::to_string(win.x_off) + "+" + std::to_string(win.y_off) +
-                  " lies outside '" + path.string() + "' (" +
-                  std::to_string(ds->GetRasterXSize()) + "x" +
+      throw Error("window " + std::to_string(win.width) + "x" + std::to_string(win.height) + "+" +
+                  std::to_string(win.x_off) + "+" + std::to_string(win.y_off) + " lies outside '" +
+                  path.string() + "' (" + std::to_string(ds->GetRasterXSize()) + "x" +
                   std::to_string(ds->GetRasterYSize()) + ")");
     }
   }
@@ -135,12 +134,10 @@ HeightField read_raster(const fs::path& path, const ReadOptions& options) {
   HeightField grid(win.width, win.height, 0.0f, geo);
   g_last_gdal_message.clear();
   const CPLErr err = band->RasterIO(GF_Read, win.x_off, win.y_off, win.width, win.height,
-                                    grid.data(), win.width, win.height, GDT_Float32, 0, 0,
-                                    nullptr);
+                                    grid.data(), win.width, win.height, GDT_Float32, 0, 0, nullptr);
   if (err != CE_None) {
     throw Error("cannot read the cells of '" + path.string() + "': " +
-                (g_last_gdal_message.empty() ? std::string("read failed")
-                                             : g_last_gdal_message) +
+                (g_last_gdal_message.empty() ? std::string("read failed") : g_last_gdal_message) +
                 " (the file may be truncated or corrupt)");
   }
   // Invalid cells become NaN in memory, whatever the file called them.
@@ -168,8 +165,8 @@ void write_geotiff(const HeightField& grid, const fs::path& path, const WriteOpt
     co.SetNameValue("TILED", "YES");
   }
   g_last_gdal_message.clear();
-  DatasetPtr ds(driver->Create(out.temp_path().c_str(), grid.width(), grid.height(), 1,
-                               GDT_Float32, co.List()));
+  DatasetPtr ds(driver->Create(out.temp_path().c_str(), grid.width(), grid.height(), 1, GDT_Float32,
+                               co.List()));
   if (!ds) {
     throw Error("cannot create '" + path.string() + "': " + last_gdal_message());
   }
@@ -185,9 +182,9 @@ void write_geotiff(const HeightField& grid, const fs::path& path, const WriteOpt
   band->SetNoDataValue(std::numeric_limits<double>::quiet_NaN());
   if (!options.description.empty()) band->SetDescription(options.description.c_str());
   if (!options.units.empty()) band->SetUnitType(options.units.c_str());
-  CPLErr err = band->RasterIO(GF_Write, 0, 0, grid.width(), grid.height(),
-                              const_cast<float*>(grid.data()), grid.width(), grid.height(),
-                              GDT_Float32, 0, 0, nullptr);
+  CPLErr err =
+      band->RasterIO(GF_Write, 0, 0, grid.width(), grid.height(), const_cast<float*>(grid.data()),
+                     grid.width(), grid.height(), GDT_Float32, 0, 0, nullptr);
   // Closing flushes: a failed close is a failed write.
   // GDAL 3.6's GDALClose returns nothing: watch the error state across it.
   CPLErrorReset();

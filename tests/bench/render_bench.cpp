@@ -71,7 +71,8 @@ BENCHMARK(BM_PathTracer)->Unit(benchmark::kSecond)->UseRealTime()->MinTime(2.0);
 void BM_RawEmbreeCameraRays(benchmark::State& state) {
   Fixture& f = fixture();
   const auto& rs = f.scene.settings;
-  const render::CameraRays pinhole = render::make_camera_rays(*f.embree, f.camera, rs.width, rs.height);
+  const render::CameraRays pinhole =
+      render::make_camera_rays(*f.embree, f.camera, rs.width, rs.height);
   const int spp = rs.samples_per_pixel;
   std::vector<Eigen::Vector3f> dirs(static_cast<std::size_t>(rs.width) * rs.height * spp);
   for (int y = 0; y < rs.height; ++y)

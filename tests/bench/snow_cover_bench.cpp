@@ -26,9 +26,9 @@ void BM_SnowCover(benchmark::State& state) {
     const auto result = drift::snow::snow_cover(dem, options);
     benchmark::DoNotOptimize(result.descriptor.data());
   }
-  state.counters["cells/s"] = benchmark::Counter(
-      static_cast<double>(dem.size()) * static_cast<double>(state.iterations()),
-      benchmark::Counter::kIsRate);
+  state.counters["cells/s"] =
+      benchmark::Counter(static_cast<double>(dem.size()) * static_cast<double>(state.iterations()),
+                         benchmark::Counter::kIsRate);
   state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
 }
 BENCHMARK(BM_SnowCover)

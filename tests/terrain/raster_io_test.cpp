@@ -78,8 +78,8 @@ TEST(RasterIo, TruncatedGeoTiffIsAClearError) {
     std::ifstream in(src, std::ios::binary);
     std::vector<char> bytes(fs::file_size(src) / 2);
     in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    std::ofstream(cut, std::ios::binary).write(bytes.data(),
-                                               static_cast<std::streamsize>(bytes.size()));
+    std::ofstream(cut, std::ios::binary)
+        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
   EXPECT_THROW(drift::terrain::read_raster(cut), drift::Error);
 }
