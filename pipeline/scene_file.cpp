@@ -3,10 +3,12 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <numbers>
 #include <set>
 
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
+#include "render/solar_position.h"
 #include "render/surface.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
@@ -112,7 +114,23 @@ SceneFile read_scene_file(const fs::path& path) {
       sun.number("angular_diameter", in.sun.angular_diameter_deg, 1e-3, 20.0);
   in.sun.irradiance = sun.number("irradiance", in.sun.irradiance, 0.0, 1e6);
   in.sun.color = sun.color("color", in.sun.color);
+  const auto date = sun.string("date"), time = sun.string("time"), zone = sun.string("timezone");
   sun.finish();
+  if (date || time || zone) {
+    if (!date || !time) {
+      throw Error(path.string() + ": [sun] needs both 'date' (\"YYYY-MM-DD\") and 'time' " +
+                  "(\"HH:MM\"), with 'timezone' as a UTC offset (\"+09:00\", default UTC)");
+    }
+    const toml::table* table = subtable(root, "sun", path);
+    if (table->contains("azimuth") || table->contains("elevation")) {
+      throw Error(path.string() + ": [sun] gives both a date/time and azimuth/elevation; give one");
+    }
+    try {
+      scene.sun_time = render::parse_local_time(*date, *time, zone.value_or("UTC"));
+    } catch (const Error& e) {
+      throw Error(path.string() + ": [sun] " + e.what());
+    }
+  }
 
   Section sky(subtable(root, "sky", path), "sky", path);
   if (const auto model = sky.string("model")) {
@@ -204,6 +222,25 @@ terrain::HeightField read_metric_raster(const fs::path& file) {
   return grid;
 }
 
+// Puts the sun where it stands over the DEM's centre at the scene's date and
+// time (NOAA's algorithm), its azimuth turned from true north to the grid's.
+void place_sun(SceneFile& scene) {
+  const terrain::HeightField& dem = scene.input.terrain;
+  if (dem.geo().crs_wkt.empty()) {
+    throw Error("[sun] date/time needs to know where '" + scene.terrain_raster.string() +
+                "' lies, but it has no CRS; give [sun] azimuth and elevation instead");
+  }
+  const auto lonlat = terrain::centre_lonlat(dem.geo(), dem.width(), dem.height());
+  const render::SolarPosition sun = render::solar_position(*scene.sun_time, lonlat[1], lonlat[0]);
+  // Meridian convergence: the grid direction of true north at the centre.
+  const auto centre = dem.geo().cell_center((dem.width() - 1) / 2.0, (dem.height() - 1) / 2.0);
+  const auto north = terrain::from_lonlat(dem.geo().crs_wkt, lonlat[0], lonlat[1] + 1e-3);
+  const double convergence =
+      std::atan2(north[0] - centre[0], north[1] - centre[1]) * 180.0 / std::numbers::pi;
+  scene.input.sun.azimuth_deg = std::fmod(sun.azimuth_deg + convergence + 720.0, 360.0);
+  scene.input.sun.elevation_deg = sun.elevation_deg;
+}
+
 // Turns the camera's lon/lat ends into CRS points at their height above the
 // (exaggerated) ground, which must be inside the DEM.
 void place_lonlat_camera(SceneFile& scene) {
@@ -234,6 +271,7 @@ void load_scene_terrain(SceneFile& scene) {
     scene.input.terrain = terrain::repeat_periodic(scene.input.terrain, scene.terrain_repeat);
   }
   place_lonlat_camera(scene);
+  if (scene.sun_time) place_sun(scene);
   if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);
   if (!scene.snow_depth.empty()) surface.snow_depth = read_metric_raster(scene.snow_depth);
   if (!scene.ripples.empty() && surface.ripples) {

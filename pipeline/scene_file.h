@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "render/render_settings.h"
+#include "render/solar_position.h"
 #include "render/tonemap.h"
 
 namespace drift::pipeline {
@@ -30,6 +31,9 @@ struct SceneFile {
   // [camera] from_lonlat / to_lonlat: resolved into input.camera by
   // load_scene_terrain.
   std::optional<GeoPoint> camera_from_lonlat, camera_to_lonlat;
+  // [sun] date/time/timezone: the sun over the DEM's centre, placed by
+  // load_scene_terrain.
+  std::optional<render::LocalTime> sun_time;
   render::SceneInput input;  // terrain not loaded yet (see load_scene_terrain)
   render::RenderSettings settings;
   std::vector<std::filesystem::path> outputs;  // resolved against the current directory

@@ -9,8 +9,10 @@
 #include <filesystem>
 #include <fstream>
 
+#include "render/solar_position.h"
 #include "render/surface.h"
 #include "terrain/error.h"
+#include "terrain/geodesy.h"
 
 namespace fs = std::filesystem;
 
@@ -231,4 +233,34 @@ TEST(SceneFile, CameraOffTheTerrainOrHalfGivenIsAnError) {
       error_of(std::string(kTerrain) + "[camera]\nfrom = [0, 0, 0]\nto = [1, 1, 1]\nf_number = 2\n")
           .find("focal_length"),
       std::string::npos);
+}
+
+TEST(SceneFile, SunFromDateTimeStandsOverTheDem) {
+  // Mount St Helens (UTM zone 10, central meridian 123 W) on 2024-06-21 at
+  // 13:00 PDT: NOAA's position over the DEM's centre, its azimuth turned to
+  // grid north by the meridian convergence, about (lon + 123) sin(lat).
+  const std::string dem = std::string(DRIFT_SOURCE_DIR) + "/data/mount_st_helens_usgs_30m.dem";
+  const fs::path p = write_scene("sun.toml", "[terrain]\nraster = \"" + dem +
+                                                 "\"\n[sun]\ndate = \"2024-06-21\"\n"
+                                                 "time = \"13:00\"\ntimezone = \"-07:00\"\n");
+  auto s = drift::pipeline::read_scene_file(p);
+  drift::pipeline::load_scene_terrain(s);
+  const auto& g = s.input.terrain.geo();
+  const auto lonlat =
+      drift::terrain::centre_lonlat(g, s.input.terrain.width(), s.input.terrain.height());
+  const auto sun = drift::render::solar_position(
+      drift::render::parse_local_time("2024-06-21", "13:00", "-07:00"), lonlat[1], lonlat[0]);
+  EXPECT_DOUBLE_EQ(s.input.sun.elevation_deg, sun.elevation_deg);
+  EXPECT_GT(sun.elevation_deg, 60.0);  // early afternoon at midsummer, 46 N
+  const double convergence = (lonlat[0] + 123.0) * std::sin(lonlat[1] * M_PI / 180.0);
+  EXPECT_NEAR(s.input.sun.azimuth_deg, sun.azimuth_deg - convergence, 0.02);
+  // Both ways at once, or half a date, are errors.
+  EXPECT_NE(error_of(std::string(kTerrain) +
+                     "[sun]\ndate = \"2024-06-21\"\ntime = \"13:00\"\nazimuth = 100\n")
+                .find("both"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[sun]\ndate = \"2024-06-21\"\n").find("time"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[sun]\ndate = \"2024-13-45\"\ntime = \"13:00\"\n"),
+            "");
 }
