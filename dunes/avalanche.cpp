@@ -20,25 +20,6 @@ constexpr int kRowBlock = 16;
 
 }  // namespace
 
-double max_edge_drop(const terrain::HeightField& h) {
-  const int w = h.width(), rows = h.height();
-  return tbb::parallel_reduce(
-      tbb::blocked_range<int>(0, rows, kRowBlock), 0.0,
-      [&](const tbb::blocked_range<int>& r, double m) {
-        for (int row = r.begin(); row < r.end(); ++row) {
-          const float* c = &h(0, row);
-          const float* s = &h(0, (row + 1) % rows);
-          for (int x = 0; x < w; ++x) {
-            const int xr = x + 1 == w ? 0 : x + 1;
-            m = std::max({m, static_cast<double>(std::fabs(c[x] - c[xr])),
-                          static_cast<double>(std::fabs(c[x] - s[x]))});
-          }
-        }
-        return m;
-      },
-      [](double a, double b) { return std::max(a, b); }, tbb::simple_partitioner());
-}
-
 double max_excess(const terrain::HeightField& h, double max_drop) {
   const int w = h.width(), rows = h.height();
   const double diagonal = std::numbers::sqrt2 * max_drop;

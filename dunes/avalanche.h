@@ -19,9 +19,6 @@ namespace drift::dunes {
 // after `max_sweeps`; returns the sweeps done.
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance = 1e-4);
 
-// The steepest east-west or north-south edge drop of the field (periodic).
-double max_edge_drop(const terrain::HeightField& h);
-
 // How far the steepest edge (of 8 neighbours) exceeds its limit (<= 0: none).
 double max_excess(const terrain::HeightField& h, double max_drop);
 

@@ -49,16 +49,7 @@ std::vector<render::PlacedMesh> read_objects(const toml::table& root, const fs::
 }
 
 std::vector<render::PlacedMesh> read_objects_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw Error("cannot read objects file '" + path.string() + "': no such file");
-  toml::table root;
-  try {
-    root = toml::parse_file(path.string());
-  } catch (const toml::parse_error& e) {
-    throw Error(path.string() + ":" + std::to_string(e.source().begin.line) +
-                ": TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table root = parse_toml_file(path, "objects file");
   for (const auto& [k, node] : root) {
     if (k.str() != "objects") {
       throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +

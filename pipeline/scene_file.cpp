@@ -32,16 +32,7 @@ const toml::table* subtable(const toml::table& root, const char* name, const fs:
 }  // namespace
 
 SceneFile read_scene_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw Error("cannot read scene '" + path.string() + "': no such file");
-  toml::table root;
-  try {
-    root = toml::parse_file(path.string());
-  } catch (const toml::parse_error& e) {
-    throw Error(path.string() + ":" + std::to_string(e.source().begin.line) +
-                ": TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table root = parse_toml_file(path, "scene");
   static const std::set<std::string> sections = {"terrain", "snow",   "ripples", "sun",    "sky",
                                                  "camera",  "render", "output",  "objects"};
   for (const auto& [k, node] : root) {

@@ -19,6 +19,20 @@
 
 namespace drift::pipeline {
 
+// Parses a TOML file; a missing file or a syntax error is a drift::Error
+// naming `what`, the file and the line.
+inline toml::table parse_toml_file(const std::filesystem::path& path, const char* what) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw Error(std::string("cannot read ") + what + " '" + path.string() + "': no such file");
+  try {
+    return toml::parse_file(path.string());
+  } catch (const toml::parse_error& e) {
+    throw Error(path.string() + ":" + std::to_string(e.source().begin.line) +
+                ": TOML syntax error: " + std::string(e.description()));
+  }
+}
+
 // Reads one table's keys, remembering which were used, so that anything left
 // over is reported as unknown (like pbrt's ReportUnused).
 class Section {
