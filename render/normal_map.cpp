@@ -78,7 +78,7 @@ Vector2f SlopePyramid::sample(double u, double v, double footprint_metres) const
       std::clamp(std::log2(std::max(footprint_metres, 1e-30) / texel_), 0.0, levels() - 1.0);
   const int lo = static_cast<int>(lod);
   const float t = static_cast<float>(lod - lo);
-  const Vector2f a = sample_level(lo, u, v);
+  Vector2f a = sample_level(lo, u, v);
   if (t <= 0.0f || lo + 1 >= levels()) return a;
   return (1 - t) * a + t * sample_level(lo + 1, u, v);
 }
