@@ -67,6 +67,7 @@ struct PixelSample {
   Vector3f normal{0, 0, 0};
   Vector3f albedo{0, 0, 0};
   float snow = 0.0f;
+  float sky = 0.0f;  // 1 where the camera sees the sky
 };
 
 }  // namespace
@@ -165,7 +166,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const int band = row_end - row_begin;
   Image image(settings.width, band,
               {"R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G",
-               "albedo.B", "coverage.snow"});
+               "albedo.B", "coverage.snow", "mask.sky"});
 
   if (band != settings.height) image.frame = {0, row_begin, settings.width, settings.height};
 
@@ -210,6 +211,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
       Hit hit;
       ++rays;
       if (!scene.intersect(origin, dir, hit, cone)) {
+        if (depth == 0) out.sky = 1.0f;
         out.radiance += throughput.cwiseProduct(sky_light(dir));
         break;
       }
@@ -287,13 +289,14 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
           sum.normal += one.normal;
           sum.albedo += one.albedo;
           sum.snow += one.snow;
+          sum.sky += one.sky;
         }
-        const float values[11] = {
+        const float values[12] = {
             sum.radiance.x() * inv_spp, sum.radiance.y() * inv_spp, sum.radiance.z() * inv_spp,
             sum.depth * inv_spp,        sum.normal.x() * inv_spp,   sum.normal.y() * inv_spp,
             sum.normal.z() * inv_spp,   sum.albedo.x() * inv_spp,   sum.albedo.y() * inv_spp,
-            sum.albedo.z() * inv_spp,   sum.snow * inv_spp};
-        for (int c = 0; c < 11; ++c) image.at(x, y - row_begin, c) = values[c];
+            sum.albedo.z() * inv_spp,   sum.snow * inv_spp,         sum.sky * inv_spp};
+        for (int c = 0; c < 12; ++c) image.at(x, y - row_begin, c) = values[c];
       }
     }
     total_rays += tile_rays;  // integer sums: the same whatever the order

@@ -48,7 +48,8 @@ struct RenderStats {
 
 // Renders channels R, G, B (linear radiance) and AOVs "depth" (metres along
 // the camera ray to the first hit, 0 for sky), "normal.X/Y/Z" and
-// "albedo.R/G/B" and "coverage.snow" of the first hit. `camera` is in the raster's CRS.
+// "albedo.R/G/B" and "coverage.snow" of the first hit, and "mask.sky"
+// (the share of the pixel's camera rays that see the sky). `camera` is in the raster's CRS.
 Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,
                    const RenderSettings& settings, const ProgressFn& progress = no_progress,
                    RenderStats* stats = nullptr);

@@ -204,3 +204,27 @@ TEST(Camera, ThinLensRaysMeetOnTheFocalPlane) {
   }
   EXPECT_GT(spread, 0.01f);  // rays do leave from across the lens
 }
+
+TEST(Renderer, SkyMaskAndSnowCoverageAovs) {
+  SceneInput in;
+  in.terrain = make_dem(64, 10.0, [](double, double) { return 0.0; });
+  in.surface.snow_cover = make_dem(64, 10.0, [](double, double) { return 0.25; });
+  in.sky.model = SkyModel::Simple;
+  const TerrainScene scene(in);
+  Camera c;  // level, looking north across the plane: sky above, ground below
+  c.from = scene.origin() + Eigen::Vector3d(0, -300, 20);
+  c.to = scene.origin() + Eigen::Vector3d(0, 300, 20);
+  c.vertical_fov_deg = 40.0;
+  RenderSettings rs;
+  rs.width = 16;
+  rs.height = 16;
+  rs.samples_per_pixel = 2;
+  const Image img = render_image(scene, in, c, rs);
+  const int sky = img.channel_index("mask.sky"), snow = img.channel_index("coverage.snow");
+  ASSERT_GE(sky, 0);
+  ASSERT_GE(snow, 0);
+  EXPECT_FLOAT_EQ(img.at(8, 0, sky), 1.0f);
+  EXPECT_FLOAT_EQ(img.at(8, 15, sky), 0.0f);
+  EXPECT_FLOAT_EQ(img.at(8, 15, snow), 0.25f);
+  EXPECT_FLOAT_EQ(img.at(8, 0, snow), 0.0f);
+}
