@@ -55,6 +55,7 @@ SceneFile read_scene_file(const fs::path& path) {
   scene.terrain_raster = resolve(*raster);
   in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
   scene.terrain_repeat = terrain.integer("repeat", 1, 1, 9);
+  if (const auto map = terrain.string("albedo_map")) scene.albedo_map = resolve(*map);
   // Objects standing on the terrain from an objects file (as `drift snow fall
   // --objects` reads), in addition to any [[objects]] here.
   std::optional<fs::path> objects_file;
@@ -263,6 +264,10 @@ void load_scene_terrain(SceneFile& scene) {
   }
   place_lonlat_camera(scene);
   if (scene.sun_time) place_sun(scene);
+  if (!scene.albedo_map.empty()) {
+    surface.albedo_map = render::read_albedo_map(scene.albedo_map);
+    require_metric_crs(surface.albedo_map->front(), scene.albedo_map);
+  }
   if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);
   if (!scene.snow_depth.empty()) surface.snow_depth = read_metric_raster(scene.snow_depth);
   if (!scene.ripples.empty() && surface.ripples) {

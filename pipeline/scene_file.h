@@ -25,7 +25,7 @@ struct SceneFile {
   std::filesystem::path terrain_raster;  // resolved against the scene file's folder
   // Layer rasters ([snow] cover and depth, [ripples] raster), resolved likewise;
   // empty when the scene has none.
-  std::filesystem::path snow_cover, snow_depth, ripples;
+  std::filesystem::path snow_cover, snow_depth, ripples, albedo_map;
   std::optional<double> ripple_texel_metres;  // default: the ripple raster's cell size
   int terrain_repeat = 1;  // [terrain] repeat: a tileable terrain laid out n x n (odd)
   // [camera] from_lonlat / to_lonlat: resolved into input.camera by

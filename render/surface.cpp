@@ -2,6 +2,11 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
+
+#include "render/tonemap.h"
+#include "terrain/error.h"
+#include "terrain/raster_io.h"
 
 namespace drift::render {
 
@@ -19,6 +24,27 @@ float sample_raster(const terrain::HeightField& raster, double x, double y, floa
   };
   return (1 - tr) * ((1 - tx) * at(x0, r0) + tx * at(x0 + 1, r0)) +
          tr * ((1 - tx) * at(x0, r0 + 1) + tx * at(x0 + 1, r0 + 1));
+}
+
+std::array<terrain::HeightField, 3> read_albedo_map(const std::filesystem::path& path) {
+  const terrain::RasterHeader header = terrain::read_raster_header(path);
+  if (header.bands != 1 && header.bands < 3) {
+    throw Error("albedo map '" + path.string() + "' has " + std::to_string(header.bands) +
+                " bands; give an RGB image (3 bands) or a grey one (1 band)");
+  }
+  const bool encoded = header.data_type == "Byte" || header.data_type == "UInt16";
+  const float full = header.data_type == "UInt16" ? 65535.0f : 255.0f;
+  std::array<terrain::HeightField, 3> rgb;
+  for (int c = 0; c < 3; ++c) {
+    terrain::ReadOptions options;
+    options.band = header.bands == 1 ? 1 : c + 1;
+    rgb[c] = terrain::read_raster(path, options);
+    if (encoded) {
+      for (float& v : rgb[c].values())
+        if (!std::isnan(v)) v = srgb_decode(std::clamp(v / full, 0.0f, 1.0f));
+    }
+  }
+  return rgb;
 }
 
 terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
@@ -53,7 +79,18 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   p.snow = surface.snow_cover
                ? std::clamp(sample_raster(*surface.snow_cover, x, y, 0.0f), 0.0f, 1.0f)
                : 0.0f;
-  p.material = mix(surface.ground, surface.snow, p.snow);
+  Material ground = surface.ground;
+  if (surface.albedo_map) {
+    const auto& map = *surface.albedo_map;
+    const float r = sample_raster(map[0], x, y, NAN);
+    if (!std::isnan(r)) {
+      ground.albedo =
+          Eigen::Vector3f(r, sample_raster(map[1], x, y, r), sample_raster(map[2], x, y, r))
+              .cwiseMax(0.0f)
+              .cwiseMin(1.0f);
+    }
+  }
+  p.material = mix(ground, surface.snow, p.snow);
 
   if (surface.ripples && normal.z() > 1e-3f) {
     const RippleLayer& r = surface.ripples.value();

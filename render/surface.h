@@ -6,6 +6,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <filesystem>
 #include <optional>
 
 #include "render/normal_map.h"
@@ -34,7 +36,16 @@ struct TerrainSurface {
   std::optional<terrain::HeightField> snow_cover;  // [0, 1]: snow's share of the surface
   std::optional<terrain::HeightField> snow_depth;  // metres, raises the surface
   std::optional<RippleLayer> ripples;
+  // The ground's albedo draped from an image in the DEM's CRS (an orthophoto
+  // or a land-cover colour map): linear R, G, B in [0, 1]; outside it the
+  // ground material's colour.
+  std::optional<std::array<terrain::HeightField, 3>> albedo_map;
 };
+
+// Reads a draped albedo image (GeoTIFF or any GDAL raster): 3 bands (or 1,
+// grey); 8/16-bit values are sRGB-encoded and decoded to linear, float values
+// are taken as linear albedo.
+std::array<terrain::HeightField, 3> read_albedo_map(const std::filesystem::path& path);
 
 // The material at a terrain point, after layers.
 struct SurfacePoint {

@@ -2,15 +2,19 @@
 // Oren-Nayar reflectance, and snow cover and depth as the renderer sees them.
 #include "render/surface.h"
 
+#include <gdal_priv.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 
 #include "render/brdf.h"
 #include "render/renderer.h"
 #include "render/terrain_scene.h"
+#include "render/tonemap.h"
 #include "terrain/error.h"
+#include "terrain/raster_io.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -153,4 +157,34 @@ TEST(Snow, CoverBlendsTheMaterialAndDepthRaisesTheSurface) {
   EXPECT_NEAR((west.albedo - in.surface.snow.albedo).norm(), 0.0f, 1e-6f);
   EXPECT_NEAR((east.albedo - in.surface.ground.albedo).norm(), 0.0f, 1e-6f);
   EXPECT_NEAR(east.distance - west.distance, 2.0f, 1e-3f);
+}
+
+TEST(AlbedoMap, ADrapedImageColoursTheGroundAndDecodesSrgb) {
+  // A 4 x 4 RGB Byte GeoTIFF, 10 m cells: the western half red (200, 0, 0),
+  // the eastern half grey (128, 128, 128).
+  const auto path = std::filesystem::temp_directory_path() / "drift_albedo_map.tif";
+  drift::terrain::ensure_gdal();
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  GDALDataset* ds = driver->Create(path.c_str(), 4, 4, 3, GDT_Byte, nullptr);
+  ASSERT_NE(ds, nullptr);
+  double gt[6] = {0.0, 10.0, 0.0, 0.0, 0.0, -10.0};
+  ds->SetGeoTransform(gt);
+  for (int band = 1; band <= 3; ++band) {
+    unsigned char px[16];
+    for (int i = 0; i < 16; ++i) px[i] = (i % 4) < 2 ? (band == 1 ? 200 : 0) : 128;
+    ASSERT_EQ(ds->GetRasterBand(band)->RasterIO(GF_Write, 0, 0, 4, 4, px, 4, 4, GDT_Byte, 0, 0),
+              CE_None);
+  }
+  GDALClose(ds);
+  TerrainSurface s;
+  s.albedo_map = read_albedo_map(path);
+  const Eigen::Vector3f up(0, 0, 1);
+  const Eigen::Vector3f west = shade_terrain(s, 5.0, -15.0, up, 0.0).material.albedo;
+  const Eigen::Vector3f east = shade_terrain(s, 35.0, -15.0, up, 0.0).material.albedo;
+  const Eigen::Vector3f outside = shade_terrain(s, 500.0, -15.0, up, 0.0).material.albedo;
+  EXPECT_NEAR(west.x(), srgb_decode(200.0f / 255.0f), 1e-6f);
+  EXPECT_NEAR(west.y(), 0.0f, 1e-6f);
+  EXPECT_NEAR(east.y(), srgb_decode(128.0f / 255.0f), 1e-6f);    // 0.216: sRGB decoded
+  EXPECT_NEAR((outside - s.ground.albedo).norm(), 0.0f, 1e-6f);  // off the map: the ground colour
+  std::filesystem::remove(path);
 }
