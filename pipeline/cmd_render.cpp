@@ -22,7 +22,7 @@ struct RenderOptions {
   int spp = 0;
   std::string size;
   std::vector<std::string> outputs;
-  std::string terrain, snow_cover, snow_depth, ripples;
+  std::string terrain, snow_cover, snow_depth, snow_objects, ripples;
   unsigned long long seed = 0;
   std::string tile;
 };
@@ -46,6 +46,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
   if (!o.snow_cover.empty()) scene.snow_cover = o.snow_cover;
   if (!o.snow_depth.empty()) scene.snow_depth = o.snow_depth;
+  if (!o.snow_objects.empty()) scene.snow_objects = o.snow_objects;
   if (!o.ripples.empty()) {
     if (!scene.input.surface.ripples) {
       throw Error("--ripples needs a [ripples] section in '" + o.scene +
@@ -119,6 +120,8 @@ void add_render_command(CLI::App& root) {
   sub->add_option("--terrain", o->terrain, "terrain raster (overrides [terrain] raster)");
   sub->add_option("--snow-cover", o->snow_cover, "snow cover raster (overrides [snow] cover)");
   sub->add_option("--snow-depth", o->snow_depth, "snow depth raster (overrides [snow] depth)");
+  sub->add_option("--snow-objects", o->snow_objects,
+                  "snowy objects from drift snow fall --mesh-out (overrides [snow] objects)");
   sub->add_option("--ripples", o->ripples, "ripple height tile (overrides [ripples] raster)");
   sub->add_option("--tile", o->tile,
                   "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16) to EXR; "

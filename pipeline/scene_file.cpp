@@ -12,6 +12,7 @@
 #include "render/surface.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -71,6 +72,7 @@ SceneFile read_scene_file(const fs::path& path) {
   Section snow(subtable(root, "snow", path), "snow", path);
   if (const auto cover = snow.string("cover")) scene.snow_cover = resolve(*cover);
   if (const auto depth = snow.string("depth")) scene.snow_depth = resolve(*depth);
+  if (const auto objects = snow.string("objects")) scene.snow_objects = resolve(*objects);
   in.surface.snow.albedo = snow.color("color", in.surface.snow.albedo);
   in.surface.snow.roughness =
       static_cast<float>(snow.number("roughness", in.surface.snow.roughness, 0.0, 1.5));
@@ -233,6 +235,32 @@ void place_sun(SceneFile& scene) {
   scene.input.sun.elevation_deg = sun.elevation_deg;
 }
 
+// Replaces the scene's objects by their snowy versions from drift snow fall:
+// the same objects in the same order, raised by their snow, keeping their
+// colours, with per-vertex snow coverage.
+void place_snowy_objects(SceneFile& scene) {
+  std::vector<render::PlacedMesh>& meshes = scene.input.meshes;
+  const terrain::Mesh snowy = terrain::read_ply(scene.snow_objects);
+  std::vector<terrain::Mesh> parts;
+  try {
+    parts = terrain::split_by_attribute(snowy, "object");
+  } catch (const Error& e) {
+    throw Error("'" + scene.snow_objects.string() + "': " + e.what() +
+                " (write it with drift snow fall --mesh-out)");
+  }
+  if (parts.size() != meshes.size()) {
+    throw Error("'" + scene.snow_objects.string() + "' holds " + std::to_string(parts.size()) +
+                " objects but the scene has " + std::to_string(meshes.size()) +
+                "; give the scene the objects file drift snow fall was given");
+  }
+  for (std::size_t o = 0; o < parts.size(); ++o) {
+    const std::vector<float>* cover = parts[o].attribute("snow_coverage");
+    meshes[o].position = parts[o].origin;
+    meshes[o].snow_coverage = cover ? *cover : std::vector<float>{};
+    meshes[o].mesh = std::move(parts[o]);
+  }
+}
+
 // Turns the camera's lon/lat ends into CRS points at their height above the
 // (exaggerated) ground, which must be inside the DEM.
 void place_lonlat_camera(SceneFile& scene) {
@@ -264,6 +292,7 @@ void load_scene_terrain(SceneFile& scene) {
   }
   place_lonlat_camera(scene);
   if (scene.sun_time) place_sun(scene);
+  if (!scene.snow_objects.empty()) place_snowy_objects(scene);
   if (!scene.albedo_map.empty()) {
     surface.albedo_map = render::read_albedo_map(scene.albedo_map);
     require_metric_crs(surface.albedo_map->front(), scene.albedo_map);

@@ -26,6 +26,9 @@ struct SceneFile {
   // Layer rasters ([snow] cover and depth, [ripples] raster), resolved likewise;
   // empty when the scene has none.
   std::filesystem::path snow_cover, snow_depth, ripples, albedo_map;
+  // [snow] objects: the scene's objects as drift snow fall left them (a PLY
+  // with per-vertex "object" and "snow_coverage"), replacing their meshes.
+  std::filesystem::path snow_objects;
   std::optional<double> ripple_texel_metres;  // default: the ripple raster's cell size
   int terrain_repeat = 1;  // [terrain] repeat: a tileable terrain laid out n x n (odd)
   // [camera] from_lonlat / to_lonlat: resolved into input.camera by

@@ -60,6 +60,8 @@ struct PlacedMesh {
   // coordinates in float would lose half a metre.
   Eigen::Vector3d position{0, 0, 0};
   Eigen::Vector3f albedo{0.5f, 0.5f, 0.5f};
+  // Per-vertex snow coverage in [0, 1] (from drift snow fall), or empty.
+  std::vector<float> snow_coverage;
 };
 
 struct RenderSettings {

@@ -136,6 +136,8 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   rtcReleaseGeometry(grid_geometry);
   terrain_geometries_ = 1;
   mesh_albedo_.push_back(surface_.ground.albedo);
+  mesh_snow_.emplace_back();
+  mesh_snow_triangles_.emplace_back();
 
   // Meshes: triangle geometry with their own (copied, shifted) buffers.
   for (const PlacedMesh& placed : input.meshes) {
@@ -158,8 +160,18 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
     rtcCommitGeometry(geom);
     const unsigned id = rtcAttachGeometry(embree_->scene, geom);
     rtcReleaseGeometry(geom);
-    if (mesh_albedo_.size() <= id) mesh_albedo_.resize(id + 1);
+    if (mesh_albedo_.size() <= id) {
+      mesh_albedo_.resize(id + 1);
+      mesh_snow_.resize(id + 1);
+      mesh_snow_triangles_.resize(id + 1);
+    }
     mesh_albedo_[id] = placed.albedo;
+    if (!placed.snow_coverage.empty()) {
+      if (placed.snow_coverage.size() != placed.mesh.positions.size())
+        throw Error("a mesh's snow coverage must have one value per vertex");
+      mesh_snow_[id] = placed.snow_coverage;
+      mesh_snow_triangles_[id] = placed.mesh.triangles;
+    }
   }
   rtcCommitScene(embree_->scene);
   check_device(embree_->device, "build the scene");
@@ -221,6 +233,17 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   } else {
     n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
     hit.albedo = mesh_albedo_[rh.hit.geomID];
+    if (rh.hit.geomID < mesh_snow_.size() && !mesh_snow_[rh.hit.geomID].empty()) {
+      // Snow coverage interpolated over the triangle (Embree's barycentrics).
+      const std::vector<float>& cover = mesh_snow_[rh.hit.geomID];
+      const std::array<int, 3>& tri = mesh_snow_triangles_[rh.hit.geomID][rh.hit.primID];
+      const float c = std::clamp((1.0f - rh.hit.u - rh.hit.v) * cover[tri[0]] +
+                                     rh.hit.u * cover[tri[1]] + rh.hit.v * cover[tri[2]],
+                                 0.0f, 1.0f);
+      hit.albedo = hit.albedo * (1.0f - c) + surface_.snow.albedo * c;
+      hit.roughness = surface_.snow.roughness * c;
+      hit.snow = c;
+    }
   }
   // Face the ray: a mesh may be seen from either side, and terrain from below
   // at the edges. (Embree's Ng of our grids points down: rows run south.)

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -72,7 +73,10 @@ class TerrainScene {
   std::vector<Eigen::Vector3f> vertex_normals_;
   TerrainSurface surface_;
   std::vector<Eigen::Vector3f> mesh_albedo_;  // by Embree geometry id
-  unsigned terrain_geometries_ = 0;           // geometry ids [0, n) are terrain grids
+  // Per-vertex snow coverage and the triangles to interpolate it, by geometry id.
+  std::vector<std::vector<float>> mesh_snow_;
+  std::vector<std::vector<std::array<int, 3>>> mesh_snow_triangles_;
+  unsigned terrain_geometries_ = 0;  // geometry ids [0, n) are terrain grids
   Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};
   Eigen::Vector2f extent_{0, 0};
 };

@@ -166,7 +166,8 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   result.mesh_origin =
       Eigen::Vector3d(std::round(scene.origin.x()), std::round(scene.origin.y()), 0.0);
   const Eigen::Vector3d shift = scene.origin - result.mesh_origin;
-  std::vector<float> a_depth, a_prob, a_cover, a_adhesion;
+  result.objects.origin = result.mesh_origin;
+  std::vector<float> a_depth, a_prob, a_cover, a_adhesion, a_object;
   for (std::size_t o = 0; o < scene.meshes.size(); ++o) {
     const terrain::Mesh& m = scene.meshes[o];
     const ObjectSnow& os = object_snow[o];
@@ -178,6 +179,7 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
       a_depth.push_back(static_cast<float>(os.depth[i]));
       a_prob.push_back(static_cast<float>(os.probability[i]));
       a_adhesion.push_back(static_cast<float>(os.adhesion[i]));
+      a_object.push_back(static_cast<float>(o));
       a_cover.push_back(static_cast<float>(
           std::max(thin_coverage(os.depth[i], options.coverage), os.adhesion[i])));
     }
@@ -187,7 +189,8 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   result.objects.vertex_attributes = {{"snow_depth", std::move(a_depth)},
                                       {"snow_probability", std::move(a_prob)},
                                       {"snow_coverage", std::move(a_cover)},
-                                      {"snow_adhesion", std::move(a_adhesion)}};
+                                      {"snow_adhesion", std::move(a_adhesion)},
+                                      {"object", std::move(a_object)}};
   report(1.0, "snowfall");
   return result;
 }

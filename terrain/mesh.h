@@ -15,6 +15,16 @@ struct Mesh {
   std::vector<Eigen::Vector3f> normals;       // per vertex, optional (empty or = positions)
   // Named per-vertex scalar attributes (e.g. "snow_depth", "snow_coverage").
   std::vector<std::pair<std::string, std::vector<float>>> vertex_attributes;
+  // Where the mesh's coordinates are measured from, in a CRS (float positions
+  // cannot hold UTM-sized numbers to the centimetre). Kept in PLY files.
+  Eigen::Vector3d origin{0, 0, 0};
+
+  // The named per-vertex attribute, or nullptr.
+  const std::vector<float>* attribute(const std::string& name) const {
+    for (const auto& [n, v] : vertex_attributes)
+      if (n == name) return &v;
+    return nullptr;
+  }
 
   std::size_t vertex_count() const { return positions.size(); }
   std::size_t triangle_count() const { return triangles.size(); }

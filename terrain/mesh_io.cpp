@@ -3,8 +3,12 @@
 #include <tiny_obj_loader.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <sstream>
+#include <string>
 #include <system_error>
+#include <vector>
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
@@ -71,6 +75,10 @@ void write_ply(const Mesh& mesh, const fs::path& path) {
   {
     std::ofstream f(out.temp_path(), std::ios::binary);
     f << "ply\nformat binary_little_endian 1.0\ncomment written by Driftscape\n";
+    char origin[128];
+    std::snprintf(origin, sizeof origin, "comment origin %.17g %.17g %.17g\n", mesh.origin.x(),
+                  mesh.origin.y(), mesh.origin.z());
+    f << origin;
     f << "element vertex " << mesh.positions.size() << "\n";
     f << "property float x\nproperty float y\nproperty float z\n";
     if (with_normals) f << "property float nx\nproperty float ny\nproperty float nz\n";
@@ -95,6 +103,137 @@ void write_ply(const Mesh& mesh, const fs::path& path) {
     if (!f) throw Error("cannot write '" + path.string() + "' (disk full?)");
   }
   out.commit();
+}
+
+std::vector<Mesh> split_by_attribute(const Mesh& mesh, const std::string& name) {
+  const std::vector<float>* key = mesh.attribute(name);
+  if (!key) throw Error("the mesh has no per-vertex '" + name + "' attribute to split by");
+  int parts = 0;
+  for (float v : *key) parts = std::max(parts, static_cast<int>(v) + 1);
+  std::vector<Mesh> out(static_cast<std::size_t>(parts));
+  std::vector<int> part_of(mesh.positions.size()), index_in(mesh.positions.size());
+  for (auto& part : out) {
+    part.origin = mesh.origin;
+    for (const auto& [n, values] : mesh.vertex_attributes)
+      part.vertex_attributes.emplace_back(n, std::vector<float>{});
+  }
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const int k = std::max(0, static_cast<int>((*key)[v]));
+    Mesh& part = out[static_cast<std::size_t>(k)];
+    part_of[v] = k;
+    index_in[v] = static_cast<int>(part.positions.size());
+    part.positions.push_back(mesh.positions[v]);
+    if (mesh.normals.size() == mesh.positions.size()) part.normals.push_back(mesh.normals[v]);
+    for (std::size_t a = 0; a < mesh.vertex_attributes.size(); ++a)
+      part.vertex_attributes[a].second.push_back(mesh.vertex_attributes[a].second[v]);
+  }
+  for (const auto& t : mesh.triangles) {
+    const int k = part_of[static_cast<std::size_t>(t[0])];
+    if (part_of[static_cast<std::size_t>(t[1])] != k ||
+        part_of[static_cast<std::size_t>(t[2])] != k)
+      continue;
+    out[static_cast<std::size_t>(k)].triangles.push_back(
+        {index_in[static_cast<std::size_t>(t[0])], index_in[static_cast<std::size_t>(t[1])],
+         index_in[static_cast<std::size_t>(t[2])]});
+  }
+  return out;
+}
+
+Mesh read_ply(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error("cannot read mesh '" + path.string() + "': no such file");
+  auto bad = [&](const std::string& what) {
+    return Error("cannot read mesh '" + path.string() + "': " + what +
+                 " (drift reads the binary PLY files it writes; convert others to OBJ)");
+  };
+  std::string line;
+  if (!std::getline(f, line) || line != "ply") throw bad("not a PLY file");
+  Mesh mesh;
+  std::vector<std::string> properties;
+  std::size_t vertices = 0, faces = 0;
+  std::string element;
+  while (std::getline(f, line) && line != "end_header") {
+    std::istringstream in(line);
+    std::string word;
+    in >> word;
+    if (word == "format") {
+      std::string format;
+      in >> format;
+      if (format != "binary_little_endian") throw bad("format '" + format + "'");
+    } else if (word == "comment") {
+      std::string key;
+      double x, y, z;
+      if (in >> key && key == "origin" && in >> x >> y >> z) mesh.origin = {x, y, z};
+    } else if (word == "element") {
+      in >> element;
+      std::size_t count = 0;
+      in >> count;
+      if (element == "vertex")
+        vertices = count;
+      else if (element == "face")
+        faces = count;
+      else
+        throw bad("element '" + element + "'");
+    } else if (word == "property") {
+      std::string type;
+      in >> type;
+      if (element == "vertex") {
+        std::string name;
+        in >> name;
+        if (type != "float") throw bad("vertex property '" + name + "' of type " + type);
+        properties.push_back(name);
+      } else if (line != "property list uchar int vertex_indices") {
+        throw bad("face property '" + line + "'");
+      }
+    }
+  }
+  if (line != "end_header") throw bad("no end_header");
+  if (vertices > (std::size_t{1} << 31) || faces > (std::size_t{1} << 31)) {
+    throw bad("implausible element counts");
+  }
+  std::vector<float> row(properties.size());
+  std::vector<std::vector<float>> columns(properties.size(), std::vector<float>(vertices));
+  for (std::size_t v = 0; v < vertices; ++v) {
+    if (!f.read(reinterpret_cast<char*>(row.data()),
+                static_cast<std::streamsize>(row.size() * sizeof(float)))) {
+      throw bad("truncated vertex data");
+    }
+    for (std::size_t p = 0; p < row.size(); ++p) columns[p][v] = row[p];
+  }
+  auto column = [&](const char* name) -> std::vector<float>* {
+    for (std::size_t p = 0; p < properties.size(); ++p)
+      if (properties[p] == name) return &columns[p];
+    return nullptr;
+  };
+  const auto *x = column("x"), *y = column("y"), *z = column("z");
+  if (!x || !y || !z) throw bad("no x, y, z vertex properties");
+  mesh.positions.resize(vertices);
+  for (std::size_t v = 0; v < vertices; ++v) mesh.positions[v] = {(*x)[v], (*y)[v], (*z)[v]};
+  const auto *nx = column("nx"), *ny = column("ny"), *nz = column("nz");
+  if (nx && ny && nz) {
+    mesh.normals.resize(vertices);
+    for (std::size_t v = 0; v < vertices; ++v) mesh.normals[v] = {(*nx)[v], (*ny)[v], (*nz)[v]};
+  }
+  for (std::size_t p = 0; p < properties.size(); ++p) {
+    const std::string& n = properties[p];
+    if (n != "x" && n != "y" && n != "z" && n != "nx" && n != "ny" && n != "nz")
+      mesh.vertex_attributes.emplace_back(n, std::move(columns[p]));
+  }
+  mesh.triangles.resize(faces);
+  for (std::size_t t = 0; t < faces; ++t) {
+    unsigned char count = 0;
+    int idx[3];
+    if (!f.read(reinterpret_cast<char*>(&count), 1) || count != 3 ||
+        !f.read(reinterpret_cast<char*>(idx), sizeof idx)) {
+      throw bad("face " + std::to_string(t) + " is not a triangle or is truncated");
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (idx[k] < 0 || static_cast<std::size_t>(idx[k]) >= vertices)
+        throw bad("face " + std::to_string(t) + " names vertex " + std::to_string(idx[k]));
+    }
+    mesh.triangles[t] = {idx[0], idx[1], idx[2]};
+  }
+  return mesh;
 }
 
 }  // namespace drift::terrain

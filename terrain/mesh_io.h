@@ -16,6 +16,18 @@ Mesh read_obj(const std::filesystem::path& path, bool y_up = false);
 
 // Binary little-endian PLY: x y z [nx ny nz] [attributes...] and triangle faces.
 // Written atomically.
+// The origin is written as a comment "origin X Y Z" (CRS metres).
 void write_ply(const Mesh& mesh, const std::filesystem::path& path);
+
+// Reads the PLY files write_ply writes (binary little-endian, float vertex
+// properties, triangle faces as "list uchar int"): positions, normals if
+// there, every other vertex property as a named attribute, and the origin
+// comment. Anything else is a drift::Error naming the file and what differs.
+Mesh read_ply(const std::filesystem::path& path);
+
+// Splits a mesh by a per-vertex integer attribute (e.g. "object"): part k holds
+// the vertices whose value is k and the triangles among them, attributes and
+// origin carried along. Throws drift::Error if the attribute is missing.
+std::vector<Mesh> split_by_attribute(const Mesh& mesh, const std::string& name);
 
 }  // namespace drift::terrain

@@ -188,3 +188,26 @@ TEST(AlbedoMap, ADrapedImageColoursTheGroundAndDecodesSrgb) {
   EXPECT_NEAR((outside - s.ground.albedo).norm(), 0.0f, 1e-6f);  // off the map: the ground colour
   std::filesystem::remove(path);
 }
+
+TEST(Snow, MeshCoverageBlendsTheObjectsMaterial) {
+  // A horizontal square 10 m above flat ground, fully snowed on one corner's
+  // vertices and bare on the others.
+  SceneInput in;
+  in.terrain = HeightField(16, 16, 0.0f, local_georeference(1.0));
+  PlacedMesh roof;
+  roof.mesh.positions = {{0, 0, 10}, {4, 0, 10}, {0, 4, 10}, {4, 4, 10}};
+  roof.mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
+  roof.position = Eigen::Vector3d(6.0, -10.0, 0.0);
+  roof.albedo = {0.3f, 0.2f, 0.1f};
+  roof.snow_coverage = {1.0f, 1.0f, 1.0f, 0.0f};
+  in.meshes.push_back(roof);
+  const TerrainScene scene(in);
+  const Eigen::Vector3f down(0, 0, -1);
+  Hit near_snowy, near_bare;
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(6.2, -9.8, 50.0)), down, near_snowy));
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(9.9, -6.1, 50.0)), down, near_bare));
+  EXPECT_GT(near_snowy.snow, 0.95f);
+  EXPECT_LT(near_bare.snow, 0.1f);
+  EXPECT_NEAR((near_snowy.albedo - in.surface.snow.albedo).norm(), 0.0f, 0.05f);
+  EXPECT_NEAR((near_bare.albedo - roof.albedo).norm(), 0.0f, 0.1f);
+}

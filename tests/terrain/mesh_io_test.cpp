@@ -1,0 +1,72 @@
+// PLY meshes: a write/read round trip keeps positions, attributes and the CRS
+// origin; splitting by an attribute; malformed files are clear errors.
+#include "terrain/mesh_io.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "terrain/error.h"
+
+using namespace drift::terrain;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Two triangles (object 0) and one (object 1).
+Mesh two_objects() {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {5, 5, 1}, {6, 5, 1}, {5, 6, 1}};
+  m.triangles = {{0, 1, 2}, {1, 3, 2}, {4, 5, 6}};
+  m.vertex_attributes = {{"snow_coverage", {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f}},
+                         {"object", {0, 0, 0, 0, 1, 1, 1}}};
+  m.origin = {746633.0, 4032753.0, 12.5};
+  return m;
+}
+
+}  // namespace
+
+TEST(MeshIo, PlyRoundTripKeepsEverything) {
+  const fs::path path = fs::temp_directory_path() / "drift_mesh_round_trip.ply";
+  const Mesh m = two_objects();
+  write_ply(m, path);
+  const Mesh back = read_ply(path);
+  EXPECT_EQ(back.positions, m.positions);
+  EXPECT_EQ(back.triangles, m.triangles);
+  ASSERT_NE(back.attribute("snow_coverage"), nullptr);
+  EXPECT_EQ(*back.attribute("snow_coverage"), *m.attribute("snow_coverage"));
+  EXPECT_EQ(back.origin, m.origin);  // to the last bit: UTM metres
+  fs::remove(path);
+}
+
+TEST(MeshIo, SplitByAttributeGivesEachObjectItsVerticesAndTriangles) {
+  const auto parts = split_by_attribute(two_objects(), "object");
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].vertex_count(), 4u);
+  EXPECT_EQ(parts[0].triangle_count(), 2u);
+  EXPECT_EQ(parts[1].vertex_count(), 3u);
+  ASSERT_EQ(parts[1].triangle_count(), 1u);
+  EXPECT_EQ(parts[1].triangles[0], (std::array<int, 3>{0, 1, 2}));
+  EXPECT_FLOAT_EQ((*parts[1].attribute("snow_coverage"))[0], 0.5f);
+  EXPECT_EQ(parts[1].origin, two_objects().origin);
+  EXPECT_THROW(split_by_attribute(two_objects(), "colour"), drift::Error);
+}
+
+TEST(MeshIo, MalformedPlyIsAClearError) {
+  const fs::path path = fs::temp_directory_path() / "drift_mesh_bad.ply";
+  write_ply(two_objects(), path);
+  fs::resize_file(path, fs::file_size(path) - 7);  // truncated faces
+  EXPECT_THROW(read_ply(path), drift::Error);
+  std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
+  try {
+    read_ply(path);
+    ADD_FAILURE() << "an ASCII PLY must be refused";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("ascii"), std::string::npos) << e.what();
+  }
+  std::ofstream(path) << "solid cube\n";
+  EXPECT_THROW(read_ply(path), drift::Error);
+  EXPECT_THROW(read_ply(fs::temp_directory_path() / "drift_no_such_mesh.ply"), drift::Error);
+  fs::remove(path);
+}
