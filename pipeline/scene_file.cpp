@@ -144,6 +144,8 @@ SceneFile read_scene_file(const fs::path& path) {
   in.sky.ground_factor =
       static_cast<float>(sky.number("ground_factor", in.sky.ground_factor, 0.0, 10.0));
   in.sky.constant = sky.boolean("constant", in.sky.constant);
+  in.sky.light_shafts = sky.boolean("light_shafts", in.sky.light_shafts);
+  in.sky.shaft_steps = sky.integer("shaft_steps", in.sky.shaft_steps, 1, 1024);
   sky.finish();
 
   if (const toml::table* cam_table = subtable(root, "camera", path)) {

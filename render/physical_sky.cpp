@@ -141,9 +141,8 @@ AirSegment PhysicalSky::from_camera(const Eigen::Vector3f& dir, float distance) 
              mix(slice(e0 + 1, a0), slice(e0 + 1, a0 + 1), ta), te);
 }
 
-AirSegment PhysicalSky::segment(float mid_altitude, const Eigen::Vector3f& dir,
-                                float length) const {
-  const int i = static_cast<int>(std::lround(altitude_index(mid_altitude)));
+Spectrum PhysicalSky::segment_inscatter(int i, const Eigen::Vector3f& dir, float length,
+                                        bool multiple, Spectrum* transmittance) const {
   const Spectrum& ext = extinction_[i];
   const Spectrum& sr = scattering_rayleigh_[i];
   const Spectrum& sm = scattering_mie_[i];
@@ -151,13 +150,32 @@ AirSegment PhysicalSky::segment(float mid_altitude, const Eigen::Vector3f& dir,
   const Spectrum& psi = multiple_[i];
   const float nu = dir.dot(sun_.cast<float>());
   const float pr = rayleigh_phase(nu), pm = mie_phase(nu, kMieG);
-  Spectrum l{}, t{};
+  Spectrum l{};
   for (int b = 0; b < kBands; ++b) {
-    t[b] = std::exp(-ext[b] * length);
-    const float source = (sr[b] * pr + sm[b] * pm) * sun_t[b] + (sr[b] + sm[b]) * psi[b];
-    l[b] = source * (1.0f - t[b]) / std::max(ext[b], 1e-12f);
+    const float t = std::exp(-ext[b] * length);
+    if (transmittance) (*transmittance)[b] = t;
+    float source = (sr[b] * pr + sm[b] * pm) * sun_t[b];
+    if (multiple) source += (sr[b] + sm[b]) * psi[b];
+    // The source integrated over the segment, each point seen through the
+    // air before it: source (1 - T) / extinction.
+    l[b] = source * (1.0f - t) / std::max(ext[b], 1e-12f);
   }
+  return l;
+}
+
+AirSegment PhysicalSky::segment(float mid_altitude, const Eigen::Vector3f& dir,
+                                float length) const {
+  const int i = static_cast<int>(std::lround(altitude_index(mid_altitude)));
+  Spectrum t{};
+  const Spectrum l = segment_inscatter(i, dir, length, true, &t);
   return {atmosphere_.radiance_to_rgb(l) * sun_scale_, atmosphere_.transmittance_rgb(t)};
+}
+
+Eigen::Vector3f PhysicalSky::sun_single_scattering(float mid_altitude, const Eigen::Vector3f& dir,
+                                                   float length) const {
+  const int i = static_cast<int>(std::lround(altitude_index(mid_altitude)));
+  return atmosphere_.radiance_to_rgb(segment_inscatter(i, dir, length, false, nullptr)) *
+         sun_scale_;
 }
 
 Eigen::Vector3f PhysicalSky::sun_irradiance(float altitude) const {

@@ -33,6 +33,11 @@ class PhysicalSky {
   AirSegment from_camera(const Eigen::Vector3f& dir, float distance) const;
   // The same for a short segment anywhere (homogeneous air at its mid altitude).
   AirSegment segment(float mid_altitude, const Eigen::Vector3f& dir, float length) const;
+  // The part of segment()'s in-scatter that is the sun's single scattering:
+  // what the air of the segment stops sending when the terrain hides the sun
+  // from it (light shafts, render/light_shafts.h).
+  Eigen::Vector3f sun_single_scattering(float mid_altitude, const Eigen::Vector3f& dir,
+                                        float length) const;
   // Irradiance of the sun at an altitude, after the air above (on a surface
   // facing it).
   Eigen::Vector3f sun_irradiance(float altitude) const;
@@ -60,6 +65,11 @@ class PhysicalSky {
                    float& fa) const;
   Eigen::Vector3d direction(int e, int a, int elevations, int azimuths) const;
   float altitude_index(float altitude) const;
+  // In-scatter (and optionally transmittance) of a homogeneous segment at
+  // altitude table index i: the sun's single scattering, plus the multiple
+  // scattering when `multiple`.
+  Spectrum segment_inscatter(int i, const Eigen::Vector3f& dir, float length, bool multiple,
+                             Spectrum* transmittance) const;
 };
 
 }  // namespace drift::render

@@ -37,6 +37,10 @@ struct Sky {
   float intensity = 1.0f;      // multiplies both
   float ground_factor = 1.0f;  // below the horizon: horizon x this (distant haze)
   bool constant = false;       // constant radiance `intensity` everywhere (white furnace)
+  // Physical sky only: the terrain's shadow on the air seen from the camera
+  // (render/light_shafts.h), tested at `shaft_steps` points per camera ray.
+  bool light_shafts = false;
+  int shaft_steps = 16;
 };
 
 struct Camera {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "render/brdf.h"
+#include "render/light_shafts.h"
 #include "render/physical_sky.h"
 #include "render/random.h"
 #include "terrain/error.h"
@@ -195,6 +196,17 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   auto sky_light = [&](const Vector3f& d) {
     return air ? air->sky(d) : sky_radiance(input.sky, d);
   };
+  // Light shafts: what the terrain's shadow takes from a camera ray's air.
+  const bool shafts = air && input.sky.light_shafts && sun_up;
+  const ShadowSlab shadow_slab{scene.bottom(), scene.top()};
+  const auto in_shadow = [&](const Vector3f& p) { return scene.occluded(p, sun_dir, 1e30f); };
+  const float air_reach = camera_rays.eye.head<2>().norm() + scene.extent().norm();
+  auto shaft_loss = [&](const Vector3f& origin, const Vector3f& dir, float distance, float jitter,
+                        std::uint64_t& rays) {
+    rays += static_cast<std::uint64_t>(input.sky.shaft_steps);
+    return shaft_shadow_loss(*air, base_altitude, {origin, dir, distance}, shadow_slab,
+                             input.sky.shaft_steps, jitter, in_shadow);
+  };
 
   auto trace = [&](int px, int py, SampleStream& rng, std::uint64_t& rays) {
     PixelSample out;
@@ -204,6 +216,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
     const float lu = camera_rays.lens_radius > 0.0f ? rng.next() : 0.0f;
     const float lv = camera_rays.lens_radius > 0.0f ? rng.next() : 0.0f;
     camera_rays.ray(static_cast<float>(px) + jx, static_cast<float>(py) + jy, lu, lv, origin, dir);
+    const float shaft_jitter = shafts ? rng.next() : 0.0f;  // likewise only when used
     Vector3f throughput(1, 1, 1);
     // Camera rays start as wide as a pixel's angle; see RayCone.
     RayCone cone{0.0f, 2.0f * camera_rays.tan_half / static_cast<float>(settings.height)};
@@ -212,7 +225,12 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
       ++rays;
       if (!scene.intersect(origin, dir, hit, cone)) {
         if (depth == 0) out.sky = 1.0f;
-        out.radiance += throughput.cwiseProduct(sky_light(dir));
+        Vector3f light = sky_light(dir);
+        if (depth == 0 && shafts) {
+          light -= shaft_loss(origin, dir, air_reach, shaft_jitter, rays);
+          light = light.cwiseMax(0.0f);
+        }
+        out.radiance += throughput.cwiseProduct(light);
         break;
       }
       if (air) {
@@ -222,7 +240,12 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
             depth == 0 ? air->from_camera(dir, hit.distance)
                        : air->segment(base_altitude + 0.5f * (origin.z() + hit.position.z()), dir,
                                       hit.distance);
-        out.radiance += throughput.cwiseProduct(seg.inscatter);
+        Vector3f inscatter = seg.inscatter;
+        if (depth == 0 && shafts) {
+          inscatter -= shaft_loss(origin, dir, hit.distance, shaft_jitter, rays);
+          inscatter = inscatter.cwiseMax(0.0f);
+        }
+        out.radiance += throughput.cwiseProduct(inscatter);
         throughput = throughput.cwiseProduct(seg.transmittance);
       }
       if (depth == 0) {

@@ -175,6 +175,10 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   }
   rtcCommitScene(embree_->scene);
   check_device(embree_->device, "build the scene");
+  RTCBounds bounds;
+  rtcGetSceneBounds(embree_->scene, &bounds);
+  bottom_ = bounds.lower_z;
+  top_ = bounds.upper_z;
 }
 
 TerrainScene::~TerrainScene() = default;

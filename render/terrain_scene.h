@@ -61,6 +61,9 @@ class TerrainScene {
   Eigen::Vector3f lowest_point() const { return lowest_; }
   Eigen::Vector2f extent() const { return extent_; }  // metres east-west, north-south
   float height_at(float x, float y) const;            // bilinear, local coordinates
+  // Lowest and highest z of all geometry (terrain and meshes), local.
+  float bottom() const { return bottom_; }
+  float top() const { return top_; }
 
  private:
   struct Embree;
@@ -78,6 +81,7 @@ class TerrainScene {
   std::vector<std::vector<std::array<int, 3>>> mesh_snow_triangles_;
   unsigned terrain_geometries_ = 0;  // geometry ids [0, n) are terrain grids
   Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};
+  float bottom_ = 0.0f, top_ = 0.0f;
   Eigen::Vector2f extent_{0, 0};
 };
 

@@ -48,6 +48,7 @@ TEST(SceneFile, ReadsEveryKey) {
       write_scene("full.toml", std::string(kTerrain) +
                                    "exaggeration = 1.5\ncolor = [0.3, 0.2, 0.1]\n"
                                    "[sun]\nazimuth = 200\nelevation = 12.5\n"
+                                   "[sky]\nlight_shafts = true\nshaft_steps = 24\n"
                                    "[camera]\nfrom = [1, 2, 3]\nto = [4, 5, 6]\nfov = 30\n"
                                    "[render]\nwidth = 320\nheight = 200\nspp = 7\nseed = 9\n"
                                    "[output]\nfiles = [\"a.png\", \"a.exr\"]\nexposure = -1\n");
@@ -55,6 +56,8 @@ TEST(SceneFile, ReadsEveryKey) {
   EXPECT_EQ(s.terrain_raster, p.parent_path() / "dem.tif");
   EXPECT_DOUBLE_EQ(s.input.vertical_exaggeration, 1.5);
   EXPECT_DOUBLE_EQ(s.input.sun.elevation_deg, 12.5);
+  EXPECT_TRUE(s.input.sky.light_shafts);
+  EXPECT_EQ(s.input.sky.shaft_steps, 24);
   ASSERT_TRUE(s.input.camera.has_value());
   EXPECT_DOUBLE_EQ(s.input.camera->to.z(), 6.0);
   EXPECT_EQ(s.settings.width, 320);
@@ -87,6 +90,8 @@ TEST(SceneFile, OutOfRangeValuesAreErrors) {
   EXPECT_NE(error_of(std::string(kTerrain) + "[render]\nwidth = 0\n").find("render.width"),
             std::string::npos);
   EXPECT_NE(error_of(std::string(kTerrain) + "[sun]\nelevation = nan\n").find("sun.elevation"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[sky]\nshaft_steps = 0\n").find("sky.shaft_steps"),
             std::string::npos);
   EXPECT_NE(
       error_of(std::string(kTerrain) + "[camera]\nfrom = [0, 0, 1]\nto = [0, 1, 1]\nfov = 180\n")
