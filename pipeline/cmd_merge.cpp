@@ -26,6 +26,8 @@ render::DisplayTransform display_of(const render::Image& frame, const CLI::App& 
   if (const std::string* e = frame.attribute("exposure")) d.exposure_ev = std::stod(*e);
   if (const std::string* t = frame.attribute("tone"); t && *t == "clamp")
     d.curve = render::ToneCurve::Clamp;
+  if (const std::string* w = frame.attribute("white_balance"); w && *w == "daylight")
+    d.white_balance = render::kDaylightWhiteBalance;
   if (sub.count("--exposure")) d.exposure_ev = exposure;
   return d;
 }

@@ -93,7 +93,9 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   // The display settings ride along so that `drift merge` can write the PNG.
   image.attributes = {
       {"exposure", std::to_string(scene.display.exposure_ev)},
-      {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"}};
+      {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"},
+      {"white_balance",
+       scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
   for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
   std::printf("rendered %dx%d at %d spp in %.1f s -> ", image.width, image.height,
               scene.settings.samples_per_pixel, seconds);

@@ -206,6 +206,13 @@ SceneFile read_scene_file(const fs::path& path) {
   }
   scene.display.curve =
       (tone && *tone == "clamp") ? render::ToneCurve::Clamp : render::ToneCurve::Filmic;
+  const std::string balance = out.string("white_balance").value_or("daylight");
+  if (balance != "daylight" && balance != "none") {
+    throw Error(path.string() + ": 'output.white_balance' is '" + balance +
+                "'; use \"daylight\" (the sun 60 degrees up reads white) or \"none\" (sRGB's D65)");
+  }
+  scene.display.white_balance =
+      balance == "daylight" ? render::kDaylightWhiteBalance : std::array<float, 3>{1, 1, 1};
   out.finish();
   return scene;
 }

@@ -165,7 +165,7 @@ static std::vector<std::uint8_t> to_srgb8(const Image& linear, const DisplayTran
   for (std::size_t p = 0; p < n; ++p) {
     const float* s = &linear.pixels[p * linear.channels.size()];
     for (int c = 0; c < 3; ++c) {
-      const float e = srgb_encode(apply_tone_curve(s[idx[c]], display));
+      const float e = srgb_encode(apply_tone_curve(s[idx[c]] * display.white_balance[c], display));
       // Round to nearest: deterministic, and decode->encode round trips exactly.
       out[p * 3 + c] = static_cast<std::uint8_t>(std::lround(e * 255.0f));
     }

@@ -178,6 +178,27 @@ Eigen::Vector3f PhysicalSky::sun_single_scattering(float mid_altitude, const Eig
          sun_scale_;
 }
 
+Eigen::Vector3f PhysicalSky::level_irradiance() const {
+  // E = E_sun sin(elevation) + integral of L cos(theta) over the upper
+  // hemisphere; with mu = cos(theta), d(omega) cos(theta) = mu d(mu) d(phi):
+  // the midpoint rule on a 64 x 128 (mu, phi) grid.
+  constexpr int kMu = 64, kPhi = 128;
+  Eigen::Vector3f sky_part(0, 0, 0);
+  for (int i = 0; i < kMu; ++i) {
+    const double mu = (i + 0.5) / kMu, sin_theta = std::sqrt(1.0 - mu * mu);
+    for (int j = 0; j < kPhi; ++j) {
+      const double phi = 2.0 * kPi * (j + 0.5) / kPhi;
+      const Eigen::Vector3f dir(static_cast<float>(sin_theta * std::cos(phi)),
+                                static_cast<float>(sin_theta * std::sin(phi)),
+                                static_cast<float>(mu));
+      sky_part += sky(dir) * static_cast<float>(mu);
+    }
+  }
+  sky_part *= static_cast<float>(2.0 * kPi / (kMu * kPhi));  // d(mu) d(phi)
+  const float sun_part = static_cast<float>(std::max(sun_.z(), 0.0));
+  return sky_part + sun_irradiance(static_cast<float>(camera_altitude_)) * sun_part;
+}
+
 Eigen::Vector3f PhysicalSky::sun_irradiance(float altitude) const {
   const float f = altitude_index(altitude);
   const int i0 = std::min(static_cast<int>(f), kAltitudes - 2);

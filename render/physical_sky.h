@@ -38,6 +38,9 @@ class PhysicalSky {
   // from it (light shafts, render/light_shafts.h).
   Eigen::Vector3f sun_single_scattering(float mid_altitude, const Eigen::Vector3f& dir,
                                         float length) const;
+  // Irradiance on a level surface at the camera from the sun and the whole
+  // sky above the horizon (the colour of the day's light; white balance).
+  Eigen::Vector3f level_irradiance() const;
   // Irradiance of the sun at an altitude, after the air above (on a surface
   // facing it).
   Eigen::Vector3f sun_irradiance(float altitude) const;

@@ -2,6 +2,8 @@
 // and the sRGB transfer function.
 #pragma once
 
+#include <array>
+
 namespace drift::render {
 
 enum class ToneCurve {
@@ -9,9 +11,19 @@ enum class ToneCurve {
   Clamp,   // plain clamp to [0, 1] (for albedo and masks, and for tests)
 };
 
+// A camera's "daylight" white balance: per-channel gains that make a white
+// level surface at sea level, lit by the sun 60 degrees up and its sky in
+// Bruneton's reference atmosphere (render/atmosphere.h), read neutral at the
+// same luminance (linear sRGB, Rec. 709 luminance weights). That light is
+// warmer than sRGB's D65 white, as photographers' "daylight" (about 5500 K)
+// is; under it snow renders white rather than cream, and a setting sun still
+// reddens. Checked against the atmosphere by tests/render/atmosphere_test.cpp.
+inline constexpr std::array<float, 3> kDaylightWhiteBalance{0.9003f, 1.0252f, 1.0904f};
+
 struct DisplayTransform {
   double exposure_ev = 0.0;  // multiply radiance by 2^exposure_ev before the curve
   ToneCurve curve = ToneCurve::Filmic;
+  std::array<float, 3> white_balance{1.0f, 1.0f, 1.0f};  // R, G, B gains before the curve
 };
 
 // Linear radiance -> display-linear value in [0, 1] (before the sRGB encoding).

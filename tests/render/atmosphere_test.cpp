@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "render/physical_sky.h"
+#include "render/tonemap.h"
 
 using namespace drift::render;
 
@@ -119,4 +120,20 @@ TEST(AerialPerspective, ShortHorizontalPathFollowsBeerLambert) {
   a.in_scattering(h, Eigen::Vector3d(1.0, 0.0, 0.0), length, from_az_el(0.0, 40.0), 64, &t);
   const Spectrum ext = a.extinction(h);
   for (int b = 0; b < kBands; ++b) EXPECT_NEAR(t[b], std::exp(-ext[b] * length), 1e-3) << b;
+}
+
+TEST(Atmosphere, DaylightWhiteBalanceIsTheLevelLightOfTheSunSixtyDegreesUp) {
+  // kDaylightWhiteBalance (render/tonemap.h) is a constant so that PNGs need
+  // no atmosphere; it must stay the gains that make a white level surface at
+  // sea level, under the sun 60 degrees up and its sky in Bruneton's reference
+  // atmosphere, read neutral at unchanged luminance.
+  const PhysicalSky air(atmosphere(), 0.0, from_az_el(180, 60), 1.0f, 1000.0);
+  const Eigen::Vector3f e = air.level_irradiance();
+  const float luminance = 0.2126f * e.x() + 0.7152f * e.y() + 0.0722f * e.z();
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(kDaylightWhiteBalance[c], luminance / e[c], 1e-3) << "channel " << c;
+  // Daylight is warmer than the sRGB white (D65) with the sun this low: red
+  // is turned down, blue up.
+  EXPECT_LT(kDaylightWhiteBalance[0], 1.0f);
+  EXPECT_GT(kDaylightWhiteBalance[2], 1.0f);
 }
