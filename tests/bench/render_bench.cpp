@@ -48,12 +48,12 @@ Fixture& fixture() {
   return f;
 }
 
-void BM_PathTracer(benchmark::State& state) {
+void trace_frames(benchmark::State& state, const render::SceneInput& input) {
   Fixture& f = fixture();
   render::RenderStats stats;
   for (auto _ : state) {
-    auto img = render::render_image(*f.embree, f.scene.input, f.camera, f.scene.settings,
-                                    no_progress, &stats);
+    auto img =
+        render::render_image(*f.embree, input, f.camera, f.scene.settings, no_progress, &stats);
     benchmark::DoNotOptimize(img.pixels.data());
   }
   state.counters["rays/s"] = benchmark::Counter(
@@ -63,7 +63,17 @@ void BM_PathTracer(benchmark::State& state) {
   state.counters["rays/sample"] = static_cast<double>(stats.rays) / stats.camera_rays;
   state.counters["peak_MiB"] = bench::peak_resident_mib();
 }
+
+void BM_PathTracer(benchmark::State& state) { trace_frames(state, fixture().scene.input); }
 BENCHMARK(BM_PathTracer)->Unit(benchmark::kSecond)->UseRealTime()->MinTime(2.0);
+
+// The same frame with light shafts (16 shadow tests per camera ray).
+void BM_PathTracerLightShafts(benchmark::State& state) {
+  render::SceneInput input = fixture().scene.input;
+  input.sky.light_shafts = true;
+  trace_frames(state, input);
+}
+BENCHMARK(BM_PathTracerLightShafts)->Unit(benchmark::kSecond)->UseRealTime()->MinTime(2.0);
 
 // Raw Embree: the same 640x360x16 camera rays, generated before timing, traced
 // with TerrainScene::intersect (rtcIntersect1 plus the hit record) over the same
