@@ -20,6 +20,7 @@ namespace {
 struct RenderOptions {
   std::string scene;
   int spp = 0;
+  double noise_target = -1.0;
   std::string size;
   std::vector<std::string> outputs;
   std::string terrain, snow_cover, snow_depth, snow_objects, ripples;
@@ -30,6 +31,7 @@ struct RenderOptions {
 void run_render(const RenderOptions& o, const CLI::App& sub) {
   SceneFile scene = read_scene_file(o.scene);
   if (o.spp > 0) scene.settings.samples_per_pixel = o.spp;
+  if (o.noise_target >= 0.0) scene.settings.noise_target = static_cast<float>(o.noise_target);
   if (!o.size.empty()) {
     std::smatch m;
     if (!std::regex_match(o.size, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
@@ -86,8 +88,9 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   const render::TerrainScene embree_scene(scene.input);
   const render::Camera camera =
       scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
+  render::RenderStats stats;
   render::Image image = render::render_image(embree_scene, scene.input, camera, scene.settings,
-                                             terminal_progress("render"));
+                                             terminal_progress("render"), &stats);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The display settings ride along so that `drift merge` can write the PNG.
@@ -97,8 +100,16 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       {"white_balance",
        scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
   for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
-  std::printf("rendered %dx%d at %d spp in %.1f s -> ", image.width, image.height,
-              scene.settings.samples_per_pixel, seconds);
+  if (scene.settings.noise_target > 0.0f) {
+    const double mean_spp =
+        static_cast<double>(stats.camera_rays) / (static_cast<double>(image.width) * image.height);
+    std::printf("rendered %dx%d at %.1f spp on average (noise target %g, at most %d) in %.1f s -> ",
+                image.width, image.height, mean_spp, scene.settings.noise_target,
+                scene.settings.samples_per_pixel, seconds);
+  } else {
+    std::printf("rendered %dx%d at %d spp in %.1f s -> ", image.width, image.height,
+                scene.settings.samples_per_pixel, seconds);
+  }
   for (const auto& f : scene.outputs) std::printf("%s ", f.c_str());
   std::printf("\n");
 }
@@ -116,6 +127,10 @@ void add_render_command(CLI::App& root) {
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
   sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, 1 << 20));
+  sub->add_option("--noise-target", o->noise_target,
+                  "adaptive sampling: stop a pixel when the relative standard error of its "
+                  "luminance is below this (e.g. 0.02; 0 turns it off; --spp is the most)")
+      ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--size", o->size, "image size WIDTHxHEIGHT (overrides the scene)");
   sub->add_option("-o,--output", o->outputs,
                   "output file(s), .png and/or .exr (override the scene)");

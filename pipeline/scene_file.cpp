@@ -194,6 +194,9 @@ SceneFile read_scene_file(const fs::path& path) {
   scene.settings.samples_per_pixel =
       rs.integer("spp", scene.settings.samples_per_pixel, 1, 1 << 20);
   scene.settings.max_depth = rs.integer("max_depth", scene.settings.max_depth, 1, 1024);
+  scene.settings.noise_target =
+      static_cast<float>(rs.number("noise_target", scene.settings.noise_target, 0.0, 1.0));
+  scene.settings.min_samples = rs.integer("min_spp", scene.settings.min_samples, 1, 1 << 20);
   scene.settings.seed = static_cast<std::uint64_t>(rs.integer("seed", 1, 0, 2147483647));
   rs.finish();
 

@@ -71,7 +71,12 @@ struct PlacedMesh {
 struct RenderSettings {
   int width = 960;
   int height = 540;
-  int samples_per_pixel = 64;
+  int samples_per_pixel = 64;  // the most a pixel takes
+  // Adaptive sampling: a pixel stops once the estimated relative standard
+  // error of its mean luminance is below noise_target (0: off, every pixel
+  // takes samples_per_pixel), after at least min_samples.
+  float noise_target = 0.0f;
+  int min_samples = 16;
   int max_depth = 4;  // path vertices after the camera; >= 1
   std::uint64_t seed = 1;
   // Render only rows [row_begin, row_end) of the frame (one tile of it); the

@@ -9,6 +9,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "render/brdf.h"
 #include "render/light_shafts.h"
@@ -70,6 +71,31 @@ struct PixelSample {
   float snow = 0.0f;
   float sky = 0.0f;  // 1 where the camera sees the sky
 };
+
+// Running mean and variance of a pixel's sample luminances (Welford 1962),
+// for adaptive sampling.
+struct PixelNoise {
+  int n = 0;
+  double mean = 0.0, m2 = 0.0;
+  void add(double v) {
+    ++n;
+    const double d = v - mean;
+    mean += d / n;
+    m2 += d * (v - mean);
+  }
+  // Standard error of the mean over the mean. Luminances below kDark (render
+  // units; black after the tone curve at exposure 0) are judged against kDark,
+  // so that dark pixels do not sample forever for an invisible relative error.
+  double relative_error() const {
+    constexpr double kDark = 0.01;
+    if (n < 2) return 1e30;
+    return std::sqrt(m2 / (n - 1) / n) / std::max(mean, kDark);
+  }
+};
+
+float luminance(const Vector3f& rgb) {  // Rec. 709 weights, linear sRGB
+  return 0.2126f * rgb.x() + 0.7152f * rgb.y() + 0.0722f * rgb.z();
+}
 
 }  // namespace
 
@@ -155,9 +181,11 @@ void CameraRays::ray(float x, float y, float u1, float u2, Vector3f& origin, Vec
 Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,
                    const RenderSettings& settings, const ProgressFn& progress, RenderStats* stats) {
   if (settings.width < 1 || settings.height < 1 || settings.samples_per_pixel < 1 ||
-      settings.max_depth < 1) {
-    throw Error("render size, samples per pixel and max depth must all be at least 1");
+      settings.max_depth < 1 || settings.min_samples < 1) {
+    throw Error(
+        "render size, samples per pixel, minimum samples and max depth must all be at least 1");
   }
+  if (!(settings.noise_target >= 0.0f)) throw Error("the noise target must be 0 (off) or more");
   const int row_begin = settings.row_begin;
   const int row_end = settings.row_end > 0 ? settings.row_end : settings.height;
   if (row_begin < 0 || row_begin >= row_end || row_end > settings.height) {
@@ -165,9 +193,11 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
                 ") are not inside the " + std::to_string(settings.height) + "-row frame");
   }
   const int band = row_end - row_begin;
-  Image image(settings.width, band,
-              {"R", "G", "B", "depth", "normal.X", "normal.Y", "normal.Z", "albedo.R", "albedo.G",
-               "albedo.B", "coverage.snow", "mask.sky"});
+  std::vector<std::string> channels = {
+      "R",        "G",        "B",        "depth",    "normal.X",      "normal.Y",
+      "normal.Z", "albedo.R", "albedo.G", "albedo.B", "coverage.snow", "mask.sky"};
+  if (settings.noise_target > 0.0f) channels.emplace_back("samples");
+  Image image(settings.width, band, channels);
 
   if (band != settings.height) image.frame = {0, row_begin, settings.width, settings.height};
 
@@ -293,43 +323,59 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const int tile_count = tiles_x * tiles_y;
   std::atomic<int> done{0};
   std::atomic<bool> cancelled{false};
-  std::atomic<std::uint64_t> total_rays{0};
+  std::atomic<std::uint64_t> total_rays{0}, total_samples{0};
   progress(0.0, "rendering");
-  const float inv_spp = 1.0f / static_cast<float>(settings.samples_per_pixel);
+  const bool adaptive = settings.noise_target > 0.0f;
   tbb::parallel_for(0, tile_count, [&](int tile) {
     if (cancelled.load(std::memory_order_relaxed)) return;
     const int x0 = (tile % tiles_x) * kTile, y0 = row_begin + (tile / tiles_x) * kTile;
-    std::uint64_t tile_rays = 0;
+    std::uint64_t tile_rays = 0, tile_samples = 0;
     for (int y = y0; y < std::min(y0 + kTile, row_end); ++y) {
       for (int x = x0; x < std::min(x0 + kTile, settings.width); ++x) {
         PixelSample sum;
+        PixelNoise noise;
         const std::uint64_t pixel = static_cast<std::uint64_t>(y) * settings.width + x;
-        for (int s = 0; s < settings.samples_per_pixel; ++s) {
-          SampleStream rng(settings.seed, pixel, static_cast<std::uint64_t>(s));
+        int taken = 0;
+        while (taken < settings.samples_per_pixel) {
+          SampleStream rng(settings.seed, pixel, static_cast<std::uint64_t>(taken));
           const PixelSample one = trace(x, y, rng, tile_rays);
+          ++taken;
           sum.radiance += one.radiance;
           sum.depth += one.depth;
           sum.normal += one.normal;
           sum.albedo += one.albedo;
           sum.snow += one.snow;
           sum.sky += one.sky;
+          if (adaptive) {
+            noise.add(luminance(one.radiance));
+            // Decide every 8 samples: the estimate needs a few to settle, and
+            // the decision only ever looks at this pixel's own samples, so
+            // the image stays the same for any thread count or tiling.
+            if (taken >= settings.min_samples && taken % 8 == 0 &&
+                noise.relative_error() < settings.noise_target)
+              break;
+          }
         }
-        const float values[12] = {
-            sum.radiance.x() * inv_spp, sum.radiance.y() * inv_spp, sum.radiance.z() * inv_spp,
-            sum.depth * inv_spp,        sum.normal.x() * inv_spp,   sum.normal.y() * inv_spp,
-            sum.normal.z() * inv_spp,   sum.albedo.x() * inv_spp,   sum.albedo.y() * inv_spp,
-            sum.albedo.z() * inv_spp,   sum.snow * inv_spp,         sum.sky * inv_spp};
-        for (int c = 0; c < 12; ++c) image.at(x, y - row_begin, c) = values[c];
+        tile_samples += static_cast<std::uint64_t>(taken);
+        const float inv = 1.0f / static_cast<float>(taken);
+        const float values[13] = {
+            sum.radiance.x() * inv,   sum.radiance.y() * inv, sum.radiance.z() * inv,
+            sum.depth * inv,          sum.normal.x() * inv,   sum.normal.y() * inv,
+            sum.normal.z() * inv,     sum.albedo.x() * inv,   sum.albedo.y() * inv,
+            sum.albedo.z() * inv,     sum.snow * inv,         sum.sky * inv,
+            static_cast<float>(taken)};
+        const int channels = adaptive ? 13 : 12;
+        for (int c = 0; c < channels; ++c) image.at(x, y - row_begin, c) = values[c];
       }
     }
-    total_rays += tile_rays;  // integer sums: the same whatever the order
+    total_rays += tile_rays;
+    total_samples += tile_samples;  // integer sums: the same whatever the order
     const int finished = ++done;
     if (!progress(static_cast<double>(finished) / tile_count, "")) cancelled = true;
   });
   if (cancelled) throw Cancelled();
   if (stats) {
-    stats->camera_rays = static_cast<std::uint64_t>(settings.width) * band *
-                         static_cast<std::uint64_t>(settings.samples_per_pixel);
+    stats->camera_rays = total_samples;
     stats->rays = total_rays;
   }
   return image;

@@ -51,6 +51,7 @@ TEST(SceneFile, ReadsEveryKey) {
                                    "[sky]\nlight_shafts = true\nshaft_steps = 24\n"
                                    "[camera]\nfrom = [1, 2, 3]\nto = [4, 5, 6]\nfov = 30\n"
                                    "[render]\nwidth = 320\nheight = 200\nspp = 7\nseed = 9\n"
+                                   "noise_target = 0.02\nmin_spp = 4\n"
                                    "[output]\nfiles = [\"a.png\", \"a.exr\"]\nexposure = -1\n");
   const auto s = drift::pipeline::read_scene_file(p);
   EXPECT_EQ(s.terrain_raster, p.parent_path() / "dem.tif");
@@ -63,6 +64,8 @@ TEST(SceneFile, ReadsEveryKey) {
   EXPECT_EQ(s.settings.width, 320);
   EXPECT_EQ(s.settings.samples_per_pixel, 7);
   EXPECT_EQ(s.settings.seed, 9u);
+  EXPECT_FLOAT_EQ(s.settings.noise_target, 0.02f);
+  EXPECT_EQ(s.settings.min_samples, 4);
   EXPECT_EQ(s.outputs.size(), 2u);
   EXPECT_DOUBLE_EQ(s.display.exposure_ev, -1.0);
 }

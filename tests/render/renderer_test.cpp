@@ -228,3 +228,73 @@ TEST(Renderer, SkyMaskAndSnowCoverageAovs) {
   EXPECT_FLOAT_EQ(img.at(8, 15, snow), 0.25f);
   EXPECT_FLOAT_EQ(img.at(8, 0, snow), 0.0f);
 }
+
+namespace {
+
+// Adaptive sampling on a uniform scene: flat ground seen straight down under
+// the physical sky, so every pixel has the same mean and the spread across
+// pixels measures each pixel's noise.
+struct AdaptiveRun {
+  Image image;
+  double mean_samples = 0, relative_spread = 0;
+};
+
+AdaptiveRun render_adaptive(float noise_target, int threads = 2) {
+  SceneInput in;
+  in.terrain = make_dem(64, 10.0, [](double, double) { return 100.0; });
+  in.surface.ground.albedo = {0.4f, 0.4f, 0.4f};
+  in.sun.elevation_deg = 40.0;
+  in.sun.angular_diameter_deg = 5.0;  // soft: some sun samples miss the cone's visible part
+  const TerrainScene scene(in);
+  RenderSettings rs;
+  rs.width = rs.height = 24;
+  rs.samples_per_pixel = 512;
+  rs.noise_target = noise_target;
+  AdaptiveRun run;
+  tbb::task_arena arena(threads);
+  arena.execute([&] { run.image = render_image(scene, in, looking_down(scene, 50.0), rs); });
+  const int samples = run.image.channel_index("samples");
+  double sum = 0, sum2 = 0, n = 0;
+  for (int y = 0; y < run.image.height; ++y)
+    for (int x = 0; x < run.image.width; ++x) {
+      const double l = run.image.at(x, y, 1);  // green: most of the luminance
+      sum += l;
+      sum2 += l * l;
+      run.mean_samples += samples >= 0 ? run.image.at(x, y, samples) : rs.samples_per_pixel;
+      ++n;
+    }
+  const double mean = sum / n;
+  run.relative_spread = std::sqrt(std::max(0.0, sum2 / n - mean * mean)) / mean;
+  run.mean_samples /= n;
+  return run;
+}
+
+}  // namespace
+
+TEST(AdaptiveSampling, StopsAtTheNoiseTarget) {
+  // Each pixel stops when its own estimate of the relative standard error is
+  // below the target: the pixels' spread around their common mean is then
+  // about the target (early stopping biases it a little upwards), and a
+  // tighter target takes more samples.
+  const AdaptiveRun loose = render_adaptive(0.01f), tight = render_adaptive(0.004f);
+  EXPECT_LT(loose.relative_spread, 1.5 * 0.01);
+  EXPECT_LT(tight.relative_spread, 1.5 * 0.004);
+  EXPECT_GT(loose.mean_samples, 16.0) << "the target, not the minimum, must stop the pixels";
+  EXPECT_LT(loose.mean_samples, 512.0);
+  EXPECT_GT(tight.mean_samples, 2.0 * loose.mean_samples);
+  // Whatever the target, every pixel takes at least min_samples, in whole
+  // batches of 8 until the cap.
+  const int samples = loose.image.channel_index("samples");
+  ASSERT_GE(samples, 0);
+  for (float s : {loose.image.at(0, 0, samples), loose.image.at(5, 7, samples)}) {
+    EXPECT_GE(s, 16.0f);
+    EXPECT_EQ(static_cast<int>(s) % 8, 0);
+  }
+}
+
+TEST(AdaptiveSampling, SameBitsForAnyThreadCountAndOffByDefault) {
+  EXPECT_EQ(render_adaptive(0.02f, 1).image.pixels, render_adaptive(0.02f, 2).image.pixels);
+  const AdaptiveRun off = render_adaptive(0.0f);
+  EXPECT_LT(off.image.channel_index("samples"), 0)
+      << "no samples channel without adaptive sampling";
+}
