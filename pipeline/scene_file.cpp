@@ -8,6 +8,7 @@
 
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
+#include "render/atmosphere.h"
 #include "render/solar_position.h"
 #include "render/surface.h"
 #include "terrain/error.h"
@@ -126,7 +127,8 @@ SceneFile read_scene_file(const fs::path& path) {
     }
   }
 
-  Section sky(subtable(root, "sky", path), "sky", path);
+  const toml::table* sky_table = subtable(root, "sky", path);
+  Section sky(sky_table, "sky", path);
   if (const auto model = sky.string("model")) {
     if (*model == "physical") {
       in.sky.model = render::SkyModel::Physical;
@@ -137,7 +139,17 @@ SceneFile read_scene_file(const fs::path& path) {
                   "'; use \"physical\" (an Earth atmosphere) or \"simple\" (a gradient)");
     }
   }
-  in.sky.haze = static_cast<float>(sky.number("haze", in.sky.haze, 0.0, 50.0));
+  in.sky.haze = static_cast<float>(sky.number("haze", in.sky.haze, 0.0, 1000.0));
+  if (sky_table && sky_table->contains("visibility")) {
+    if (sky_table->contains("haze"))
+      throw Error(path.string() + ": give [sky] haze or visibility, not both");
+    const double km = sky.number("visibility", 0.0, 1.0, 1000.0);
+    try {
+      in.sky.haze = static_cast<float>(render::Atmosphere::aerosol_scale_for_visibility(km));
+    } catch (const Error& e) {
+      throw Error(path.string() + ": 'sky.visibility': " + e.what());
+    }
+  }
   in.sky.zenith = sky.color("zenith", in.sky.zenith);
   in.sky.horizon = sky.color("horizon", in.sky.horizon);
   in.sky.intensity = static_cast<float>(sky.number("intensity", in.sky.intensity, 0.0, 1e6));

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+
+#include "terrain/error.h"
 
 namespace drift::render {
 
@@ -120,6 +123,17 @@ float mie_phase(float c, float g) {
 }
 
 double Atmosphere::wavelength_nm(int band) { return 360.0 + 30.0 * band; }
+
+double Atmosphere::aerosol_scale_for_visibility(double km) {
+  const double extinction = 3.912 / (km * 1000.0);  // Koschmieder 1924
+  const double rayleigh = rayleigh_coefficient(550.0);
+  if (!(km > 0.0) || !(extinction > rayleigh)) {
+    throw Error("a visibility of " + std::to_string(km) +
+                " km is clearer than air without aerosols allows (at most " +
+                std::to_string(3.912 / rayleigh / 1000.0) + " km); give a shorter one");
+  }
+  return (extinction - rayleigh) / kMieExtinction;
+}
 
 double Atmosphere::rayleigh_coefficient(double nm) {
   const double um = nm * 1e-3;

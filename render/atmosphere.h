@@ -38,6 +38,11 @@ class Atmosphere {
 
   // Rayleigh scattering at sea level (per metre) at any wavelength.
   static double rayleigh_coefficient(double nm);
+  // The aerosol_scale that gives a meteorological visibility of `km` at sea
+  // level: Koschmieder's law, extinction at 550 nm = 3.912 / V (a black
+  // object at distance V keeps 2 % contrast). Throws drift::Error when V is
+  // clearer than air without aerosols allows (about 288 km).
+  static double aerosol_scale_for_visibility(double km);
   // Optical depth at one wavelength from an altitude along cosine-zenith mu to
   // the top of the atmosphere (infinite if the ray meets the ground).
   double optical_depth_to_space(double nm, double altitude, double mu) const;

@@ -96,6 +96,10 @@ TEST(SceneFile, OutOfRangeValuesAreErrors) {
             std::string::npos);
   EXPECT_NE(error_of(std::string(kTerrain) + "[sky]\nshaft_steps = 0\n").find("sky.shaft_steps"),
             std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[sky]\nvisibility = 500\n").find("sky.visibility"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kTerrain) + "[sky]\nvisibility = 20\nhaze = 2\n").find("not both"),
+            std::string::npos);
   EXPECT_NE(
       error_of(std::string(kTerrain) + "[camera]\nfrom = [0, 0, 1]\nto = [0, 1, 1]\nfov = 180\n")
           .find("camera.fov"),

@@ -10,6 +10,7 @@
 
 #include "render/physical_sky.h"
 #include "render/tonemap.h"
+#include "terrain/error.h"
 
 using namespace drift::render;
 
@@ -136,4 +137,30 @@ TEST(Atmosphere, DaylightWhiteBalanceIsTheLevelLightOfTheSunSixtyDegreesUp) {
   // is turned down, blue up.
   EXPECT_LT(kDaylightWhiteBalance[0], 1.0f);
   EXPECT_GT(kDaylightWhiteBalance[2], 1.0f);
+}
+
+TEST(Atmosphere, VisibilityFollowsKoschmieder) {
+  // Koschmieder: at the meteorological visibility V a black object keeps
+  // exp(-3.912) = 2 % contrast: sea-level extinction at 550 nm (log-linear
+  // between the 540 and 570 nm bands) is 3.912 / V, for a hazy 10 km and a
+  // clear 60 km day.
+  for (double km : {10.0, 60.0}) {
+    AtmosphereParameters p;
+    p.aerosol_scale = Atmosphere::aerosol_scale_for_visibility(km);
+    const Atmosphere hazy(p);
+    const Spectrum e = hazy.extinction(0.0);
+    ASSERT_DOUBLE_EQ(Atmosphere::wavelength_nm(6), 540.0);
+    const double at_550 = std::exp(std::log(e[6]) + (std::log(e[7]) - std::log(e[6])) / 3.0);
+    EXPECT_NEAR(at_550 * km * 1000.0, 3.912, 0.01 * 3.912) << km << " km";
+  }
+  // And along a real 10 km line of sight at sea level (Earth's curvature
+  // lifts its end by 8 m only): 2 % transmittance either side of 550 nm.
+  AtmosphereParameters p;
+  p.aerosol_scale = Atmosphere::aerosol_scale_for_visibility(10.0);
+  const Atmosphere hazy(p);
+  Spectrum t{};
+  hazy.in_scattering(0.0, Eigen::Vector3d(1, 0, 0), 10000.0, from_az_el(0, 30), 256, &t);
+  EXPECT_NEAR(t[6], 0.02, 0.002);
+  EXPECT_NEAR(t[7], 0.02, 0.002);
+  EXPECT_THROW(Atmosphere::aerosol_scale_for_visibility(400.0), drift::Error);
 }
