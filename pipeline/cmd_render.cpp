@@ -20,7 +20,7 @@ namespace {
 struct RenderOptions {
   std::string scene;
   int spp = 0;
-  double noise_target = -1.0;
+  double noise_target = -1.0;  // < 0: the scene's
   std::string size;
   std::vector<std::string> outputs;
   std::string terrain, snow_cover, snow_depth, snow_objects, ripples;

@@ -3,12 +3,14 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <set>
 
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
 #include "render/atmosphere.h"
+#include "render/material.h"
 #include "render/solar_position.h"
 #include "render/surface.h"
 #include "terrain/error.h"
@@ -29,6 +31,79 @@ const toml::table* subtable(const toml::table& root, const char* name, const fs:
     throw Error(file.string() + ": '" + name + "' must be a table ([" + name + "])");
   }
   return node->as_table();
+}
+
+// The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
+// `material` names a preset (which sets every field), and `color`,
+// `roughness` and `wetness` set (or override) one field each.
+render::MaterialOverride read_material(Section& s) {
+  render::MaterialOverride m;
+  if (const auto name = s.string("material")) {
+    const auto preset = render::material_preset(*name);
+    if (!preset) {
+      s.invalid("material",
+                "is '" + *name + "'; known materials: " + render::material_preset_names());
+    }
+    m = render::full_override(*preset);
+  }
+  const Eigen::Vector3f none = Eigen::Vector3f::Constant(-1.0f);
+  if (const Eigen::Vector3f c = s.color("color", none); c != none) m.albedo = c;
+  if (const double r = s.number("roughness", -1.0, 0.0, 1.5); r >= 0.0)
+    m.roughness = static_cast<float>(r);
+  if (const double w = s.number("wetness", -1.0, 0.0, 1.0); w >= 0.0)
+    m.wetness = static_cast<float>(w);
+  return m;
+}
+
+// One side of a rule: `<name>_min`, `<name>_max` (open when absent) and the
+// width of the soft band at each edge, `<name>_blend`.
+render::SoftRange read_range(Section& s, const std::string& name, double lo, double hi,
+                             double blend) {
+  render::SoftRange r;
+  const std::string min_key = name + "_min", max_key = name + "_max", blend_key = name + "_blend";
+  const double inf = std::numeric_limits<double>::infinity();
+  const double a = s.number(min_key.c_str(), -inf, lo, hi);
+  const double b = s.number(max_key.c_str(), inf, lo, hi);
+  if (!(a < b)) s.invalid(max_key.c_str(), "must be above '" + min_key + "'");
+  r.lo = static_cast<float>(a);
+  r.hi = static_cast<float>(b);
+  r.band = static_cast<float>(s.number(blend_key.c_str(), blend, 0.0, hi - lo));
+  return r;
+}
+
+// [[terrain.rule]]: a material by altitude and slope (docs/rendering.md).
+render::MaterialRule read_rule(const toml::table* table, const fs::path& file) {
+  Section s(table, "terrain.rule", file);
+  render::MaterialRule rule;
+  rule.material = read_material(s);
+  rule.altitude = read_range(s, "altitude", -1e4, 1e5, 100.0);
+  rule.slope = read_range(s, "slope", 0.0, 90.0, 5.0);
+  rule.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
+  s.finish();
+  if (rule.material.empty()) {
+    s.invalid_table("sets no material: give 'material' (" + render::material_preset_names() +
+                    ") or 'color', 'roughness' or 'wetness'");
+  }
+  return rule;
+}
+
+// [[terrain.layer]]: a material placed by a mask raster; the mask is read by
+// load_scene_terrain.
+render::MaterialLayer read_layer(const toml::table* table, const fs::path& file, fs::path& mask) {
+  Section s(table, "terrain.layer", file);
+  render::MaterialLayer layer;
+  const auto mask_file = s.string("mask");
+  layer.material = read_material(s);
+  layer.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
+  s.finish();
+  if (!mask_file) s.invalid_table("needs 'mask' (a raster in [0, 1] in the DEM's CRS)");
+  if (layer.material.empty()) {
+    s.invalid_table("sets no material: give 'material' (" + render::material_preset_names() +
+                    ") or 'color', 'roughness' or 'wetness'");
+  }
+  mask =
+      fs::path(*mask_file).is_absolute() ? fs::path(*mask_file) : file.parent_path() / *mask_file;
+  return layer;
 }
 
 }  // namespace
@@ -65,9 +140,12 @@ SceneFile read_scene_file(const fs::path& path) {
   if (scene.terrain_repeat % 2 == 0) {
     throw Error(path.string() + ": 'terrain.repeat' must be odd (the raster stays in the middle)");
   }
-  in.surface.ground.albedo = terrain.color("color", in.surface.ground.albedo);
-  in.surface.ground.roughness =
-      static_cast<float>(terrain.number("roughness", in.surface.ground.roughness, 0.0, 1.5));
+  in.surface.ground = render::blend(in.surface.ground, read_material(terrain), 1.0f);
+  for (const toml::table* rule : terrain.tables("rule"))
+    in.surface.rules.push_back(read_rule(rule, path));
+  for (const toml::table* layer : terrain.tables("layer")) {
+    in.surface.layers.push_back(read_layer(layer, path, scene.layer_masks.emplace_back()));
+  }
   terrain.finish();
 
   Section snow(subtable(root, "snow", path), "snow", path);
@@ -210,6 +288,7 @@ SceneFile read_scene_file(const fs::path& path) {
       static_cast<float>(rs.number("noise_target", scene.settings.noise_target, 0.0, 1.0));
   scene.settings.min_samples = rs.integer("min_spp", scene.settings.min_samples, 1, 1 << 20);
   scene.settings.seed = static_cast<std::uint64_t>(rs.integer("seed", 1, 0, 2147483647));
+  scene.settings.sample_sky = rs.boolean("sample_sky", scene.settings.sample_sky);
   rs.finish();
 
   Section out(subtable(root, "output", path), "output", path);
@@ -321,6 +400,8 @@ void load_scene_terrain(SceneFile& scene) {
     surface.albedo_map = render::read_albedo_map(scene.albedo_map);
     require_metric_crs(surface.albedo_map->front(), scene.albedo_map);
   }
+  for (std::size_t i = 0; i < scene.layer_masks.size(); ++i)
+    surface.layers[i].mask = read_metric_raster(scene.layer_masks[i]);
   if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);
   if (!scene.snow_depth.empty()) surface.snow_depth = read_metric_raster(scene.snow_depth);
   if (!scene.ripples.empty() && surface.ripples) {

@@ -26,6 +26,8 @@ struct SceneFile {
   // Layer rasters ([snow] cover and depth, [ripples] raster), resolved likewise;
   // empty when the scene has none.
   std::filesystem::path snow_cover, snow_depth, ripples, albedo_map;
+  // The masks of input.surface.layers, in order (read by load_scene_terrain).
+  std::vector<std::filesystem::path> layer_masks;
   // [snow] objects: the scene's objects as drift snow fall left them (a PLY
   // with per-vertex "object" and "snow_coverage"), replacing their meshes.
   std::filesystem::path snow_objects;

@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -112,6 +113,35 @@ class Section {
   Eigen::Vector3f color(const char* key, const Eigen::Vector3f& fallback) {
     auto v = vector<3>(key, 0.0, 1.0);
     return v ? v->cast<float>() : fallback;
+  }
+
+  // An array of tables ([[name.key]] entries), empty if absent.
+  std::vector<const toml::table*> tables(const char* key) {
+    const toml::node* node = take(key);
+    if (!node) return {};
+    const toml::array* a = node->as_array();
+    std::vector<const toml::table*> out;
+    if (a) {
+      for (const toml::node& e : *a) out.push_back(e.as_table());
+    }
+    if (!a || std::find(out.begin(), out.end(), nullptr) != out.end()) {
+      fail(key, *node, "must be an array of tables ([[" + name_ + "." + key + "]])");
+    }
+    return out;
+  }
+
+  // Reports a bad value of `key` (read before) with the file and line.
+  [[noreturn]] void invalid(const char* key, const std::string& what) const {
+    const toml::node* node = table_ ? table_->get(key) : nullptr;
+    if (node) fail(key, *node, what);
+    throw Error(file_.string() + ": '" + name_ + "." + key + "' " + what);
+  }
+  // Reports a problem with the table as a whole.
+  [[noreturn]] void invalid_table(const std::string& what) const {
+    std::string s = file_.string();
+    if (table_ && table_->source().begin.line > 0)
+      s += ":" + std::to_string(table_->source().begin.line);
+    throw Error(s + ": [" + name_ + "] " + what);
   }
 
   // Call last: any key not taken is unknown.

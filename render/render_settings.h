@@ -79,6 +79,10 @@ struct RenderSettings {
   int min_samples = 16;
   int max_depth = 4;  // path vertices after the camera; >= 1
   std::uint64_t seed = 1;
+  // Next-event estimation of the sky (importance-sampled, combined with the
+  // BSDF's bounces by multiple importance sampling); false: the sky is only
+  // found by bounces (brute force, for tests and comparisons).
+  bool sample_sky = true;
   // Render only rows [row_begin, row_end) of the frame (one tile of it); the
   // pixels are the same bits as in a whole-frame render. row_end 0: to the end.
   int row_begin = 0;

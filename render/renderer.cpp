@@ -6,15 +6,20 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "render/brdf.h"
+#include "render/bsdf.h"
 #include "render/light_shafts.h"
 #include "render/physical_sky.h"
 #include "render/random.h"
+#include "render/sampling.h"
+#include "render/sky_sampler.h"
 #include "terrain/error.h"
 
 namespace drift::render {
@@ -32,36 +37,9 @@ Vector3f direction_from_az_el(double azimuth_deg, double elevation_deg) {
                   static_cast<float>(std::sin(el)));
 }
 
-// An orthonormal basis around unit n (Duff et al. 2017, "Building an
-// orthonormal basis, revisited").
-void basis(const Vector3f& n, Vector3f& t, Vector3f& b) {
-  const float sign = std::copysign(1.0f, n.z());
-  const float a = -1.0f / (sign + n.z());
-  const float c = n.x() * n.y() * a;
-  t = Vector3f(1.0f + sign * n.x() * n.x() * a, sign * c, -sign * n.x());
-  b = Vector3f(c, sign + n.y() * n.y() * a, -n.y());
-}
-
-Vector3f cosine_sample(const Vector3f& n, float u1, float u2) {
-  const float r = std::sqrt(u1), phi = 2.0f * kPi * u2;
-  Vector3f t, b;
-  basis(n, t, b);
-  return (t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
-          n * std::sqrt(std::max(0.0f, 1.0f - u1)))
-      .normalized();
-}
-
-// Uniform direction in the cone of half-angle with cosine `cos_max` around `axis`.
-Vector3f cone_sample(const Vector3f& axis, float cos_max, float u1, float u2) {
-  const float cos_t = 1.0f - u1 * (1.0f - cos_max);
-  const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
-  const float phi = 2.0f * kPi * u2;
-  Vector3f t, b;
-  basis(axis, t, b);
-  return (t * (sin_t * std::cos(phi)) + b * (sin_t * std::sin(phi)) + axis * cos_t).normalized();
-}
-
 float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCoeff()); }
+
+float luminance(const Vector3f& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
 struct PixelSample {
   Vector3f radiance{0, 0, 0};
@@ -92,10 +70,6 @@ struct PixelNoise {
     return std::sqrt(m2 / (n - 1) / n) / std::max(mean, kDark);
   }
 };
-
-float luminance(const Vector3f& rgb) {  // Rec. 709 weights, linear sRGB
-  return 0.2126f * rgb.x() + 0.7152f * rgb.y() + 0.0722f * rgb.z();
-}
 
 }  // namespace
 
@@ -237,6 +211,10 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
     return shaft_shadow_loss(*air, base_altitude, {origin, dir, distance}, shadow_slab,
                              input.sky.shaft_steps, jitter, in_shadow);
   };
+  // The sky as a light, tabulated once for this camera and sun and
+  // importance-sampled at every vertex (render/sky_sampler.h).
+  std::optional<SkySampler> sky_sampler;
+  if (settings.sample_sky) sky_sampler.emplace(sky_light);
 
   auto trace = [&](int px, int py, SampleStream& rng, std::uint64_t& rays) {
     PixelSample out;
@@ -250,17 +228,26 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
     Vector3f throughput(1, 1, 1);
     // Camera rays start as wide as a pixel's angle; see RayCone.
     RayCone cone{0.0f, 2.0f * camera_rays.tan_half / static_cast<float>(settings.height)};
-    for (int depth = 0; depth < settings.max_depth; ++depth) {
+    float bounce_pdf = 0.0f;  // density of the BSDF sample that led here
+    // Vertices 0 .. max_depth - 1 are shaded; the ray leaving the last one is
+    // traced too, only to see whether it escapes to the sky, so that both
+    // strategies of the last vertex's sky light are there (PBRT's loop).
+    for (int depth = 0;; ++depth) {
       Hit hit;
       ++rays;
       if (!scene.intersect(origin, dir, hit, cone)) {
         if (depth == 0) out.sky = 1.0f;
+        // An escaping bounce is the BSDF strategy's sample of the sky,
+        // weighted against the sky's own (camera rays see it as it is, less
+        // the terrain's shadow on the air with light shafts).
         Vector3f light = sky_light(dir);
         if (depth == 0 && shafts) {
           light -= shaft_loss(origin, dir, air_reach, shaft_jitter, rays);
           light = light.cwiseMax(0.0f);
         }
-        out.radiance += throughput.cwiseProduct(light);
+        const float w =
+            depth > 0 && sky_sampler ? power_heuristic(bounce_pdf, sky_sampler->pdf(dir)) : 1.0f;
+        out.radiance += throughput.cwiseProduct(light) * w;
         break;
       }
       if (air) {
@@ -278,6 +265,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         out.radiance += throughput.cwiseProduct(inscatter);
         throughput = throughput.cwiseProduct(seg.transmittance);
       }
+      if (depth == settings.max_depth) break;
       if (depth == 0) {
         out.depth = hit.distance;
         out.normal = hit.normal;
@@ -286,9 +274,9 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
       }
       const Vector3f wo = -dir;
       const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
-      const Vector3f brdf = hit.albedo / kPi;  // Lambert
+      const GroundBsdf bsdf(hit.normal, wo, {hit.albedo, hit.roughness, hit.wetness});
       // Next-event estimation of the sun: uniform in its cone, pdf 1/solid angle,
-      // radiance E/solid angle, so the estimate is E * cos * brdf.
+      // radiance E/solid angle, so the estimate is E * cos * f.
       const float u1 = rng.next(), u2 = rng.next();
       if (sun_up) {
         const Vector3f l = cone_sample(sun_dir, sun_cos_max, u1, u2);
@@ -296,16 +284,33 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         if (cos_l > 0.0f && l.z() > -0.2f && (++rays, !scene.occluded(p, l, 1e30f))) {
           const Vector3f e =
               air ? air->sun_irradiance(base_altitude + hit.position.z()) : sun_irradiance;
-          out.radiance += throughput.cwiseProduct(brdf).cwiseProduct(e) *
-                          (cos_l * oren_nayar_factor(hit.normal, l, wo, hit.roughness));
+          out.radiance += throughput.cwiseProduct(bsdf.eval(l)).cwiseProduct(e) * cos_l;
         }
       }
-      // Bounce: cosine-weighted, so the weight is the albedo (times the
-      // Oren-Nayar factor for rough surfaces).
-      dir = cosine_sample(hit.normal, rng.next(), rng.next());
+      // Next-event estimation of the sky, weighted against the BSDF's sample
+      // of the same direction by the power heuristic (Veach 1997, eq. 9.13).
+      const float s1 = rng.next(), s2 = rng.next();
+      SkySampler::Sample light;
+      if (sky_sampler && sky_sampler->sample(s1, s2, light)) {
+        const float cos_l = hit.normal.dot(light.dir);
+        const Vector3f f = cos_l > 0.0f ? bsdf.eval(light.dir) : Vector3f::Zero();
+        if (f.maxCoeff() > 0.0f && (++rays, !scene.occluded(p, light.dir, 1e30f))) {
+          const float w = power_heuristic(light.pdf, bsdf.pdf(light.dir));
+          out.radiance += throughput.cwiseProduct(f).cwiseProduct(sky_light(light.dir)) *
+                          (cos_l * w / light.pdf);
+        }
+      }
+      // Bounce by the BSDF: cosine-weighted on dry ground (weight: the albedo
+      // times the Oren-Nayar factor), the wet coat's lobe by its probability.
+      // Dry ground draws no lobe number.
+      const float u_lobe = bsdf.specular_probability() > 0.0f ? rng.next() : 0.0f;
+      const float b1 = rng.next(), b2 = rng.next();
+      GroundBsdf::Sample bounce;
+      if (!bsdf.sample(u_lobe, b1, b2, bounce)) break;
+      bounce_pdf = bounce.pdf;
+      dir = bounce.wi;
       origin = p;
-      throughput = throughput.cwiseProduct(hit.albedo) *
-                   oren_nayar_factor(hit.normal, dir, wo, hit.roughness);
+      throughput = throughput.cwiseProduct(bounce.weight);
       // A diffuse bounce spreads the footprint over about a radian.
       cone = {cone.width + cone.spread * hit.distance, 1.0f};
       if (depth >= 2) {  // Russian roulette (unbiased)

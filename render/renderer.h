@@ -1,7 +1,10 @@
-// The path tracer: unidirectional, with next-event estimation of the sun,
-// cosine-weighted bounces that gather the sky, Lambertian surfaces and Russian
-// roulette. Pixels are independent and their random numbers counter-based, so
-// the image is the same bits for any thread count and tile order.
+// The path tracer: unidirectional, with next-event estimation of the sun and
+// of the importance-sampled sky (render/sky_sampler.h), BSDF-sampled bounces
+// (render/bsdf.h: rough diffuse ground with a wet coat) whose escapes to the
+// sky are weighed against the sky's samples by multiple importance sampling,
+// and Russian roulette. Pixels are independent and their random numbers
+// counter-based, so the image is the same bits for any thread count and tile
+// order.
 #pragma once
 
 #include <cstdint>
@@ -42,14 +45,15 @@ Eigen::Vector3f sky_radiance(const Sky& sky, const Eigen::Vector3f& dir);
 
 // Counts of the work a render did (for benchmarks and logs).
 struct RenderStats {
-  std::uint64_t camera_rays = 0;
-  std::uint64_t rays = 0;  // all intersection and shadow rays
+  std::uint64_t camera_rays = 0;  // the samples taken (fewer than spp x pixels if adaptive)
+  std::uint64_t rays = 0;         // all intersection and shadow rays
 };
 
 // Renders channels R, G, B (linear radiance) and AOVs "depth" (metres along
 // the camera ray to the first hit, 0 for sky), "normal.X/Y/Z" and
 // "albedo.R/G/B" and "coverage.snow" of the first hit, and "mask.sky"
-// (the share of the pixel's camera rays that see the sky). `camera` is in the raster's CRS.
+// (the share of the pixel's camera rays that see the sky); with a noise
+// target also "samples" (the samples the pixel took). `camera` is in the raster's CRS.
 Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,
                    const RenderSettings& settings, const ProgressFn& progress = no_progress,
                    RenderStats* stats = nullptr);

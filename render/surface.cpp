@@ -59,21 +59,8 @@ terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
   return out;
 }
 
-namespace {
-
-Material mix(const Material& a, const Material& b, float t) {
-  return {a.albedo * (1 - t) + b.albedo * t, a.roughness * (1 - t) + b.roughness * t};
-}
-
-float smoothstep(float e0, float e1, float x) {
-  const float t = std::clamp((x - e0) / std::max(e1 - e0, 1e-6f), 0.0f, 1.0f);
-  return t * t * (3 - 2 * t);
-}
-
-}  // namespace
-
 SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
-                           const Eigen::Vector3f& normal, double footprint) {
+                           const Eigen::Vector3f& normal, double footprint, const Relief& relief) {
   SurfacePoint p;
   p.normal = normal;
   p.snow = surface.snow_cover
@@ -89,6 +76,11 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
               .cwiseMax(0.0f)
               .cwiseMin(1.0f);
     }
+  }
+  ground = apply_rules(ground, surface.rules, relief.altitude, relief.slope_deg);
+  for (const MaterialLayer& layer : surface.layers) {
+    const float w = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f) * layer.opacity;
+    if (w > 0.0f) ground = blend(ground, layer.material, w);
   }
   p.material = mix(ground, surface.snow, p.snow);
 

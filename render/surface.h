@@ -9,16 +9,21 @@
 #include <array>
 #include <filesystem>
 #include <optional>
+#include <vector>
 
+#include "render/material.h"
 #include "render/normal_map.h"
 #include "terrain/grid.h"
 
 namespace drift::render {
 
-// A rough diffuse material (Oren & Nayar 1994, qualitative model).
-struct Material {
-  Eigen::Vector3f albedo{0.28f, 0.26f, 0.23f};
-  float roughness = 0.0f;  // sigma of the facet slopes, radians; 0 is Lambert
+// A material placed by a raster in the DEM's CRS: the mask's value in [0, 1]
+// (clamped; outside the raster and nodata 0) times `opacity` blends the fields
+// `material` sets over what lies beneath.
+struct MaterialLayer {
+  MaterialOverride material;
+  terrain::HeightField mask;
+  float opacity = 1.0f;
 };
 
 // Wind ripples as bump mapping on the ground (paper 002, section 5).
@@ -30,9 +35,15 @@ struct RippleLayer {
   float fade_end_deg = 31.0f;    // slopes: they do not survive on slip faces
 };
 
+// The ground's material, bottom to top: `ground` (its albedo from
+// `albedo_map` where that covers the point), then `rules` by altitude and
+// slope, then `layers` by their masks, each over what lies beneath in order,
+// then snow by its cover.
 struct TerrainSurface {
   Material ground;
-  Material snow{{0.90f, 0.92f, 0.95f}, 0.1f};
+  std::vector<MaterialRule> rules;
+  std::vector<MaterialLayer> layers;
+  Material snow{{0.90f, 0.92f, 0.95f}, 0.1f};      // the "snow" preset
   std::optional<terrain::HeightField> snow_cover;  // [0, 1]: snow's share of the surface
   std::optional<terrain::HeightField> snow_depth;  // metres, raises the surface
   std::optional<RippleLayer> ripples;
@@ -63,9 +74,18 @@ float sample_raster(const terrain::HeightField& raster, double x, double y, floa
 terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
                                     const terrain::HeightField& depth);
 
+// Where a terrain point lies, for material rules: its altitude in metres
+// (without vertical exaggeration) and the slope of the unbumped terrain in
+// degrees (likewise).
+struct Relief {
+  float altitude = 0.0f;
+  float slope_deg = 0.0f;
+};
+
 // Evaluates the layers at CRS point (x, y) with the smooth terrain normal
 // `normal` (unit, z up) and a ray footprint `footprint` metres wide.
 SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
-                           const Eigen::Vector3f& normal, double footprint);
+                           const Eigen::Vector3f& normal, double footprint,
+                           const Relief& relief = {});
 
 }  // namespace drift::render

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "terrain/derivatives.h"
@@ -77,6 +78,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   }
   if (!std::isfinite(lo)) throw Error("the terrain raster holds no valid height (all nodata)");
   const float k = static_cast<float>(input.vertical_exaggeration);
+  exaggeration_ = k;
   heights_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     heights_[i] = (std::isnan(dem.values()[i]) ? lo : dem.values()[i]) * k;
@@ -228,11 +230,18 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
          tr * ((1 - tx) * vn(x0, r0 + 1) + tx * vn(x0 + 1, r0 + 1)))
             .normalized();
     const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
-    const SurfacePoint surface =
-        shade_terrain(surface_, world.x(), world.y(), n, cone.width + cone.spread * hit.distance);
+    // Material rules see the real relief: heights and slopes without the
+    // vertical exaggeration (n ~ (-k Zx, -k Zy, 1)).
+    Relief relief;
+    relief.altitude = static_cast<float>(world.z() / exaggeration_);
+    relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
+                       static_cast<float>(180.0 / std::numbers::pi);
+    const SurfacePoint surface = shade_terrain(surface_, world.x(), world.y(), n,
+                                               cone.width + cone.spread * hit.distance, relief);
     n = surface.normal;
     hit.albedo = surface.material.albedo;
     hit.roughness = surface.material.roughness;
+    hit.wetness = surface.material.wetness;
     hit.snow = surface.snow;
   } else {
     n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();

@@ -22,6 +22,7 @@ struct Hit {
   Eigen::Vector3f normal{0, 0, 1};    // unit shading normal, facing the ray
   Eigen::Vector3f albedo{0, 0, 0};
   float roughness = 0.0f;  // Oren-Nayar sigma, radians
+  float wetness = 0.0f;    // share under a water film, [0, 1] (render/bsdf.h)
   float snow = 0.0f;       // snow coverage of the surface, [0, 1]
 };
 
@@ -70,6 +71,7 @@ class TerrainScene {
   std::unique_ptr<Embree> embree_;
   int width_ = 0, height_ = 0;
   float dx_ = 1.0f, dy_ = 1.0f;
+  float exaggeration_ = 1.0f;
   Eigen::Vector3d origin_{0, 0, 0};
   std::vector<float> heights_;             // filled, exaggerated, row 0 = north
   std::vector<Eigen::Vector3f> vertices_;  // Embree's shared vertex buffer

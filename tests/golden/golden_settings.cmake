@@ -10,6 +10,6 @@
 set(GOLDEN_SIZE 160x90)
 set(GOLDEN_SPP 16)
 set(GOLDEN_METRIC relmse)       # mean (a-b)^2 / (b^2 + 1e-2) over pixels and R,G,B
-set(GOLDEN_THRESHOLD 1e-4)      # global relMSE allowed
+set(GOLDEN_THRESHOLD 1e-5)      # global relMSE allowed (a new seed at sunset gives ~1e-4)
 set(GOLDEN_PIXEL_THRESHOLD 1e-2)  # per-pixel relative squared error ...
 set(GOLDEN_FAIL_PERCENT 1)        # ... exceeded by at most 1 % of the pixels

@@ -51,7 +51,7 @@ TEST(SceneFile, ReadsEveryKey) {
                                    "[sky]\nlight_shafts = true\nshaft_steps = 24\n"
                                    "[camera]\nfrom = [1, 2, 3]\nto = [4, 5, 6]\nfov = 30\n"
                                    "[render]\nwidth = 320\nheight = 200\nspp = 7\nseed = 9\n"
-                                   "noise_target = 0.02\nmin_spp = 4\n"
+                                   "sample_sky = false\nnoise_target = 0.02\nmin_spp = 8\n"
                                    "[output]\nfiles = [\"a.png\", \"a.exr\"]\nexposure = -1\n");
   const auto s = drift::pipeline::read_scene_file(p);
   EXPECT_EQ(s.terrain_raster, p.parent_path() / "dem.tif");
@@ -64,8 +64,9 @@ TEST(SceneFile, ReadsEveryKey) {
   EXPECT_EQ(s.settings.width, 320);
   EXPECT_EQ(s.settings.samples_per_pixel, 7);
   EXPECT_EQ(s.settings.seed, 9u);
+  EXPECT_FALSE(s.settings.sample_sky);
   EXPECT_FLOAT_EQ(s.settings.noise_target, 0.02f);
-  EXPECT_EQ(s.settings.min_samples, 4);
+  EXPECT_EQ(s.settings.min_samples, 8);
   EXPECT_EQ(s.outputs.size(), 2u);
   EXPECT_DOUBLE_EQ(s.display.exposure_ev, -1.0);
 }
@@ -275,4 +276,59 @@ TEST(SceneFile, SunFromDateTimeStandsOverTheDem) {
             std::string::npos);
   EXPECT_NE(error_of(std::string(kTerrain) + "[sun]\ndate = \"2024-13-45\"\ntime = \"13:00\"\n"),
             "");
+}
+
+TEST(SceneFile, ReadsMaterialRulesAndLayers) {
+  const fs::path p = write_scene("materials.toml",
+                                 std::string(kTerrain) +
+                                     "material = \"rock\"\nwetness = 0.2\n"
+                                     "[[terrain.rule]]\nmaterial = \"grass\"\naltitude_max = 2400\n"
+                                     "altitude_blend = 200\nslope_max = 30\n"
+                                     "[[terrain.rule]]\ncolor = [0.5, 0.4, 0.3]\nslope_min = 40\n"
+                                     "opacity = 0.5\n"
+                                     "[[terrain.layer]]\nmask = \"wet.tif\"\nwetness = 1\n");
+  const auto s = drift::pipeline::read_scene_file(p);
+  const auto& surface = s.input.surface;
+  EXPECT_EQ(surface.ground.albedo, drift::render::material_preset("rock")->albedo);
+  EXPECT_FLOAT_EQ(surface.ground.wetness, 0.2f);
+  ASSERT_EQ(surface.rules.size(), 2u);
+  EXPECT_EQ(*surface.rules[0].material.albedo, drift::render::material_preset("grass")->albedo);
+  EXPECT_FLOAT_EQ(surface.rules[0].altitude.hi, 2400.0f);
+  EXPECT_FLOAT_EQ(surface.rules[0].altitude.band, 200.0f);
+  EXPECT_TRUE(std::isinf(surface.rules[0].altitude.lo));
+  EXPECT_FLOAT_EQ(surface.rules[0].slope.hi, 30.0f);
+  EXPECT_FLOAT_EQ(surface.rules[0].slope.band, 5.0f);  // the default band
+  EXPECT_FALSE(surface.rules[1].material.roughness.has_value());
+  EXPECT_FLOAT_EQ(surface.rules[1].opacity, 0.5f);
+  ASSERT_EQ(surface.layers.size(), 1u);
+  EXPECT_FLOAT_EQ(*surface.layers[0].material.wetness, 1.0f);
+  ASSERT_EQ(s.layer_masks.size(), 1u);
+  EXPECT_EQ(s.layer_masks[0], p.parent_path() / "wet.tif");
+}
+
+TEST(SceneFile, BadMaterialKeysNameKeyAndFile) {
+  const std::string t = kTerrain;
+  const std::string preset = error_of(t + "[[terrain.rule]]\nmaterial = \"lava\"\n");
+  EXPECT_NE(preset.find("'terrain.rule.material' is 'lava'"), std::string::npos) << preset;
+  EXPECT_NE(preset.find("rock, sand, mud, grass, snow"), std::string::npos) << preset;
+  EXPECT_NE(preset.find("s.toml:4"), std::string::npos) << preset;
+  EXPECT_NE(error_of(t + "material = \"lava\"\n").find("'terrain.material'"), std::string::npos);
+  EXPECT_NE(error_of(t + "[[terrain.rule]]\nmaterial = \"sand\"\nslop_min = 3\n")
+                .find("terrain.rule.slop_min"),
+            std::string::npos);
+  EXPECT_NE(error_of(t + "[[terrain.rule]]\nmaterial = \"sand\"\nslope_min = 30\nslope_max = 20\n")
+                .find("terrain.rule.slope_max"),
+            std::string::npos);
+  EXPECT_NE(error_of(t + "[[terrain.rule]]\nmaterial = \"sand\"\nslope_max = 95\n")
+                .find("terrain.rule.slope_max' is 95"),
+            std::string::npos);
+  EXPECT_NE(error_of(t + "[[terrain.layer]]\nmask = \"m.tif\"\nwetness = 1.5\n")
+                .find("terrain.layer.wetness' is 1.5"),
+            std::string::npos);
+  EXPECT_NE(error_of(t + "[[terrain.layer]]\nmaterial = \"mud\"\n").find("needs 'mask'"),
+            std::string::npos);
+  const std::string empty = error_of(t + "[[terrain.rule]]\naltitude_min = 100\n");
+  EXPECT_NE(empty.find("sets no material"), std::string::npos) << empty;
+  EXPECT_NE(empty.find("s.toml"), std::string::npos) << empty;
+  EXPECT_NE(error_of(t + "rule = 3\n").find("[[terrain.rule]]"), std::string::npos);
 }

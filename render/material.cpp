@@ -1,0 +1,95 @@
+#include "render/material.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace drift::render {
+
+namespace {
+
+struct Preset {
+  std::string_view name;
+  Material material;
+};
+
+// Linear sRGB albedos in the visible (what an RGB render sees), picked inside
+// the broadband ranges of Hartmann 1994 ("Global Physical Climatology",
+// table 4.2) and Oke 1987 ("Boundary Layer Climates", table 1.1):
+// - rock: weathered granite and scree, visible reflectance 0.2-0.35 in the
+//   USGS spectral library (Kokaly et al. 2017); basalt is far darker (~0.08).
+// - sand: desert sand 0.25-0.40 (Hartmann), quartz sand tinted yellow by iron
+//   oxide coatings; luminance 0.38.
+// - mud: bare soil 0.10-0.25 dry, as low as 0.05 dark and wet (Oke); a dark
+//   soil (luminance 0.17) under a film of water, wetness 0.8, which darkens
+//   it to about 0.11 (render/bsdf.h, Lekner & Dorf 1988) and makes it shine.
+// - grass: broadband 0.16-0.26 (Oke), but most of that is near infrared; in
+//   the visible chlorophyll absorbs blue and red, leaving ~0.05-0.12 with a
+//   green peak (luminance 0.10). A canopy is very rough.
+// - snow: fresh snow 0.75-0.95 (Hartmann), visible albedo of clean snow
+//   0.95-0.98 (Warren 1982, Rev. Geophys. 20(1)); a little blue.
+constexpr float kRough = 0.35f;
+const std::array<Preset, 5> kPresets = {{
+    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f}},
+    {"sand", {{0.45f, 0.37f, 0.26f}, 0.3f, 0.0f}},
+    {"mud", {{0.20f, 0.16f, 0.12f}, 0.1f, 0.8f}},
+    {"grass", {{0.07f, 0.12f, 0.04f}, 0.6f, 0.0f}},
+    {"snow", {{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f}},
+}};
+
+}  // namespace
+
+Material mix(const Material& a, const Material& b, float t) {
+  return {a.albedo * (1 - t) + b.albedo * t, a.roughness * (1 - t) + b.roughness * t,
+          a.wetness * (1 - t) + b.wetness * t};
+}
+
+std::optional<Material> material_preset(std::string_view name) {
+  for (const Preset& p : kPresets)
+    if (p.name == name) return p.material;
+  return std::nullopt;
+}
+
+std::string material_preset_names() {
+  std::string out;
+  for (const Preset& p : kPresets) out += (out.empty() ? "" : ", ") + std::string(p.name);
+  return out;
+}
+
+MaterialOverride full_override(const Material& m) { return {m.albedo, m.roughness, m.wetness}; }
+
+Material blend(const Material& under, const MaterialOverride& over, float t) {
+  Material out = under;
+  if (over.albedo) out.albedo = under.albedo * (1 - t) + *over.albedo * t;
+  if (over.roughness) out.roughness = under.roughness * (1 - t) + *over.roughness * t;
+  if (over.wetness) out.wetness = under.wetness * (1 - t) + *over.wetness * t;
+  return out;
+}
+
+float smoothstep(float e0, float e1, float x) {
+  if (!(e1 > e0)) return x < e0 ? 0.0f : 1.0f;
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+  return t * t * (3 - 2 * t);
+}
+
+float SoftRange::weight(float x) const {
+  const float h = 0.5f * band;
+  const float rise = std::isfinite(lo) ? smoothstep(lo - h, lo + h, x) : 1.0f;
+  const float fall = std::isfinite(hi) ? 1.0f - smoothstep(hi - h, hi + h, x) : 1.0f;
+  return rise * fall;
+}
+
+float MaterialRule::weight(float altitude_m, float slope_deg) const {
+  return opacity * altitude.weight(altitude_m) * slope.weight(slope_deg);
+}
+
+Material apply_rules(Material base, const std::vector<MaterialRule>& rules, float altitude_m,
+                     float slope_deg) {
+  for (const MaterialRule& rule : rules) {
+    const float w = rule.weight(altitude_m, slope_deg);
+    if (w > 0.0f) base = blend(base, rule.material, w);
+  }
+  return base;
+}
+
+}  // namespace drift::render

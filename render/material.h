@@ -1,0 +1,79 @@
+// Ground materials: a rough diffuse base (Oren-Nayar) with an optional wet
+// coat, named presets with typical measured albedos, and the rules that choose
+// materials by altitude and slope. Rasters (masks) that place materials are in
+// render/surface.h; the reflectance model itself is render/bsdf.h.
+//
+// | field     | meaning                                             | range    |
+// |-----------|-----------------------------------------------------|----------|
+// | albedo    | linear RGB diffuse albedo of the dry material       | [0, 1]^3 |
+// | roughness | Oren-Nayar facet slope deviation sigma, radians     | [0, 1.5] |
+// | wetness   | share of a water film: darker base, glossy coat     | [0, 1]   |
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace drift::render {
+
+struct Material {
+  Eigen::Vector3f albedo{0.28f, 0.26f, 0.23f};
+  float roughness = 0.0f;  // sigma of the facet slopes, radians; 0 is Lambert
+  float wetness = 0.0f;    // 0 dry, 1 a continuous water film (render/bsdf.h)
+};
+
+// Linear blend of every field: (1 - t) a + t b.
+Material mix(const Material& a, const Material& b, float t);
+
+// The named presets (rock, sand, mud, grass, snow), or nullopt for an unknown
+// name. Values and their sources are in material.cpp.
+std::optional<Material> material_preset(std::string_view name);
+// "rock, sand, mud, grass, snow", for error messages.
+std::string material_preset_names();
+
+// The fields a rule or a layer sets; the others are left as they were beneath.
+struct MaterialOverride {
+  std::optional<Eigen::Vector3f> albedo;
+  std::optional<float> roughness;
+  std::optional<float> wetness;
+  bool empty() const { return !albedo && !roughness && !wetness; }
+};
+// A preset as an override that sets every field.
+MaterialOverride full_override(const Material& m);
+
+// `under` with the fields `over` sets blended in by weight t in [0, 1].
+Material blend(const Material& under, const MaterialOverride& over, float t);
+
+// A range [lo, hi] with soft edges: the weight rises from 0 to 1 over a band
+// `band` wide centred on lo and falls back over one centred on hi (smoothstep,
+// so the blend has no visible seam). An open side (infinite bound) is 1.
+struct SoftRange {
+  float lo = -std::numeric_limits<float>::infinity();
+  float hi = std::numeric_limits<float>::infinity();
+  float band = 0.0f;
+  float weight(float x) const;
+};
+
+// A material chosen by where the ground lies: weight = opacity x altitude
+// weight x slope weight. Altitude in metres above the DEM's datum (without
+// vertical exaggeration), slope in degrees of the unbumped terrain.
+struct MaterialRule {
+  MaterialOverride material;
+  SoftRange altitude;
+  SoftRange slope;
+  float opacity = 1.0f;
+  float weight(float altitude_m, float slope_deg) const;
+};
+
+// Applies rules in order, each blended over the result of those before it, so
+// later rules win where they overlap.
+Material apply_rules(Material base, const std::vector<MaterialRule>& rules, float altitude_m,
+                     float slope_deg);
+
+// Hermite smoothstep of x between e0 and e1 (a step at e0 when e1 <= e0).
+float smoothstep(float e0, float e1, float x);
+
+}  // namespace drift::render

@@ -1,0 +1,110 @@
+// Material presets, rules by altitude and slope, and mask layers.
+#include "render/material.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "render/surface.h"
+#include "render/terrain_scene.h"
+
+using namespace drift::render;
+using drift::terrain::HeightField;
+using drift::terrain::local_georeference;
+
+TEST(MaterialPresets, KnownNamesWithPlausibleAlbedos) {
+  EXPECT_EQ(material_preset_names(), "rock, sand, mud, grass, snow");
+  auto lum = [](const Material& m) {
+    return 0.2126f * m.albedo.x() + 0.7152f * m.albedo.y() + 0.0722f * m.albedo.z();
+  };
+  EXPECT_GT(lum(*material_preset("snow")), 0.85f);
+  EXPECT_GT(lum(*material_preset("sand")), lum(*material_preset("rock")));
+  EXPECT_LT(lum(*material_preset("grass")), 0.15f);
+  EXPECT_GT(material_preset("grass")->albedo.y(), material_preset("grass")->albedo.x());
+  EXPECT_GT(material_preset("mud")->wetness, 0.5f);
+  EXPECT_FALSE(material_preset("lava").has_value());
+}
+
+TEST(MaterialRules, SoftRangesAndLaterRulesWin) {
+  const SoftRange r{1000.0f, 2000.0f, 100.0f};
+  EXPECT_EQ(r.weight(900.0f), 0.0f);
+  EXPECT_FLOAT_EQ(r.weight(1000.0f), 0.5f);  // the band is centred on the bound
+  EXPECT_EQ(r.weight(1500.0f), 1.0f);
+  EXPECT_FLOAT_EQ(r.weight(2000.0f), 0.5f);
+  EXPECT_EQ(r.weight(2100.0f), 0.0f);
+  EXPECT_EQ(SoftRange{}.weight(-1e9f), 1.0f);  // open on both sides
+
+  // Grass below 2000 m, rock on slopes over 35 degrees (wins where both hold).
+  MaterialRule grass, rock;
+  grass.material = full_override(*material_preset("grass"));
+  grass.altitude = {-1e9f, 2000.0f, 100.0f};
+  rock.material.albedo = material_preset("rock")->albedo;  // colour only
+  rock.slope = {35.0f, 90.0f, 0.0f};
+  const Material base{{0.5f, 0.5f, 0.5f}, 0.2f, 0.0f};
+  const std::vector<MaterialRule> rules = {grass, rock};
+  EXPECT_EQ(apply_rules(base, rules, 1500.0f, 10.0f).albedo, material_preset("grass")->albedo);
+  const Material steep_low = apply_rules(base, rules, 1500.0f, 50.0f);
+  EXPECT_EQ(steep_low.albedo, material_preset("rock")->albedo);
+  EXPECT_EQ(steep_low.roughness, material_preset("grass")->roughness);  // rock set only colour
+  EXPECT_EQ(apply_rules(base, rules, 3000.0f, 10.0f).albedo, base.albedo);
+  // Half way up the tree line band: half grass.
+  const Material edge = apply_rules(base, rules, 2000.0f, 10.0f);
+  EXPECT_NEAR(edge.albedo.x(), 0.5f * (base.albedo.x() + material_preset("grass")->albedo.x()),
+              1e-6f);
+}
+
+TEST(MaterialRules, TerrainHitsSeeTrueSlopeAndAltitude) {
+  // A plane rising 0.5 m per metre east (26.6 degrees) at 1000 m, rendered
+  // with exaggeration 2 (45 degrees on screen): rules judge the real relief.
+  SceneInput in;
+  in.terrain = HeightField(64, 64, 0.0f, local_georeference(1.0));
+  for (int r = 0; r < 64; ++r)
+    for (int x = 0; x < 64; ++x) in.terrain(x, r) = 1000.0f + 0.5f * x;
+  in.vertical_exaggeration = 2.0;
+  MaterialRule steep, high;
+  steep.material.roughness = 1.0f;
+  steep.slope = {30.0f, 90.0f, 0.0f};  // not met: the real slope is 26.6
+  high.material.wetness = 1.0f;
+  high.altitude = {1016.0f, 1e9f, 0.0f};  // the eastern half
+  in.surface.rules = {steep, high};
+  const TerrainScene scene(in);
+  Hit west, east;
+  const Eigen::Vector3f down(0, 0, -1);
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(10.0, -32.0, 5000.0)), down, west));
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(50.0, -32.0, 5000.0)), down, east));
+  EXPECT_EQ(west.roughness, 0.0f);
+  EXPECT_EQ(west.wetness, 0.0f);
+  EXPECT_EQ(east.wetness, 1.0f);
+  // 27 degrees is steep enough for a rule at 25.
+  in.surface.rules[0].slope = {25.0f, 90.0f, 0.0f};
+  const TerrainScene scene25(in);
+  ASSERT_TRUE(
+      scene25.intersect(scene25.to_local(Eigen::Vector3d(10.0, -32.0, 5000.0)), down, west));
+  EXPECT_EQ(west.roughness, 1.0f);
+}
+
+TEST(MaterialLayers, MasksBlendInOrderUnderSnow) {
+  TerrainSurface s;
+  // Sand where the mask is 1 (western half), 0.5 in the middle column.
+  MaterialLayer sand;
+  sand.material = full_override(*material_preset("sand"));
+  sand.mask = HeightField(4, 4, 0.0f, local_georeference(10.0));
+  for (int r = 0; r < 4; ++r) sand.mask(0, r) = sand.mask(1, r) = 1.0f;
+  // Wetness everywhere over it, at 0.6 opacity.
+  MaterialLayer wet;
+  wet.material.wetness = 1.0f;
+  wet.mask = HeightField(4, 4, 1.0f, local_georeference(10.0));
+  wet.opacity = 0.6f;
+  s.layers = {sand, wet};
+  const Eigen::Vector3f up(0, 0, 1);
+  const Material west = shade_terrain(s, 5.0, -15.0, up, 0.0).material;
+  const Material east = shade_terrain(s, 35.0, -15.0, up, 0.0).material;
+  EXPECT_EQ(west.albedo, material_preset("sand")->albedo);
+  EXPECT_FLOAT_EQ(west.wetness, 0.6f);
+  EXPECT_EQ(east.albedo, s.ground.albedo);
+  EXPECT_FLOAT_EQ(east.wetness, 0.6f);
+  EXPECT_EQ(shade_terrain(s, 500.0, -15.0, up, 0.0).material.wetness, 0.0f);  // off the masks
+  // Snow covers everything.
+  s.snow_cover = HeightField(4, 4, 1.0f, local_georeference(10.0));
+  EXPECT_EQ(shade_terrain(s, 5.0, -15.0, up, 0.0).material.albedo, s.snow.albedo);
+}
