@@ -68,8 +68,8 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   }
   surface_ = input.surface;
   const std::size_t n = dem.size();
-  // Vertices, normals and Embree's own grid data (~17.5 B per vertex).
-  require_memory(n * (4 + 12 + 12 + 20), "the terrain scene", "crop or resample the DEM");
+  // Vertices and Embree's own grid data (~17.5 B per vertex).
+  require_memory(n * (12 + 20), "the terrain scene", "crop or resample the DEM");
 
   // Heights: nodata cells become the lowest valid height.
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
@@ -79,10 +79,6 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   if (!std::isfinite(lo)) throw Error("the terrain raster holds no valid height (all nodata)");
   const float k = static_cast<float>(input.vertical_exaggeration);
   exaggeration_ = k;
-  heights_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    heights_[i] = (std::isnan(dem.values()[i]) ? lo : dem.values()[i]) * k;
-  }
   // Local frame: origin at the DEM's centre (cell centres) and lowest height, so
   // float coordinates stay small.
   const auto centre = dem.geo().cell_center((width_ - 1) / 2.0, (height_ - 1) / 2.0);
@@ -91,20 +87,22 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   const float x0 = static_cast<float>(nw[0] - origin_.x());
   const float y0 = static_cast<float>(nw[1] - origin_.y());
 
-  // Shading normals: Horn's gradient of the (exaggerated) DEM, the same as
-  // the slope and aspect rasters (terrain/derivatives.h).
-  vertex_normals_ = terrain::normals(dem, k).values();
+  // The vertex buffer is the only copy of the heights the scene keeps: shading
+  // normals are computed from it at each hit (vertex_normal), so a DEM costs
+  // 12 bytes a vertex here plus Embree's own grid data.
   vertices_.resize(n);
+  const float z0 = static_cast<float>(origin_.z());
   tbb::parallel_for(0, height_, [&](int row) {
     for (int x = 0; x < width_; ++x) {
       const std::size_t i = static_cast<std::size_t>(row) * width_ + x;
-      vertices_[i] = {x0 + x * dx_, y0 - row * dy_, heights_[i] - static_cast<float>(origin_.z())};
+      const float h = std::isnan(dem.values()[i]) ? lo : dem.values()[i];
+      vertices_[i] = {x0 + x * dx_, y0 - row * dy_, h * k - z0};
     }
   });
   std::size_t hi_i = 0, lo_i = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (heights_[i] > heights_[hi_i]) hi_i = i;
-    if (heights_[i] < heights_[lo_i]) lo_i = i;
+    if (vertices_[i].z() > vertices_[hi_i].z()) hi_i = i;
+    if (vertices_[i].z() < vertices_[lo_i].z()) lo_i = i;
   }
   highest_ = vertices_[hi_i];
   lowest_ = vertices_[lo_i];
@@ -199,6 +197,16 @@ float TerrainScene::height_at(float x, float y) const {
          tr * ((1 - tx) * h(x0, r0 + 1) + tx * h(x0 + 1, r0 + 1));
 }
 
+Eigen::Vector3f TerrainScene::vertex_normal(int x, int row) const {
+  // Horn's gradient of the exaggerated heights, as the slope and aspect
+  // rasters compute it (terrain/derivatives.h), edges included.
+  const auto z = [&](int xx, int rr) {
+    return vertices_[static_cast<std::size_t>(rr) * width_ + xx].z();
+  };
+  const terrain::Gradient g = terrain::horn_gradient(z, width_, height_, dx_, dy_, x, row);
+  return Eigen::Vector3f(-g.dzdx, -g.dzdy, 1.0f).normalized();
+}
+
 bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
                              const RayCone& cone) const {
   RTCIntersectContext context;
@@ -223,9 +231,7 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
     const int x0 = std::min(static_cast<int>(fx), width_ - 2);
     const int r0 = std::min(static_cast<int>(fr), height_ - 2);
     const float tx = fx - x0, tr = fr - r0;
-    auto vn = [&](int xx, int rr) {
-      return vertex_normals_[static_cast<std::size_t>(rr) * width_ + xx];
-    };
+    auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
     n = ((1 - tr) * ((1 - tx) * vn(x0, r0) + tx * vn(x0 + 1, r0)) +
          tr * ((1 - tx) * vn(x0, r0 + 1) + tx * vn(x0 + 1, r0 + 1)))
             .normalized();

@@ -67,15 +67,18 @@ class TerrainScene {
   float top() const { return top_; }
 
  private:
+  // The unit shading normal at vertex (x, row), from the vertex buffer.
+  Eigen::Vector3f vertex_normal(int x, int row) const;
+
   struct Embree;
   std::unique_ptr<Embree> embree_;
   int width_ = 0, height_ = 0;
   float dx_ = 1.0f, dy_ = 1.0f;
   float exaggeration_ = 1.0f;
   Eigen::Vector3d origin_{0, 0, 0};
-  std::vector<float> heights_;             // filled, exaggerated, row 0 = north
-  std::vector<Eigen::Vector3f> vertices_;  // Embree's shared vertex buffer
-  std::vector<Eigen::Vector3f> vertex_normals_;
+  // Embree's shared vertex buffer: local x, y and the filled, exaggerated
+  // heights, row 0 = north.
+  std::vector<Eigen::Vector3f> vertices_;
   TerrainSurface surface_;
   std::vector<Eigen::Vector3f> mesh_albedo_;  // by Embree geometry id
   // Per-vertex snow coverage and the triangles to interpolate it, by geometry id.

@@ -24,39 +24,9 @@ void require_metric_cells(const HeightField& dem) {
 }  // namespace
 
 Gradient horn_gradient(const HeightField& dem, int x, int row) {
-  const float centre = dem(x, row);
-  if (std::isnan(centre)) return {NAN, NAN};
-  // z(dx, dr): the neighbour's height. Beyond the border it is extrapolated
-  // linearly from the two nearest cells in its column (rows beyond) or row
-  // (columns beyond), the column clamped first; a nodata neighbour, or one
-  // extrapolated from nodata, takes the centre's height. These are exactly
-  // gdaldem's -compute_edges rules, so the results agree at the border too.
-  const int width = dem.width(), height = dem.height();
-  auto valid_or_centre = [&](float v) { return std::isnan(v) ? centre : v; };
-  auto z = [&](int dx, int dr) {
-    int xx = x + dx;
-    const int rr = row + dr;
-    if (rr < 0 || rr >= height) {
-      xx = std::clamp(xx, 0, width - 1);
-      const int edge = rr < 0 ? 0 : height - 1;
-      const int inner = rr < 0 ? std::min(1, height - 1) : std::max(height - 2, 0);
-      return valid_or_centre(2 * dem(xx, edge) - dem(xx, inner));
-    }
-    if (xx < 0 || xx >= width) {
-      const int edge = xx < 0 ? 0 : width - 1;
-      const int inner = xx < 0 ? std::min(1, width - 1) : std::max(width - 2, 0);
-      return valid_or_centre(2 * dem(edge, rr) - dem(inner, rr));
-    }
-    return valid_or_centre(dem(xx, rr));
-  };
-  // Horn (1981): a b c / d e f / g h i with row -1 (a b c) to the north.
-  const float a = z(-1, -1), b = z(0, -1), c = z(1, -1);
-  const float d = z(-1, 0), f = z(1, 0);
-  const float g = z(-1, 1), h = z(0, 1), i = z(1, 1);
-  const float ew = static_cast<float>(dem.geo().cell_size_x());
-  const float ns = static_cast<float>(dem.geo().cell_size_y());
-  return {((c + 2 * f + i) - (a + 2 * d + g)) / (8 * ew),
-          ((a + 2 * b + c) - (g + 2 * h + i)) / (8 * ns)};
+  return horn_gradient([&](int xx, int rr) { return dem(xx, rr); }, dem.width(), dem.height(),
+                       static_cast<float>(dem.geo().cell_size_x()),
+                       static_cast<float>(dem.geo().cell_size_y()), x, row);
 }
 
 namespace {

@@ -11,6 +11,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "terrain/grid.h"
@@ -25,6 +27,13 @@ struct Gradient {
 
 // Horn's gradient at cell (x, row); NaN components for a nodata cell.
 Gradient horn_gradient(const HeightField& dem, int x, int row);
+
+// The same for any north-up grid of `width` x `height` heights read through
+// `z_at(x, row)` (NaN for nodata), with cells `ew` by `ns` metres: for callers
+// that keep heights in their own layout (the renderer's vertex buffer).
+template <class HeightAt>
+Gradient horn_gradient(const HeightAt& z_at, int width, int height, float ew, float ns, int x,
+                       int row);
 
 // Per-cell gradient, computed in parallel.
 Grid<Gradient> gradient(const HeightField& dem);
@@ -48,5 +57,40 @@ std::vector<HeightField> pyramid(const HeightField& dem, int min_size = 1);
 
 // One pyramid step (exposed for tests and for other grids of floats).
 HeightField halve(const HeightField& grid);
+
+template <class HeightAt>
+Gradient horn_gradient(const HeightAt& z_at, int width, int height, float ew, float ns, int x,
+                       int row) {
+  const float centre = z_at(x, row);
+  if (std::isnan(centre)) return {NAN, NAN};
+  // z(dx, dr): the neighbour's height. Beyond the border it is extrapolated
+  // linearly from the two nearest cells in its column (rows beyond) or row
+  // (columns beyond), the column clamped first; a nodata neighbour, or one
+  // extrapolated from nodata, takes the centre's height. These are exactly
+  // gdaldem's -compute_edges rules, so the results agree at the border too.
+  auto valid_or_centre = [&](float v) { return std::isnan(v) ? centre : v; };
+  auto z = [&](int dx, int dr) {
+    int xx = x + dx;
+    const int rr = row + dr;
+    if (rr < 0 || rr >= height) {
+      xx = std::clamp(xx, 0, width - 1);
+      const int edge = rr < 0 ? 0 : height - 1;
+      const int inner = rr < 0 ? std::min(1, height - 1) : std::max(height - 2, 0);
+      return valid_or_centre(2 * z_at(xx, edge) - z_at(xx, inner));
+    }
+    if (xx < 0 || xx >= width) {
+      const int edge = xx < 0 ? 0 : width - 1;
+      const int inner = xx < 0 ? std::min(1, width - 1) : std::max(width - 2, 0);
+      return valid_or_centre(2 * z_at(edge, rr) - z_at(inner, rr));
+    }
+    return valid_or_centre(z_at(xx, rr));
+  };
+  // Horn (1981): a b c / d e f / g h i with row -1 (a b c) to the north.
+  const float a = z(-1, -1), b = z(0, -1), c = z(1, -1);
+  const float d = z(-1, 0), f = z(1, 0);
+  const float g = z(-1, 1), h = z(0, 1), i = z(1, 1);
+  return {((c + 2 * f + i) - (a + 2 * d + g)) / (8 * ew),
+          ((a + 2 * b + c) - (g + 2 * h + i)) / (8 * ns)};
+}
 
 }  // namespace drift::terrain

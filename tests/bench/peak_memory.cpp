@@ -5,11 +5,13 @@
 
 namespace drift::bench {
 
-std::uint64_t peak_resident_bytes() {
+namespace {
+
+std::uint64_t status_bytes(const std::string& field) {
   std::ifstream in("/proc/self/status");
   std::string key;
   while (in >> key) {
-    if (key == "VmHWM:") {
+    if (key == field) {
       std::uint64_t kb = 0;
       in >> kb;
       return kb * 1024;
@@ -19,5 +21,13 @@ std::uint64_t peak_resident_bytes() {
   }
   return 0;
 }
+
+}  // namespace
+
+std::uint64_t peak_resident_bytes() { return status_bytes("VmHWM:"); }
+
+std::uint64_t resident_bytes() { return status_bytes("VmRSS:"); }
+
+void reset_peak_resident() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
 }  // namespace drift::bench

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "render/terrain_scene.h"
+#include "terrain/derivatives.h"
 #include "terrain/error.h"
 
 using namespace drift::render;
@@ -155,6 +156,29 @@ TEST(Renderer, GridHitsLieOnAnAnalyticPlane) {
     const double x_from_nw = world.x(), y_from_nw = world.y();  // local georef: NW at (0, 0)
     EXPECT_NEAR(world.z(), 0.3 * x_from_nw - 0.2 * y_from_nw + 50.0, 1e-3);
     EXPECT_GT(hit.normal.dot(n_expected), 0.9999f);
+  }
+}
+
+TEST(Renderer, ShadingNormalsAreTheTerrainsHornNormals) {
+  // The scene computes normals from its vertex buffer at each hit; at a vertex
+  // they must be terrain::normals of the same DEM (vertical exaggeration
+  // included), interior and border alike.
+  SceneInput in;
+  in.vertical_exaggeration = 1.5;
+  in.terrain = make_dem(24, 5.0, [](double x, double y) {
+    return 80.0 + 0.002 * (x - 40) * (x - 40) - 0.003 * (y + 70) * (y + 70) + 0.1 * x;
+  });
+  const TerrainScene scene(in);
+  const auto expected = drift::terrain::normals(in.terrain, 1.5f);
+  const auto nw = in.terrain.geo().cell_center(0, 0);
+  for (const auto& [x, row] : {std::pair{0, 0}, {5, 7}, {23, 12}, {11, 23}, {17, 3}}) {
+    const Eigen::Vector3d at = Eigen::Vector3d(nw[0] + 5.0 * x, nw[1] - 5.0 * row, 1e4);
+    Hit hit;
+    ASSERT_TRUE(scene.intersect(scene.to_local(at), {0, 0, -1}, hit));
+    const Eigen::Vector3f n = expected(x, row);
+    EXPECT_GT(hit.normal.dot(n), 1.0f - 1e-6f)
+        << "vertex (" << x << ", " << row << "): " << hit.normal.transpose() << " vs "
+        << n.transpose();
   }
 }
 
