@@ -155,6 +155,10 @@ SceneFile read_scene_file(const fs::path& path) {
   in.surface.snow.albedo = snow.color("color", in.surface.snow.albedo);
   in.surface.snow.roughness =
       static_cast<float>(snow.number("roughness", in.surface.snow.roughness, 0.0, 1.5));
+  in.surface.snow.forward_scattering = static_cast<float>(
+      snow.number("forward_scattering", in.surface.snow.forward_scattering, 0.0, 1.0));
+  in.surface.snow_scattering =
+      static_cast<float>(snow.number("scattering", in.surface.snow_scattering, 1.0, 1e5));
   snow.finish();
 
   if (const toml::table* ripple_table = subtable(root, "ripples", path)) {

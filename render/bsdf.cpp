@@ -70,17 +70,75 @@ const CoatTable& coat_table() {
   return table;
 }
 
-}  // namespace
+float snow_single(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::Vector3f& wo) {
+  const float cos_i = n.dot(wi), cos_o = n.dot(wo);
+  if (cos_i <= 0.0f || cos_o <= 0.0f) return 0.0f;
+  // Light travels along -wi into the snow and leaves along wo.
+  return henyey_greenstein(-wi.dot(wo), kSnowAsymmetry) / (cos_i + cos_o);
+}
 
-float coat_albedo(float cos_o) {
-  const CoatTable& t = coat_table();
+// R(mu) at kTable cosines by midpoint quadrature over (cos_i, phi): the lobe
+// is smooth but forward-peaked, so 256 x 256 cells (error below 1e-4, checked
+// against 4x the cells); and R_avg = 2 int R(mu) mu dmu.
+struct SnowTable {
+  float r[kTable];
+  float average = 0.0f;
+  SnowTable() {
+    const Eigen::Vector3f n(0, 0, 1);
+    constexpr int cells = 256;
+    for (int i = 0; i < kTable; ++i) {
+      const float mu = (static_cast<float>(i) + 0.5f) / kTable;
+      const Eigen::Vector3f wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
+      double sum = 0.0;
+      for (int a = 0; a < cells; ++a) {
+        const float cos_i = (a + 0.5f) / cells;
+        for (int b = 0; b < cells; ++b) {
+          const Eigen::Vector3f wi = around(n, cos_i, 2.0f * kPi * (b + 0.5f) / cells);
+          // dw = dcos dphi; the integrand is f cos_i.
+          sum += snow_single(n, wi, wo) * cos_i;
+        }
+      }
+      r[i] = static_cast<float>(sum * 2.0 * std::numbers::pi / (cells * cells));
+      average += 2.0f * r[i] * mu / kTable;
+    }
+  }
+};
+const SnowTable& snow_table() {
+  static const SnowTable table;
+  return table;
+}
+
+// Linear interpolation in a table of kTable values at cosines (i + 0.5) / kTable.
+float lookup(const float* table, float cos_o) {
   const float x = std::clamp(cos_o, 0.0f, 1.0f) * kTable - 0.5f;
   const int i = std::clamp(static_cast<int>(std::floor(x)), 0, kTable - 2);
   const float f = std::clamp(x - static_cast<float>(i), 0.0f, 1.0f);
-  return t.e[i] * (1.0f - f) + t.e[i + 1] * f;
+  return table[i] * (1.0f - f) + table[i + 1] * f;
 }
 
+}  // namespace
+
+float coat_albedo(float cos_o) { return lookup(coat_table().e, cos_o); }
+
 float coat_albedo_average() { return coat_table().average; }
+
+float henyey_greenstein(float c, float g) {
+  const float d = 1.0f + g * g - 2.0f * g * c;
+  return (1.0f - g * g) / (4.0f * kPi * d * std::sqrt(d));
+}
+
+float snow_single_albedo(float cos_o) { return lookup(snow_table().r, cos_o); }
+
+float snow_single_albedo_average() { return snow_table().average; }
+
+float snow_reflectance(const Eigen::Vector3f& n, const Eigen::Vector3f& wi,
+                       const Eigen::Vector3f& wo) {
+  const float cos_i = n.dot(wi), cos_o = n.dot(wo);
+  if (cos_i <= 0.0f || cos_o <= 0.0f) return 0.0f;
+  const float multiple = (1.0f - snow_single_albedo(cos_i)) * (1.0f - snow_single_albedo(cos_o)) /
+                         (kPi * (1.0f - snow_single_albedo_average()));
+  return snow_single(n, wi, wo) + multiple;
+}
 
 float schlick_fresnel(float c, float f0) {
   const float m = std::clamp(1.0f - c, 0.0f, 1.0f);
@@ -111,6 +169,7 @@ GroundBsdf::GroundBsdf(const Eigen::Vector3f& n, const Eigen::Vector3f& wo,
                        const Material& material)
     : n_(n), wo_(wo), m_(material) {
   m_.wetness = std::clamp(m_.wetness, 0.0f, 1.0f);
+  m_.forward_scattering = std::clamp(m_.forward_scattering, 0.0f, 1.0f);
   cos_o_ = n_.dot(wo_);
   if (m_.wetness <= 0.0f) return;
   albedo_wet_ = wet_albedo(m_.albedo);
@@ -129,12 +188,18 @@ Eigen::Vector3f GroundBsdf::eval(const Eigen::Vector3f& wi) const {
   if (cos_i <= 0.0f) return Eigen::Vector3f::Zero();
   const float on = oren_nayar_factor(n_, wi, wo_, m_.roughness);
   const float w = m_.wetness;
-  Eigen::Vector3f f = m_.albedo * ((1.0f - w) * on / kPi);
+  Eigen::Vector3f f = dry(wi, on) * (1.0f - w);
   if (w <= 0.0f || cos_o_ <= 0.0f) return f;
   // Under the film: what the coat passes in and out (Kelemen & Szirmay-Kalos 2001).
   const float t_i = 1.0f - coat_albedo(cos_i);
   f += albedo_wet_ * (w * on / kPi * t_i * t_o_ / (1.0f - coat_albedo_average()));
   return f + Eigen::Vector3f::Constant(w * coat_f(n_, wi, wo_));
+}
+
+Eigen::Vector3f GroundBsdf::dry(const Eigen::Vector3f& wi, float on) const {
+  const float s = m_.forward_scattering;
+  if (s <= 0.0f) return m_.albedo * (on / kPi);
+  return m_.albedo * ((1.0f - s) * on / kPi + s * snow_reflectance(n_, wi, wo_));
 }
 
 float GroundBsdf::pdf(const Eigen::Vector3f& wi) const {
@@ -152,10 +217,11 @@ float GroundBsdf::pdf(const Eigen::Vector3f& wi) const {
 
 bool GroundBsdf::sample(float u_lobe, float u1, float u2, Sample& s) const {
   if (p_spec_ <= 0.0f) {
-    // Dry: cosine-weighted, f cos / pdf is the albedo times the Oren-Nayar factor.
+    // Dry: cosine-weighted, so f cos / pdf = pi f: the albedo times the
+    // Oren-Nayar factor, or with snow's lobe its share of pi f_snow.
     s.wi = cosine_sample(n_, u1, u2);
     s.pdf = std::max(n_.dot(s.wi), 0.0f) / kPi;
-    s.weight = m_.albedo * oren_nayar_factor(n_, s.wi, wo_, m_.roughness);
+    s.weight = dry(s.wi, oren_nayar_factor(n_, s.wi, wo_, m_.roughness)) * kPi;
     return true;
   }
   if (u_lobe < p_spec_) {

@@ -20,6 +20,25 @@
 // trip is absorbed with probability 1 - A (Lekner & Dorf 1988, "Why some
 // things are darker when wet", Appl. Opt. 27(7)). A white ground stays white,
 // a dark one darkens most: wet sand keeps about 60 % of its dry albedo.
+//
+// Snow (Material::forward_scattering = s) replaces part of the dry diffuse:
+//
+//   f_dry = (1 - s) A / pi * ON + s f_snow
+//   f_snow = A [ P(-wi.wo) / (cos_i + cos_o)
+//                + (1 - R(cos_i)) (1 - R(cos_o)) / (pi (1 - R_avg)) ]
+//
+// The first term is single scattering in a semi-infinite medium
+// (Chandrasekhar 1960, "Radiative Transfer", sec. 46; Hanrahan & Krueger 1993,
+// eq. 21, without the interface) with the Henyey-Greenstein phase function P
+// (normalised over the sphere) of ice grains, asymmetry g = 0.89 in the
+// visible (Wiscombe & Warren 1980, J. Atmos. Sci. 37): snow throws light
+// forward, so a low sun seen from the far side glints off it. R(mu) is that
+// lobe's directional albedo and R_avg its cosine-weighted mean (tabulated
+// once); the second term gives back, diffusely, the multiply scattered rest,
+// coupled as for the wet coat (Kelemen & Szirmay-Kalos 2001), so f_snow is
+// reciprocal and reflects exactly A at every view angle. Snow's translucency
+// over the ground beneath (thin snow reads grey) is in the albedo
+// (layer_albedo, render/material.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -50,6 +69,18 @@ float coat_albedo_average();
 // The ground's albedo under a water film (Lekner & Dorf 1988; see above).
 Eigen::Vector3f wet_albedo(const Eigen::Vector3f& albedo);
 
+// Asymmetry of the phase function of snow grains in the visible.
+constexpr float kSnowAsymmetry = 0.89f;
+// Henyey & Greenstein 1941: the phase function at scattering cosine `c`,
+// normalised to 1 over the sphere.
+float henyey_greenstein(float c, float g);
+// f_snow / A of the header comment, for unit wi, wo on the side of unit n.
+float snow_reflectance(const Eigen::Vector3f& n, const Eigen::Vector3f& wi,
+                       const Eigen::Vector3f& wo);
+// The single-scattering lobe's directional albedo R(mu) and its mean R_avg.
+float snow_single_albedo(float cos_o);
+float snow_single_albedo_average();
+
 class GroundBsdf {
  public:
   // n: unit shading normal; wo: unit direction towards the viewer.
@@ -69,7 +100,7 @@ class GroundBsdf {
   // a cosine-weighted diffuse direction (u1, u2). False: no direction (below
   // the surface).
   bool sample(float u_lobe, float u1, float u2, Sample& s) const;
-  // 0 for a dry material, whose sample() does not look at u_lobe.
+  // 0 for a dry material (snow included), whose sample() does not look at u_lobe.
   float specular_probability() const { return p_spec_; }
 
  private:
@@ -79,6 +110,8 @@ class GroundBsdf {
   float cos_o_ = 0.0f;
   float t_o_ = 1.0f;  // 1 - E(cos_o): what the coat passes towards wo
   float p_spec_ = 0.0f;
+  // The part of eval() without the wet coat: rough diffuse and snow.
+  Eigen::Vector3f dry(const Eigen::Vector3f& wi, float on) const;
 };
 
 }  // namespace drift::render

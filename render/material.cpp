@@ -27,21 +27,23 @@ struct Preset {
 //   the visible chlorophyll absorbs blue and red, leaving ~0.05-0.12 with a
 //   green peak (luminance 0.10). A canopy is very rough.
 // - snow: fresh snow 0.75-0.95 (Hartmann), visible albedo of clean snow
-//   0.95-0.98 (Warren 1982, Rev. Geophys. 20(1)); a little blue.
+//   0.95-0.98 (Warren 1982, Rev. Geophys. 20(1)); a little blue. Half of its
+//   reflection through the forward-scattering lobe of render/bsdf.h.
 constexpr float kRough = 0.35f;
 const std::array<Preset, 5> kPresets = {{
-    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f}},
-    {"sand", {{0.45f, 0.37f, 0.26f}, 0.3f, 0.0f}},
-    {"mud", {{0.20f, 0.16f, 0.12f}, 0.1f, 0.8f}},
-    {"grass", {{0.07f, 0.12f, 0.04f}, 0.6f, 0.0f}},
-    {"snow", {{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f}},
+    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f}},
+    {"sand", {{0.45f, 0.37f, 0.26f}, 0.3f, 0.0f, 0.0f}},
+    {"mud", {{0.20f, 0.16f, 0.12f}, 0.1f, 0.8f, 0.0f}},
+    {"grass", {{0.07f, 0.12f, 0.04f}, 0.6f, 0.0f, 0.0f}},
+    {"snow", {{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f, 0.5f}},
 }};
 
 }  // namespace
 
 Material mix(const Material& a, const Material& b, float t) {
   return {a.albedo * (1 - t) + b.albedo * t, a.roughness * (1 - t) + b.roughness * t,
-          a.wetness * (1 - t) + b.wetness * t};
+          a.wetness * (1 - t) + b.wetness * t,
+          a.forward_scattering * (1 - t) + b.forward_scattering * t};
 }
 
 std::optional<Material> material_preset(std::string_view name) {
@@ -56,13 +58,36 @@ std::string material_preset_names() {
   return out;
 }
 
-MaterialOverride full_override(const Material& m) { return {m.albedo, m.roughness, m.wetness}; }
+MaterialOverride full_override(const Material& m) {
+  return {m.albedo, m.roughness, m.wetness, m.forward_scattering};
+}
 
 Material blend(const Material& under, const MaterialOverride& over, float t) {
   Material out = under;
   if (over.albedo) out.albedo = under.albedo * (1 - t) + *over.albedo * t;
   if (over.roughness) out.roughness = under.roughness * (1 - t) + *over.roughness * t;
   if (over.wetness) out.wetness = under.wetness * (1 - t) + *over.wetness * t;
+  if (over.forward_scattering) {
+    out.forward_scattering = under.forward_scattering * (1 - t) + *over.forward_scattering * t;
+  }
+  return out;
+}
+
+Eigen::Vector3f layer_albedo(const Eigen::Vector3f& infinite, const Eigen::Vector3f& under,
+                             float optical_depth) {
+  if (!(optical_depth > 0.0f)) return under;
+  Eigen::Vector3f out;
+  for (int c = 0; c < 3; ++c) {
+    // A layer that absorbs nothing (R_inf = 1) is the limit b -> 0; keep b > 0.
+    const float r_inf = std::clamp(infinite[c], 1e-4f, 0.9999f);
+    const float r_g = std::clamp(under[c], 0.0f, 1.0f);
+    const float a = 0.5f * (1.0f / r_inf + r_inf);  // (S + K) / S
+    const float b = std::sqrt(a * a - 1.0f);
+    const float x = b * optical_depth;
+    // coth x, without overflow for thick layers.
+    const float coth = x > 20.0f ? 1.0f : 1.0f / std::tanh(x);
+    out[c] = (1.0f - r_g * (a - b * coth)) / (a - r_g + b * coth);
+  }
   return out;
 }
 

@@ -8,6 +8,7 @@
 // | albedo    | linear RGB diffuse albedo of the dry material       | [0, 1]^3 |
 // | roughness | Oren-Nayar facet slope deviation sigma, radians     | [0, 1.5] |
 // | wetness   | share of a water film: darker base, glossy coat     | [0, 1]   |
+// | forward_scattering | share of the snowpack's single-scattering lobe | [0, 1]   |
 #pragma once
 
 #include <Eigen/Core>
@@ -23,6 +24,9 @@ struct Material {
   Eigen::Vector3f albedo{0.28f, 0.26f, 0.23f};
   float roughness = 0.0f;  // sigma of the facet slopes, radians; 0 is Lambert
   float wetness = 0.0f;    // 0 dry, 1 a continuous water film (render/bsdf.h)
+  // Share of the reflection by a forward-scattering granular medium (snow:
+  // single scattering by ice grains, render/bsdf.h); 0 plain rough diffuse.
+  float forward_scattering = 0.0f;
 };
 
 // Linear blend of every field: (1 - t) a + t b.
@@ -39,7 +43,8 @@ struct MaterialOverride {
   std::optional<Eigen::Vector3f> albedo;
   std::optional<float> roughness;
   std::optional<float> wetness;
-  bool empty() const { return !albedo && !roughness && !wetness; }
+  std::optional<float> forward_scattering;
+  bool empty() const { return !albedo && !roughness && !wetness && !forward_scattering; }
 };
 // A preset as an override that sets every field.
 MaterialOverride full_override(const Material& m);
@@ -72,6 +77,15 @@ struct MaterialRule {
 // later rules win where they overlap.
 Material apply_rules(Material base, const std::vector<MaterialRule>& rules, float altitude_m,
                      float slope_deg);
+
+// Kubelka-Munk reflectance of a layer over ground (Kubelka & Munk 1931; the
+// closed form in Kortuem 1969, "Reflectance Spectroscopy", eq. 4.45), per
+// channel: `infinite` is the layer's reflectance when it is deep (its albedo),
+// `under` the ground's, `optical_depth` = S d, the layer's scattering
+// coefficient times its thickness. 0 gives the ground, large values the layer.
+// Thin snow is translucent: over dark rock a few millimetres read grey.
+Eigen::Vector3f layer_albedo(const Eigen::Vector3f& infinite, const Eigen::Vector3f& under,
+                             float optical_depth);
 
 // Hermite smoothstep of x between e0 and e1 (a step at e0 when e1 <= e0).
 float smoothstep(float e0, float e1, float x);

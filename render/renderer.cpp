@@ -269,12 +269,12 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
       if (depth == 0) {
         out.depth = hit.distance;
         out.normal = hit.normal;
-        out.albedo = hit.albedo;
+        out.albedo = hit.material.albedo;
         out.snow = hit.snow;
       }
       const Vector3f wo = -dir;
       const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
-      const GroundBsdf bsdf(hit.normal, wo, {hit.albedo, hit.roughness, hit.wetness});
+      const GroundBsdf bsdf(hit.normal, wo, hit.material);
       // Next-event estimation of the sun: uniform in its cone, pdf 1/solid angle,
       // radiance E/solid angle, so the estimate is E * cos * f.
       const float u1 = rng.next(), u2 = rng.next();

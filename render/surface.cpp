@@ -82,7 +82,13 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
     const float w = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f) * layer.opacity;
     if (w > 0.0f) ground = blend(ground, layer.material, w);
   }
-  p.material = mix(ground, surface.snow, p.snow);
+  Material snow = surface.snow;
+  if (surface.snow_depth && p.snow > 0.0f) {
+    // Thin snow lets the ground show through (translucency).
+    const float depth = std::max(sample_raster(*surface.snow_depth, x, y, 0.0f), 0.0f);
+    snow.albedo = layer_albedo(snow.albedo, ground.albedo, surface.snow_scattering * depth);
+  }
+  p.material = mix(ground, snow, p.snow);
 
   if (surface.ripples && normal.z() > 1e-3f) {
     const RippleLayer& r = surface.ripples.value();

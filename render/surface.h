@@ -43,7 +43,13 @@ struct TerrainSurface {
   Material ground;
   std::vector<MaterialRule> rules;
   std::vector<MaterialLayer> layers;
-  Material snow{{0.90f, 0.92f, 0.95f}, 0.1f};      // the "snow" preset
+  Material snow{{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f, 0.5f};  // the "snow" preset
+  // Kubelka-Munk scattering coefficient S of the snowpack, per metre: with a
+  // depth raster, snow of depth d over the ground reflects layer_albedo(snow,
+  // ground, S d) (render/material.h). 400/m: fresh snow of about 0.1 mm grains
+  // at 300 kg/m^3 (reduced scattering ~500/m, Wiscombe & Warren 1980); 1 cm
+  // over black rock then reflects 0.79 where deep snow reflects 0.90.
+  float snow_scattering = 400.0f;
   std::optional<terrain::HeightField> snow_cover;  // [0, 1]: snow's share of the surface
   std::optional<terrain::HeightField> snow_depth;  // metres, raises the surface
   std::optional<RippleLayer> ripples;

@@ -245,13 +245,11 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
     const SurfacePoint surface = shade_terrain(surface_, world.x(), world.y(), n,
                                                cone.width + cone.spread * hit.distance, relief);
     n = surface.normal;
-    hit.albedo = surface.material.albedo;
-    hit.roughness = surface.material.roughness;
-    hit.wetness = surface.material.wetness;
+    hit.material = surface.material;
     hit.snow = surface.snow;
   } else {
     n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
-    hit.albedo = mesh_albedo_[rh.hit.geomID];
+    hit.material = Material{mesh_albedo_[rh.hit.geomID]};
     if (rh.hit.geomID < mesh_snow_.size() && !mesh_snow_[rh.hit.geomID].empty()) {
       // Snow coverage interpolated over the triangle (Embree's barycentrics).
       const std::vector<float>& cover = mesh_snow_[rh.hit.geomID];
@@ -259,8 +257,7 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
       const float c = std::clamp((1.0f - rh.hit.u - rh.hit.v) * cover[tri[0]] +
                                      rh.hit.u * cover[tri[1]] + rh.hit.v * cover[tri[2]],
                                  0.0f, 1.0f);
-      hit.albedo = hit.albedo * (1.0f - c) + surface_.snow.albedo * c;
-      hit.roughness = surface_.snow.roughness * c;
+      hit.material = mix(hit.material, surface_.snow, c);
       hit.snow = c;
     }
   }

@@ -20,10 +20,8 @@ struct Hit {
   float distance = 0.0f;
   Eigen::Vector3f position{0, 0, 0};  // local (origin-shifted) coordinates
   Eigen::Vector3f normal{0, 0, 1};    // unit shading normal, facing the ray
-  Eigen::Vector3f albedo{0, 0, 0};
-  float roughness = 0.0f;  // Oren-Nayar sigma, radians
-  float wetness = 0.0f;    // share under a water film, [0, 1] (render/bsdf.h)
-  float snow = 0.0f;       // snow coverage of the surface, [0, 1]
+  Material material{{0, 0, 0}};       // what the BSDF sees (render/bsdf.h)
+  float snow = 0.0f;                  // snow coverage of the surface, [0, 1]
 };
 
 // A ray's footprint as a cone (Akenine-Moller et al. 2019, "Texture level of

@@ -7,7 +7,7 @@
 # With names, only those scenes' references are rewritten.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${1:-$root/build}"
+build="$(realpath -m "${1:-$root/build}")"
 cmake -S "$root" -B "$build" >/dev/null
 cmake --build "$build" --target drift -j2
 drift="$(find "$build" -type f -name drift -perm -u+x | head -n 1)"

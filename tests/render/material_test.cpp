@@ -72,15 +72,15 @@ TEST(MaterialRules, TerrainHitsSeeTrueSlopeAndAltitude) {
   const Eigen::Vector3f down(0, 0, -1);
   ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(10.0, -32.0, 5000.0)), down, west));
   ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(50.0, -32.0, 5000.0)), down, east));
-  EXPECT_EQ(west.roughness, 0.0f);
-  EXPECT_EQ(west.wetness, 0.0f);
-  EXPECT_EQ(east.wetness, 1.0f);
+  EXPECT_EQ(west.material.roughness, 0.0f);
+  EXPECT_EQ(west.material.wetness, 0.0f);
+  EXPECT_EQ(east.material.wetness, 1.0f);
   // 27 degrees is steep enough for a rule at 25.
   in.surface.rules[0].slope = {25.0f, 90.0f, 0.0f};
   const TerrainScene scene25(in);
   ASSERT_TRUE(
       scene25.intersect(scene25.to_local(Eigen::Vector3d(10.0, -32.0, 5000.0)), down, west));
-  EXPECT_EQ(west.roughness, 1.0f);
+  EXPECT_EQ(west.material.roughness, 1.0f);
 }
 
 TEST(MaterialLayers, MasksBlendInOrderUnderSnow) {
@@ -107,4 +107,41 @@ TEST(MaterialLayers, MasksBlendInOrderUnderSnow) {
   // Snow covers everything.
   s.snow_cover = HeightField(4, 4, 1.0f, local_georeference(10.0));
   EXPECT_EQ(shade_terrain(s, 5.0, -15.0, up, 0.0).material.albedo, s.snow.albedo);
+}
+
+TEST(SnowLayer, ThinSnowShowsTheGroundThrough) {
+  const Eigen::Vector3f snow(0.9f, 0.92f, 0.95f), rock(0.1f, 0.09f, 0.08f);
+  // Limits: no snow is the ground, a deep pack is the snow's own albedo.
+  EXPECT_NEAR((layer_albedo(snow, rock, 0.0f) - rock).norm(), 0.0f, 1e-6f);
+  EXPECT_NEAR((layer_albedo(snow, rock, 1e4f) - snow).norm(), 0.0f, 1e-5f);
+  // Kubelka-Munk over black ground, R = 1 / (a + b coth(b S d)), by hand for
+  // R_inf = 0.9, S d = 4: a = 1.005556, b = 0.105409, coth(0.421637) = 2.51085.
+  const Eigen::Vector3f black = Eigen::Vector3f::Zero();
+  EXPECT_NEAR(layer_albedo(Eigen::Vector3f::Constant(0.9f), black, 4.0f).x(),
+              1.0 / (1.005556 + 0.105409 * 2.51085), 1e-4);
+  // Deeper snow moves monotonically from the ground to the snow, from above
+  // over dark rock and from below over a ground brighter than snow.
+  const Eigen::Vector3f bright = Eigen::Vector3f::Constant(0.97f);
+  float last_dark = 0.0f, last_bright = 1.0f;
+  for (float d = 0.5f; d < 20.0f; d *= 1.5f) {
+    const float dark = layer_albedo(snow, rock, d).x(), over = layer_albedo(snow, bright, d).x();
+    EXPECT_GT(dark, last_dark);
+    EXPECT_LT(over, last_bright);
+    last_dark = dark, last_bright = over;
+  }
+}
+
+TEST(SnowLayer, ADepthRasterMakesThinSnowGrey) {
+  // Full cover everywhere; depth 2 mm in the west, 20 cm in the east.
+  TerrainSurface s;
+  s.ground.albedo = Eigen::Vector3f::Constant(0.05f);
+  s.snow_cover = HeightField(4, 4, 1.0f, drift::terrain::local_georeference(1.0));
+  s.snow_depth = HeightField(4, 4, 0.002f, drift::terrain::local_georeference(1.0));
+  for (int row = 0; row < 4; ++row) (*s.snow_depth)(3, row) = (*s.snow_depth)(2, row) = 0.2f;
+  const Eigen::Vector3f up(0, 0, 1);
+  const float thin = shade_terrain(s, 0.5, -1.5, up, 0.1).material.albedo.x();
+  const float deep = shade_terrain(s, 3.5, -1.5, up, 0.1).material.albedo.x();
+  EXPECT_NEAR(deep, s.snow.albedo.x(), 1e-3f);
+  EXPECT_LT(thin, 0.6f * deep);
+  EXPECT_GT(thin, s.ground.albedo.x());
 }
