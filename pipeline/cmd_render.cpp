@@ -26,7 +26,25 @@ struct RenderOptions {
   std::string terrain, snow_cover, snow_depth, snow_objects, ripples;
   unsigned long long seed = 0;
   std::string tile;
+  std::string sun_time;
+  double exposure_ev = 0.0;
 };
+
+// --sun-time "YYYY-MM-DD HH:MM[:SS] [+HH:MM]" (the offset as in [sun]
+// timezone, default UTC) -> the scene's date and time.
+render::LocalTime parse_sun_time(const std::string& text) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((\S+)\s+(\S+)(?:\s+(\S+))?)"))) {
+    usage_error(
+        "--sun-time '" + text +
+        "' must be \"YYYY-MM-DD HH:MM[:SS] [UTC offset]\", e.g. \"2026-10-15 17:05 +09:00\"");
+  }
+  try {
+    return render::parse_local_time(m[1], m[2], m[3].matched ? m[3].str() : "UTC");
+  } catch (const Error& e) {
+    usage_error(std::string("--sun-time: ") + e.what());
+  }
+}
 
 void run_render(const RenderOptions& o, const CLI::App& sub) {
   SceneFile scene = read_scene_file(o.scene);
@@ -45,6 +63,9 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     }
   }
   if (sub.count("--seed")) scene.settings.seed = o.seed;
+  // Placed over the DEM when the terrain is loaded, replacing [sun]'s direction.
+  if (!o.sun_time.empty()) scene.sun_time = parse_sun_time(o.sun_time);
+  if (sub.count("--exposure")) scene.display.exposure_ev = o.exposure_ev;
   if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
   if (!o.snow_cover.empty()) scene.snow_cover = o.snow_cover;
   if (!o.snow_depth.empty()) scene.snow_depth = o.snow_depth;
@@ -143,6 +164,13 @@ void add_render_command(CLI::App& root) {
   sub->add_option("--tile", o->tile,
                   "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16) to EXR; "
                   "join the bands with drift merge (docs/rendering.md)");
+  sub->add_option("--sun-time", o->sun_time,
+                  "put the sun where it stands over the DEM at this local time, "
+                  "\"YYYY-MM-DD HH:MM[:SS] [UTC offset]\" (e.g. \"2026-10-15 17:05 +09:00\"; "
+                  "default offset UTC); overrides [sun] azimuth/elevation or date/time");
+  sub->add_option("--exposure", o->exposure_ev,
+                  "exposure of the PNG in EV (overrides [output] exposure; EXR stays linear)")
+      ->check(CLI::Range(-20.0, 20.0));
   add_seed_option(*sub, o->seed);
 }
 

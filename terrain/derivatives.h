@@ -25,6 +25,14 @@ struct Gradient {
   float dzdy = 0.0f;
 };
 
+// Horn (1981) from a 3x3 neighbourhood  a b c / d e f / g h i  (row a b c to
+// the north) of cells `ew` by `ns` metres.
+inline Gradient horn_3x3(float a, float b, float c, float d, float f, float g, float h, float i,
+                         float ew, float ns) {
+  return {((c + 2 * f + i) - (a + 2 * d + g)) / (8 * ew),
+          ((a + 2 * b + c) - (g + 2 * h + i)) / (8 * ns)};
+}
+
 // Horn's gradient at cell (x, row); NaN components for a nodata cell.
 Gradient horn_gradient(const HeightField& dem, int x, int row);
 
@@ -85,12 +93,8 @@ Gradient horn_gradient(const HeightAt& z_at, int width, int height, float ew, fl
     }
     return valid_or_centre(z_at(xx, rr));
   };
-  // Horn (1981): a b c / d e f / g h i with row -1 (a b c) to the north.
-  const float a = z(-1, -1), b = z(0, -1), c = z(1, -1);
-  const float d = z(-1, 0), f = z(1, 0);
-  const float g = z(-1, 1), h = z(0, 1), i = z(1, 1);
-  return {((c + 2 * f + i) - (a + 2 * d + g)) / (8 * ew),
-          ((a + 2 * b + c) - (g + 2 * h + i)) / (8 * ns)};
+  return horn_3x3(z(-1, -1), z(0, -1), z(1, -1), z(-1, 0), z(1, 0), z(-1, 1), z(0, 1), z(1, 1), ew,
+                  ns);
 }
 
 }  // namespace drift::terrain

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "render/image_io.h"
 #include "render/solar_position.h"
 #include "render/surface.h"
 #include "terrain/error.h"
@@ -276,6 +277,42 @@ TEST(SceneFile, SunFromDateTimeStandsOverTheDem) {
             std::string::npos);
   EXPECT_NE(error_of(std::string(kTerrain) + "[sun]\ndate = \"2024-13-45\"\ntime = \"13:00\"\n"),
             "");
+}
+
+TEST(RenderCommand, SunTimeOverridesTheScenesSun) {
+  // --sun-time puts the sun exactly where [sun] date/time would: the same
+  // pixels; at night the frame is dark; a malformed time is a usage error.
+  const std::string dem = std::string(DRIFT_SOURCE_DIR) + "/data/mount_st_helens_usgs_30m.dem";
+  const std::string common = "[terrain]\nraster = \"" + dem + "\"\n[render]\nspp = 2\n";
+  const fs::path by_date =
+      write_scene("date.toml", common +
+                                   "[sun]\ndate = \"2024-06-21\"\ntime = \"19:30\"\n"
+                                   "timezone = \"-07:00\"\n");
+  const fs::path by_angle =
+      write_scene("angle.toml", common + "[sun]\nazimuth = 100\nelevation = 30\n");
+  const fs::path dir = by_date.parent_path();
+  auto render = [&](const fs::path& scene, const std::string& extra, const std::string& out) {
+    const std::string cmd = std::string(DRIFT_EXECUTABLE) + " render " + scene.string() +
+                            " --size 32x18 -o " + (dir / out).string() + " " + extra +
+                            " 2>/dev/null >/dev/null";
+    return WEXITSTATUS(std::system(cmd.c_str()));
+  };
+  ASSERT_EQ(render(by_date, "", "date.exr"), 0);
+  ASSERT_EQ(render(by_angle, "--sun-time '2024-06-21 19:30 -07:00'", "cli.exr"), 0);
+  ASSERT_EQ(render(by_angle, "--sun-time '2024-06-21 23:30 -07:00'", "night.exr"), 0);
+  const auto date = drift::render::read_image(dir / "date.exr");
+  const auto cli = drift::render::read_image(dir / "cli.exr");
+  const auto night = drift::render::read_image(dir / "night.exr");
+  EXPECT_EQ(date.pixels, cli.pixels);
+  auto mean_red = [](const drift::render::Image& img) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < img.pixels.size(); i += img.channels.size()) sum += img.pixels[i];
+    return sum / (img.pixels.size() / img.channels.size());
+  };
+  EXPECT_LT(mean_red(night), 0.2 * mean_red(cli));
+  EXPECT_EQ(render(by_angle, "--sun-time '2024-06-21'", "bad.exr"), 2);
+  EXPECT_EQ(render(by_angle, "--sun-time '2024-06-21 25:00'", "bad.exr"), 2);
+  EXPECT_FALSE(fs::exists(dir / "bad.exr"));
 }
 
 TEST(SceneFile, ReadsMaterialRulesAndLayers) {
