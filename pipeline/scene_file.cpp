@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <regex>
 #include <set>
 
 #include "pipeline/object_list.h"
@@ -35,10 +36,13 @@ const toml::table* subtable(const toml::table& root, const char* name, const fs:
 
 // The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
 // `material` names a preset (which sets every field), and `color`,
-// `roughness` and `wetness` set (or override) one field each.
-render::MaterialOverride read_material(Section& s) {
+// `roughness` and `wetness` set (or override) one field each. `preset` gets
+// the preset's name (empty without one).
+render::MaterialOverride read_material(Section& s, std::string& preset) {
   render::MaterialOverride m;
+  preset.clear();
   if (const auto name = s.string("material")) {
+    preset = *name;
     const auto preset = render::material_preset(*name);
     if (!preset) {
       s.invalid("material",
@@ -53,6 +57,19 @@ render::MaterialOverride read_material(Section& s) {
   if (const double w = s.number("wetness", -1.0, 0.0, 1.0); w >= 0.0)
     m.wetness = static_cast<float>(w);
   return m;
+}
+
+// The coverage channel of a rule or layer (render/coverage.h): `name`, else
+// its preset's name, else `fallback`.
+std::string coverage_name(Section& s, const std::string& preset, const std::string& fallback) {
+  const auto name = s.string("name");
+  if (!name) return preset.empty() ? fallback : preset;
+  static const std::regex word("[A-Za-z0-9_-]{1,32}");
+  if (!std::regex_match(*name, word)) {
+    s.invalid("name", "is '" + *name + "'; use 1-32 letters, digits, '_' or '-' (it names the " +
+                          "EXR channel coverage.<name>)");
+  }
+  return *name;
 }
 
 // One side of a rule: `<name>_min`, `<name>_max` (open when absent) and the
@@ -72,10 +89,12 @@ render::SoftRange read_range(Section& s, const std::string& name, double lo, dou
 }
 
 // [[terrain.rule]]: a material by altitude and slope (docs/rendering.md).
-render::MaterialRule read_rule(const toml::table* table, const fs::path& file) {
+render::MaterialRule read_rule(const toml::table* table, const fs::path& file, std::size_t index) {
   Section s(table, "terrain.rule", file);
   render::MaterialRule rule;
-  rule.material = read_material(s);
+  std::string preset;
+  rule.material = read_material(s, preset);
+  rule.name = coverage_name(s, preset, "rule" + std::to_string(index + 1));
   rule.altitude = read_range(s, "altitude", -1e4, 1e5, 100.0);
   rule.slope = read_range(s, "slope", 0.0, 90.0, 5.0);
   rule.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
@@ -89,11 +108,14 @@ render::MaterialRule read_rule(const toml::table* table, const fs::path& file) {
 
 // [[terrain.layer]]: a material placed by a mask raster; the mask is read by
 // load_scene_terrain.
-render::MaterialLayer read_layer(const toml::table* table, const fs::path& file, fs::path& mask) {
+render::MaterialLayer read_layer(const toml::table* table, const fs::path& file, std::size_t index,
+                                 fs::path& mask) {
   Section s(table, "terrain.layer", file);
   render::MaterialLayer layer;
   const auto mask_file = s.string("mask");
-  layer.material = read_material(s);
+  std::string preset;
+  layer.material = read_material(s, preset);
+  layer.name = coverage_name(s, preset, "layer" + std::to_string(index + 1));
   layer.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
   s.finish();
   if (!mask_file) s.invalid_table("needs 'mask' (a raster in [0, 1] in the DEM's CRS)");
@@ -140,11 +162,14 @@ SceneFile read_scene_file(const fs::path& path) {
   if (scene.terrain_repeat % 2 == 0) {
     throw Error(path.string() + ": 'terrain.repeat' must be odd (the raster stays in the middle)");
   }
-  in.surface.ground = render::blend(in.surface.ground, read_material(terrain), 1.0f);
+  std::string ground_preset;
+  in.surface.ground = render::blend(in.surface.ground, read_material(terrain, ground_preset), 1.0f);
+  if (!ground_preset.empty()) in.surface.ground_name = ground_preset;
   for (const toml::table* rule : terrain.tables("rule"))
-    in.surface.rules.push_back(read_rule(rule, path));
+    in.surface.rules.push_back(read_rule(rule, path, in.surface.rules.size()));
   for (const toml::table* layer : terrain.tables("layer")) {
-    in.surface.layers.push_back(read_layer(layer, path, scene.layer_masks.emplace_back()));
+    in.surface.layers.push_back(
+        read_layer(layer, path, in.surface.layers.size(), scene.layer_masks.emplace_back()));
   }
   terrain.finish();
 

@@ -108,13 +108,4 @@ float MaterialRule::weight(float altitude_m, float slope_deg) const {
   return opacity * altitude.weight(altitude_m) * slope.weight(slope_deg);
 }
 
-Material apply_rules(Material base, const std::vector<MaterialRule>& rules, float altitude_m,
-                     float slope_deg) {
-  for (const MaterialRule& rule : rules) {
-    const float w = rule.weight(altitude_m, slope_deg);
-    if (w > 0.0f) base = blend(base, rule.material, w);
-  }
-  return base;
-}
-
 }  // namespace drift::render

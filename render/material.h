@@ -66,17 +66,13 @@ struct SoftRange {
 // weight x slope weight. Altitude in metres above the DEM's datum (without
 // vertical exaggeration), slope in degrees of the unbumped terrain.
 struct MaterialRule {
+  std::string name = "rule";  // its coverage channel (render/coverage.h)
   MaterialOverride material;
   SoftRange altitude;
   SoftRange slope;
   float opacity = 1.0f;
   float weight(float altitude_m, float slope_deg) const;
 };
-
-// Applies rules in order, each blended over the result of those before it, so
-// later rules win where they overlap.
-Material apply_rules(Material base, const std::vector<MaterialRule>& rules, float altitude_m,
-                     float slope_deg);
 
 // Kubelka-Munk reflectance of a layer over ground (Kubelka & Munk 1931; the
 // closed form in Kortuem 1969, "Reflectance Spectroscopy", eq. 4.45), per

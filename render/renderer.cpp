@@ -46,8 +46,8 @@ struct PixelSample {
   float depth = 0.0f;
   Vector3f normal{0, 0, 0};
   Vector3f albedo{0, 0, 0};
-  float snow = 0.0f;
-  float sky = 0.0f;  // 1 where the camera sees the sky
+  Coverage coverage{};  // by TerrainScene::coverage_names()
+  float sky = 0.0f;     // 1 where the camera sees the sky
 };
 
 // Running mean and variance of a pixel's sample luminances (Welford 1962),
@@ -167,9 +167,11 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
                 ") are not inside the " + std::to_string(settings.height) + "-row frame");
   }
   const int band = row_end - row_begin;
-  std::vector<std::string> channels = {
-      "R",        "G",        "B",        "depth",    "normal.X",      "normal.Y",
-      "normal.Z", "albedo.R", "albedo.G", "albedo.B", "coverage.snow", "mask.sky"};
+  std::vector<std::string> channels = {"R",        "G",        "B",        "depth",    "normal.X",
+                                       "normal.Y", "normal.Z", "albedo.R", "albedo.G", "albedo.B"};
+  const int coverage_count = static_cast<int>(scene.coverage_names().size());
+  for (const std::string& name : scene.coverage_names()) channels.push_back("coverage." + name);
+  channels.emplace_back("mask.sky");
   if (settings.noise_target > 0.0f) channels.emplace_back("samples");
   Image image(settings.width, band, channels);
 
@@ -270,7 +272,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         out.depth = hit.distance;
         out.normal = hit.normal;
         out.albedo = hit.material.albedo;
-        out.snow = hit.snow;
+        out.coverage = hit.coverage;
       }
       const Vector3f wo = -dir;
       const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
@@ -349,7 +351,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
           sum.depth += one.depth;
           sum.normal += one.normal;
           sum.albedo += one.albedo;
-          sum.snow += one.snow;
+          for (int c = 0; c < coverage_count; ++c) sum.coverage[c] += one.coverage[c];
           sum.sky += one.sky;
           if (adaptive) {
             noise.add(luminance(one.radiance));
@@ -363,14 +365,16 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
         }
         tile_samples += static_cast<std::uint64_t>(taken);
         const float inv = 1.0f / static_cast<float>(taken);
-        const float values[13] = {
-            sum.radiance.x() * inv,   sum.radiance.y() * inv, sum.radiance.z() * inv,
-            sum.depth * inv,          sum.normal.x() * inv,   sum.normal.y() * inv,
-            sum.normal.z() * inv,     sum.albedo.x() * inv,   sum.albedo.y() * inv,
-            sum.albedo.z() * inv,     sum.snow * inv,         sum.sky * inv,
-            static_cast<float>(taken)};
-        const int channels = adaptive ? 13 : 12;
-        for (int c = 0; c < channels; ++c) image.at(x, y - row_begin, c) = values[c];
+        // In the order of `channels`.
+        int c = 0;
+        auto put = [&](float v) { image.at(x, y - row_begin, c++) = v; };
+        for (int i = 0; i < 3; ++i) put(sum.radiance[i] * inv);
+        put(sum.depth * inv);
+        for (int i = 0; i < 3; ++i) put(sum.normal[i] * inv);
+        for (int i = 0; i < 3; ++i) put(sum.albedo[i] * inv);
+        for (int i = 0; i < coverage_count; ++i) put(sum.coverage[i] * inv);
+        put(sum.sky * inv);
+        if (adaptive) put(static_cast<float>(taken));
       }
     }
     total_rays += tile_rays;

@@ -51,7 +51,8 @@ struct RenderStats {
 
 // Renders channels R, G, B (linear radiance) and AOVs "depth" (metres along
 // the camera ray to the first hit, 0 for sky), "normal.X/Y/Z" and
-// "albedo.R/G/B" and "coverage.snow" of the first hit, and "mask.sky"
+// "albedo.R/G/B" and "coverage.<name>" (each ground material's share, the last
+// "coverage.snow"; render/coverage.h) of the first hit, and "mask.sky"
 // (the share of the pixel's camera rays that see the sky); with a noise
 // target also "samples" (the samples the pixel took). `camera` is in the raster's CRS.
 Image render_image(const TerrainScene& scene, const SceneInput& input, const Camera& camera,

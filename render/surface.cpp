@@ -60,7 +60,8 @@ terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
 }
 
 SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
-                           const Eigen::Vector3f& normal, double footprint, const Relief& relief) {
+                           const Eigen::Vector3f& normal, double footprint, const Relief& relief,
+                           const CoverageChannels* channels) {
   SurfacePoint p;
   p.normal = normal;
   p.snow = surface.snow_cover
@@ -77,10 +78,24 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
               .cwiseMin(1.0f);
     }
   }
-  ground = apply_rules(ground, surface.rules, relief.altitude, relief.slope_deg);
-  for (const MaterialLayer& layer : surface.layers) {
-    const float w = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f) * layer.opacity;
-    if (w > 0.0f) ground = blend(ground, layer.material, w);
+  // The stack over the base, each entry over what lies beneath in order (so
+  // later ones win where they overlap), and its coverage share.
+  if (channels) p.coverage[channels->ground] = 1.0f;
+  auto put_on_top = [&](const MaterialOverride& material, float w,
+                        const std::vector<int> CoverageChannels::*entries, std::size_t i) {
+    if (!(w > 0.0f)) return;
+    ground = blend(ground, material, w);
+    if (channels) cover(p.coverage, (channels->*entries)[i], w);
+  };
+  for (std::size_t i = 0; i < surface.rules.size(); ++i) {
+    const MaterialRule& rule = surface.rules[i];
+    put_on_top(rule.material, rule.weight(relief.altitude, relief.slope_deg),
+               &CoverageChannels::rules, i);
+  }
+  for (std::size_t i = 0; i < surface.layers.size(); ++i) {
+    const MaterialLayer& layer = surface.layers[i];
+    const float mask = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f);
+    put_on_top(layer.material, mask * layer.opacity, &CoverageChannels::layers, i);
   }
   Material snow = surface.snow;
   if (surface.snow_depth && p.snow > 0.0f) {
@@ -89,6 +104,7 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
     snow.albedo = layer_albedo(snow.albedo, ground.albedo, surface.snow_scattering * depth);
   }
   p.material = mix(ground, snow, p.snow);
+  if (channels) cover(p.coverage, channels->snow, p.snow);
 
   if (surface.ripples && normal.z() > 1e-3f) {
     const RippleLayer& r = surface.ripples.value();

@@ -11,6 +11,7 @@
 #include <optional>
 #include <vector>
 
+#include "render/coverage.h"
 #include "render/material.h"
 #include "render/normal_map.h"
 #include "terrain/grid.h"
@@ -21,6 +22,7 @@ namespace drift::render {
 // (clamped; outside the raster and nodata 0) times `opacity` blends the fields
 // `material` sets over what lies beneath.
 struct MaterialLayer {
+  std::string name = "layer";  // its coverage channel (render/coverage.h)
   MaterialOverride material;
   terrain::HeightField mask;
   float opacity = 1.0f;
@@ -41,6 +43,7 @@ struct RippleLayer {
 // then snow by its cover.
 struct TerrainSurface {
   Material ground;
+  std::string ground_name = "ground";  // its coverage channel (render/coverage.h)
   std::vector<MaterialRule> rules;
   std::vector<MaterialLayer> layers;
   Material snow{{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f, 0.5f};  // the "snow" preset
@@ -69,6 +72,7 @@ struct SurfacePoint {
   Material material;
   Eigen::Vector3f normal{0, 0, 1};  // unit shading normal (bumped)
   float snow = 0.0f;                // snow coverage, for the AOV
+  Coverage coverage{};              // shares by CoverageChannels (if asked for)
 };
 
 // Bilinear sample of `raster` at CRS coordinates (x, y); cells outside or
@@ -89,9 +93,10 @@ struct Relief {
 };
 
 // Evaluates the layers at CRS point (x, y) with the smooth terrain normal
-// `normal` (unit, z up) and a ray footprint `footprint` metres wide.
+// `normal` (unit, z up) and a ray footprint `footprint` metres wide; with
+// `channels` (coverage_channels(surface)) also the coverage shares.
 SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
                            const Eigen::Vector3f& normal, double footprint,
-                           const Relief& relief = {});
+                           const Relief& relief = {}, const CoverageChannels* channels = nullptr);
 
 }  // namespace drift::render

@@ -67,6 +67,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
     throw Error("the terrain raster's cell size must be positive (north-up, metres)");
   }
   surface_ = input.surface;
+  coverage_ = coverage_channels(surface_);
   const std::size_t n = dem.size();
   // Vertices and Embree's own grid data (~17.5 B per vertex).
   require_memory(n * (12 + 20), "the terrain scene", "crop or resample the DEM");
@@ -242,14 +243,18 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
     relief.altitude = static_cast<float>(world.z() / exaggeration_);
     relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
                        static_cast<float>(180.0 / std::numbers::pi);
-    const SurfacePoint surface = shade_terrain(surface_, world.x(), world.y(), n,
-                                               cone.width + cone.spread * hit.distance, relief);
+    const SurfacePoint surface =
+        shade_terrain(surface_, world.x(), world.y(), n, cone.width + cone.spread * hit.distance,
+                      relief, &coverage_);
     n = surface.normal;
     hit.material = surface.material;
     hit.snow = surface.snow;
+    hit.coverage = surface.coverage;
   } else {
     n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
     hit.material = Material{mesh_albedo_[rh.hit.geomID]};
+    hit.snow = 0.0f;
+    hit.coverage = {};
     if (rh.hit.geomID < mesh_snow_.size() && !mesh_snow_[rh.hit.geomID].empty()) {
       // Snow coverage interpolated over the triangle (Embree's barycentrics).
       const std::vector<float>& cover = mesh_snow_[rh.hit.geomID];
@@ -259,6 +264,7 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                                  0.0f, 1.0f);
       hit.material = mix(hit.material, surface_.snow, c);
       hit.snow = c;
+      hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel
     }
   }
   // Face the ray: a mesh may be seen from either side, and terrain from below

@@ -22,6 +22,7 @@ struct Hit {
   Eigen::Vector3f normal{0, 0, 1};    // unit shading normal, facing the ray
   Material material{{0, 0, 0}};       // what the BSDF sees (render/bsdf.h)
   float snow = 0.0f;                  // snow coverage of the surface, [0, 1]
+  Coverage coverage{};                // by TerrainScene::coverage_names()
 };
 
 // A ray's footprint as a cone (Akenine-Moller et al. 2019, "Texture level of
@@ -62,6 +63,8 @@ class TerrainScene {
   float height_at(float x, float y) const;            // bilinear, local coordinates
   // Lowest and highest z of all geometry (terrain and meshes), local.
   float bottom() const { return bottom_; }
+  // The names of Hit::coverage's channels (render/coverage.h).
+  const std::vector<std::string>& coverage_names() const { return coverage_.names; }
   float top() const { return top_; }
 
  private:
@@ -78,6 +81,7 @@ class TerrainScene {
   // heights, row 0 = north.
   std::vector<Eigen::Vector3f> vertices_;
   TerrainSurface surface_;
+  CoverageChannels coverage_;
   std::vector<Eigen::Vector3f> mesh_albedo_;  // by Embree geometry id
   // Per-vertex snow coverage and the triangles to interpolate it, by geometry id.
   std::vector<std::vector<float>> mesh_snow_;

@@ -323,7 +323,8 @@ TEST(SceneFile, ReadsMaterialRulesAndLayers) {
                                      "altitude_blend = 200\nslope_max = 30\n"
                                      "[[terrain.rule]]\ncolor = [0.5, 0.4, 0.3]\nslope_min = 40\n"
                                      "opacity = 0.5\n"
-                                     "[[terrain.layer]]\nmask = \"wet.tif\"\nwetness = 1\n");
+                                     "[[terrain.layer]]\nmask = \"wet.tif\"\nwetness = 1\n"
+                                     "name = \"puddles\"\n");
   const auto s = drift::pipeline::read_scene_file(p);
   const auto& surface = s.input.surface;
   EXPECT_EQ(surface.ground.albedo, drift::render::material_preset("rock")->albedo);
@@ -341,6 +342,14 @@ TEST(SceneFile, ReadsMaterialRulesAndLayers) {
   EXPECT_FLOAT_EQ(*surface.layers[0].material.wetness, 1.0f);
   ASSERT_EQ(s.layer_masks.size(), 1u);
   EXPECT_EQ(s.layer_masks[0], p.parent_path() / "wet.tif");
+  // Coverage channels: the preset's name, else rule<N> / layer<N>, or `name`.
+  EXPECT_EQ(surface.ground_name, "rock");
+  EXPECT_EQ(surface.rules[0].name, "grass");
+  EXPECT_EQ(surface.rules[1].name, "rule2");
+  EXPECT_EQ(surface.layers[0].name, "puddles");
+  EXPECT_NE(error_of(std::string(kTerrain) + "[[terrain.rule]]\nwetness = 1\nname = \"a b\"\n")
+                .find("terrain.rule.name"),
+            std::string::npos);
 }
 
 TEST(SceneFile, BadMaterialKeysNameKeyAndFile) {

@@ -7,6 +7,7 @@
 
 #include "render/surface.h"
 #include "render/terrain_scene.h"
+#include "terrain/error.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -40,15 +41,21 @@ TEST(MaterialRules, SoftRangesAndLaterRulesWin) {
   grass.altitude = {-1e9f, 2000.0f, 100.0f};
   rock.material.albedo = material_preset("rock")->albedo;  // colour only
   rock.slope = {35.0f, 90.0f, 0.0f};
-  const Material base{{0.5f, 0.5f, 0.5f}, 0.2f, 0.0f};
-  const std::vector<MaterialRule> rules = {grass, rock};
-  EXPECT_EQ(apply_rules(base, rules, 1500.0f, 10.0f).albedo, material_preset("grass")->albedo);
-  const Material steep_low = apply_rules(base, rules, 1500.0f, 50.0f);
+  TerrainSurface surface;
+  surface.ground = Material{{0.5f, 0.5f, 0.5f}, 0.2f, 0.0f};
+  surface.rules = {grass, rock};
+  const Material& base = surface.ground;
+  auto apply_rules = [&](float altitude, float slope) {
+    return shade_terrain(surface, 0.0, 0.0, Eigen::Vector3f(0, 0, 1), 0.0, {altitude, slope})
+        .material;
+  };
+  EXPECT_EQ(apply_rules(1500.0f, 10.0f).albedo, material_preset("grass")->albedo);
+  const Material steep_low = apply_rules(1500.0f, 50.0f);
   EXPECT_EQ(steep_low.albedo, material_preset("rock")->albedo);
   EXPECT_EQ(steep_low.roughness, material_preset("grass")->roughness);  // rock set only colour
-  EXPECT_EQ(apply_rules(base, rules, 3000.0f, 10.0f).albedo, base.albedo);
+  EXPECT_EQ(apply_rules(3000.0f, 10.0f).albedo, base.albedo);
   // Half way up the tree line band: half grass.
-  const Material edge = apply_rules(base, rules, 2000.0f, 10.0f);
+  const Material edge = apply_rules(2000.0f, 10.0f);
   EXPECT_NEAR(edge.albedo.x(), 0.5f * (base.albedo.x() + material_preset("grass")->albedo.x()),
               1e-6f);
 }
@@ -107,6 +114,56 @@ TEST(MaterialLayers, MasksBlendInOrderUnderSnow) {
   // Snow covers everything.
   s.snow_cover = HeightField(4, 4, 1.0f, local_georeference(10.0));
   EXPECT_EQ(shade_terrain(s, 5.0, -15.0, up, 0.0).material.albedo, s.snow.albedo);
+}
+
+TEST(Coverage, SharesFollowTheStackAndSumToOne) {
+  // Base "rock"; a grass rule below 2000 m; a layer "wet" by a mask at 0.5
+  // opacity; a second rule "rock" on cliffs shares the base's channel; snow.
+  TerrainSurface s;
+  s.ground_name = "rock";
+  MaterialRule grass, cliffs;
+  grass.name = "grass";
+  grass.material = full_override(*material_preset("grass"));
+  grass.altitude = {-1e9f, 2000.0f, 0.0f};
+  cliffs.name = "rock";
+  cliffs.material = full_override(*material_preset("rock"));
+  cliffs.slope = {40.0f, 90.0f, 0.0f};
+  s.rules = {grass, cliffs};
+  MaterialLayer wet;
+  wet.name = "wet";
+  wet.material.wetness = 1.0f;
+  wet.mask = HeightField(4, 4, 1.0f, local_georeference(10.0));
+  wet.opacity = 0.5f;
+  s.layers = {wet};
+  s.snow_cover = HeightField(4, 4, 0.2f, local_georeference(10.0));
+  const CoverageChannels c = coverage_channels(s);
+  ASSERT_EQ(c.names, (std::vector<std::string>{"rock", "grass", "wet", "snow"}));
+  EXPECT_EQ(c.rules, (std::vector<int>{1, 0}));
+  const Eigen::Vector3f up(0, 0, 1);
+  auto shares = [&](float altitude, float slope) {
+    return shade_terrain(s, 5.0, -15.0, up, 0.0, {altitude, slope}, &c).coverage;
+  };
+  // Low and gentle: grass, then half of it under the wet layer, then 20 % snow.
+  const Coverage low = shares(1000.0f, 10.0f);
+  EXPECT_FLOAT_EQ(low[0], 0.0f);
+  EXPECT_FLOAT_EQ(low[1], 0.5f * 0.8f);
+  EXPECT_FLOAT_EQ(low[2], 0.5f * 0.8f);
+  EXPECT_FLOAT_EQ(low[3], 0.2f);
+  // Low cliff: the cliff rule takes the grass's share back to "rock".
+  const Coverage cliff = shares(1000.0f, 60.0f);
+  EXPECT_FLOAT_EQ(cliff[0], 0.4f);
+  EXPECT_FLOAT_EQ(cliff[1], 0.0f);
+  for (const Coverage& k : {low, cliff, shares(3000.0f, 20.0f)}) {
+    float sum = 0.0f;
+    for (float v : k) sum += v;
+    EXPECT_NEAR(sum, 1.0f, 1e-6f);
+  }
+  // More names than channels is an error that says what to do.
+  for (int i = 0; i < kMaxCoverage; ++i) {
+    s.rules.push_back(grass);
+    s.rules.back().name = "r" + std::to_string(i);
+  }
+  EXPECT_THROW(coverage_channels(s), drift::Error);
 }
 
 TEST(SnowLayer, ThinSnowShowsTheGroundThrough) {

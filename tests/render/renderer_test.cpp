@@ -303,6 +303,11 @@ TEST(Renderer, SkyMaskAndSnowCoverageAovs) {
   EXPECT_FLOAT_EQ(img.at(8, 15, sky), 0.0f);
   EXPECT_FLOAT_EQ(img.at(8, 15, snow), 0.25f);
   EXPECT_FLOAT_EQ(img.at(8, 0, snow), 0.0f);
+  // The ground's own channel takes the rest: the shares of a ground pixel sum to 1.
+  const int ground = img.channel_index("coverage.ground");
+  ASSERT_GE(ground, 0);
+  EXPECT_FLOAT_EQ(img.at(8, 15, ground), 0.75f);
+  EXPECT_FLOAT_EQ(img.at(8, 0, ground), 0.0f);
 }
 
 namespace {
