@@ -149,6 +149,7 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
 
   ensure_gdal();
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopts(

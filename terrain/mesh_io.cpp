@@ -180,7 +180,13 @@ Mesh read_ply(const fs::path& path) {
       if (element == "vertex") {
         std::string name;
         in >> name;
-        if (type != "float") throw bad("vertex property '" + name + "' of type " + type);
+        if (type != "float") {
+          std::string what = "vertex property '";
+          what += name;
+          what += "' of type ";
+          what += type;
+          throw bad(what);
+        }
         properties.push_back(name);
       } else if (line != "property list uchar int vertex_indices") {
         throw bad("face property '" + line + "'");
