@@ -33,40 +33,56 @@ float coat_f(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eigen::V
          ggx_g1(cos_i, kWetCoatAlpha) * ggx_g1(cos_o, kWetCoatAlpha) / (4.0f * cos_i * cos_o);
 }
 
-// E(mu) at kTable cosines (mu = (i + 0.5) / kTable), by stratified sampling
-// of the microfacet normals (Walter et al. 2007, eqs. 35-36 and 41), and its
-// mean 2 int E(mu) mu dmu; computed once, deterministically.
+// A directional albedo E(mu), tabulated once at kTable view cosines
+// mu = (i + 0.5) / kTable and looked up linearly, with its cosine-weighted
+// mean 2 int E(mu) mu dmu.
 constexpr int kTable = 64;
-struct CoatTable {
-  float e[kTable];
-  float average = 0.0f;
-  CoatTable() {
-    const Eigen::Vector3f n(0, 0, 1);
-    const int strata = 96;
+class AlbedoTable {
+ public:
+  // `albedo(wo)`: the integral int f(wi, wo) cos_i dwi for a view wo in the
+  // x-z plane over the normal (0, 0, 1).
+  template <class Fn>
+  explicit AlbedoTable(Fn albedo) {
     for (int i = 0; i < kTable; ++i) {
       const float mu = (static_cast<float>(i) + 0.5f) / kTable;
-      const Eigen::Vector3f wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
-      double sum = 0.0;
-      for (int a = 0; a < strata; ++a) {
-        for (int b = 0; b < strata; ++b) {
-          const float u1 = (a + 0.5f) / strata, u2 = (b + 0.5f) / strata;
-          const float tan2 = kWetCoatAlpha * kWetCoatAlpha * u1 / (1.0f - u1);
-          const Eigen::Vector3f h =
-              around(n, 1.0f / std::sqrt(1.0f + tan2), 2.0f * std::numbers::pi_v<float> * u2);
-          const Eigen::Vector3f wi = 2.0f * wo.dot(h) * h - wo;
-          if (wi.z() <= 0.0f) continue;
-          // f cos_i / pdf with pdf = D cos_h / (4 |wo.h|).
-          const float pdf = ggx_d(h.z(), kWetCoatAlpha) * h.z() / (4.0f * std::abs(wo.dot(h)));
-          sum += coat_f(n, wi, wo) * wi.z() / pdf;
-        }
-      }
-      e[i] = static_cast<float>(sum / (strata * strata));
-      average += 2.0f * e[i] * mu / kTable;
+      e_[i] = albedo(Eigen::Vector3f(std::sqrt(1.0f - mu * mu), 0.0f, mu));
+      average_ += 2.0f * e_[i] * mu / kTable;
     }
   }
+  float at(float cos_o) const {
+    const float x = std::clamp(cos_o, 0.0f, 1.0f) * kTable - 0.5f;
+    const int i = std::clamp(static_cast<int>(std::floor(x)), 0, kTable - 2);
+    const float f = std::clamp(x - static_cast<float>(i), 0.0f, 1.0f);
+    return e_[i] * (1.0f - f) + e_[i + 1] * f;
+  }
+  float average() const { return average_; }
+
+ private:
+  float e_[kTable] = {};
+  float average_ = 0.0f;
 };
-const CoatTable& coat_table() {
-  static const CoatTable table;
+
+// The coat's E(mu) by stratified sampling of the microfacet normals (Walter
+// et al. 2007, eqs. 35-36 and 41); computed once, deterministically.
+const AlbedoTable& coat_table() {
+  static const AlbedoTable table([](const Eigen::Vector3f& wo) {
+    const Eigen::Vector3f n(0, 0, 1);
+    constexpr int strata = 96;
+    double sum = 0.0;
+    for (int a = 0; a < strata; ++a) {
+      for (int b = 0; b < strata; ++b) {
+        const float u1 = (a + 0.5f) / strata, u2 = (b + 0.5f) / strata;
+        const float tan2 = kWetCoatAlpha * kWetCoatAlpha * u1 / (1.0f - u1);
+        const Eigen::Vector3f h = around(n, 1.0f / std::sqrt(1.0f + tan2), 2.0f * kPi * u2);
+        const Eigen::Vector3f wi = 2.0f * wo.dot(h) * h - wo;
+        if (wi.z() <= 0.0f) continue;
+        // f cos_i / pdf with pdf = D cos_h / (4 |wo.h|).
+        const float pdf = ggx_d(h.z(), kWetCoatAlpha) * h.z() / (4.0f * std::abs(wo.dot(h)));
+        sum += coat_f(n, wi, wo) * wi.z() / pdf;
+      }
+    }
+    return static_cast<float>(sum / (strata * strata));
+  });
   return table;
 }
 
@@ -77,59 +93,40 @@ float snow_single(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eig
   return henyey_greenstein(-wi.dot(wo), kSnowAsymmetry) / (cos_i + cos_o);
 }
 
-// R(mu) at kTable cosines by midpoint quadrature over (cos_i, phi): the lobe
-// is smooth but forward-peaked, so 256 x 256 cells (error below 1e-4, checked
-// against 4x the cells); and R_avg = 2 int R(mu) mu dmu.
-struct SnowTable {
-  float r[kTable];
-  float average = 0.0f;
-  SnowTable() {
+// Snow's single-scattering R(mu) by the midpoint rule over (cos_i, phi), fine
+// enough for the forward peak at grazing views (the energy test of
+// tests/render/bsdf_test.cpp holds to 3e-3).
+const AlbedoTable& snow_table() {
+  static const AlbedoTable table([](const Eigen::Vector3f& wo) {
     const Eigen::Vector3f n(0, 0, 1);
     constexpr int cells = 256;
-    for (int i = 0; i < kTable; ++i) {
-      const float mu = (static_cast<float>(i) + 0.5f) / kTable;
-      const Eigen::Vector3f wo(std::sqrt(1.0f - mu * mu), 0.0f, mu);
-      double sum = 0.0;
-      for (int a = 0; a < cells; ++a) {
-        const float cos_i = (a + 0.5f) / cells;
-        for (int b = 0; b < cells; ++b) {
-          const Eigen::Vector3f wi = around(n, cos_i, 2.0f * kPi * (b + 0.5f) / cells);
-          // dw = dcos dphi; the integrand is f cos_i.
-          sum += snow_single(n, wi, wo) * cos_i;
-        }
+    double sum = 0.0;
+    for (int a = 0; a < cells; ++a) {
+      const float cos_i = (a + 0.5f) / cells;
+      for (int b = 0; b < cells; ++b) {
+        const Eigen::Vector3f wi = around(n, cos_i, 2.0f * kPi * (b + 0.5f) / cells);
+        sum += snow_single(n, wi, wo) * cos_i;  // dw = dcos dphi
       }
-      r[i] = static_cast<float>(sum * 2.0 * std::numbers::pi / (cells * cells));
-      average += 2.0f * r[i] * mu / kTable;
     }
-  }
-};
-const SnowTable& snow_table() {
-  static const SnowTable table;
+    return static_cast<float>(sum * 2.0 * std::numbers::pi / (cells * cells));
+  });
   return table;
-}
-
-// Linear interpolation in a table of kTable values at cosines (i + 0.5) / kTable.
-float lookup(const float* table, float cos_o) {
-  const float x = std::clamp(cos_o, 0.0f, 1.0f) * kTable - 0.5f;
-  const int i = std::clamp(static_cast<int>(std::floor(x)), 0, kTable - 2);
-  const float f = std::clamp(x - static_cast<float>(i), 0.0f, 1.0f);
-  return table[i] * (1.0f - f) + table[i + 1] * f;
 }
 
 }  // namespace
 
-float coat_albedo(float cos_o) { return lookup(coat_table().e, cos_o); }
+float coat_albedo(float cos_o) { return coat_table().at(cos_o); }
 
-float coat_albedo_average() { return coat_table().average; }
+float coat_albedo_average() { return coat_table().average(); }
 
 float henyey_greenstein(float c, float g) {
   const float d = 1.0f + g * g - 2.0f * g * c;
   return (1.0f - g * g) / (4.0f * kPi * d * std::sqrt(d));
 }
 
-float snow_single_albedo(float cos_o) { return lookup(snow_table().r, cos_o); }
+float snow_single_albedo(float cos_o) { return snow_table().at(cos_o); }
 
-float snow_single_albedo_average() { return snow_table().average; }
+float snow_single_albedo_average() { return snow_table().average(); }
 
 float snow_reflectance(const Eigen::Vector3f& n, const Eigen::Vector3f& wi,
                        const Eigen::Vector3f& wo) {
