@@ -5,7 +5,9 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <numbers>
 #include <vector>
@@ -22,27 +24,46 @@ constexpr int kRowBlock = 16;
 
 double max_excess(const terrain::HeightField& h, double max_drop) {
   const int w = h.width(), rows = h.height();
-  const double diagonal = std::numbers::sqrt2 * max_drop;
-  return tbb::parallel_reduce(
-      tbb::blocked_range<int>(0, rows, kRowBlock), 0.0,
-      [&](const tbb::blocked_range<int>& r, double m) {
+  const float limit = static_cast<float>(max_drop);
+  const float diagonal = static_cast<float>(std::numbers::sqrt2 * max_drop);
+  // Excesses clamped at 0 are non-negative floats, whose bits order like
+  // integers: an integer max reduction, which vectorises (a float one does
+  // not without -ffast-math).
+  auto excess = [](float a, float b, float lim) {
+    const float e = std::fabs(a - b) - lim;
+    return std::bit_cast<std::int32_t>(e > 0.0f ? e : 0.0f);
+  };
+  auto larger = [](std::int32_t a, std::int32_t b) { return a > b ? a : b; };
+  const std::int32_t bits = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, rows, kRowBlock), std::int32_t{0},
+      [&](const tbb::blocked_range<int>& r, std::int32_t m) {
         for (int row = r.begin(); row < r.end(); ++row) {
-          const float* c = &h(0, row);
-          const float* s = &h(0, (row + 1) % rows);
-          for (int x = 0; x < w; ++x) {
-            const int xr = x + 1 == w ? 0 : x + 1, xl = x == 0 ? w - 1 : x - 1;
-            m = std::max({m, std::fabs(c[x] - c[xr]) - max_drop, std::fabs(c[x] - s[x]) - max_drop,
-                          std::fabs(c[x] - s[xr]) - diagonal, std::fabs(c[x] - s[xl]) - diagonal});
-          }
+          const float* __restrict c = &h(0, row);
+          const float* __restrict s = &h(0, row + 1 == rows ? 0 : row + 1);
+          // Each edge once: east, south, south-east, south-west.
+          auto cell = [&](int x, int xl, int xr) {
+            return larger(larger(excess(c[x], c[xr], limit), excess(c[x], s[x], limit)),
+                          larger(excess(c[x], s[xr], diagonal), excess(c[x], s[xl], diagonal)));
+          };
+          std::int32_t row_max = larger(cell(0, w - 1, 1), cell(w - 1, w - 2, 0));
+          for (int x = 1; x + 1 < w; ++x) row_max = larger(row_max, cell(x, x - 1, x + 1));
+          m = larger(m, row_max);
         }
         return m;
       },
-      [](double a, double b) { return std::max(a, b); }, tbb::simple_partitioner());
+      [](std::int32_t a, std::int32_t b) { return std::max(a, b); }, tbb::simple_partitioner());
+  return static_cast<double>(std::bit_cast<float>(bits));
 }
 
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance) {
+  std::vector<float> scratch;
+  return avalanche(h, max_drop, max_sweeps, tolerance, scratch);
+}
+
+int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
+              std::vector<float>& next) {
   const int w = h.width(), rows = h.height();
-  std::vector<float> next(h.size());
+  next.resize(h.size());
   const float limit = static_cast<float>(max_drop);
   const float diagonal_limit = static_cast<float>(std::numbers::sqrt2 * max_drop);
   // Flux out of a cell across one of its 8 edges: a ninth of the excess drop
@@ -54,10 +75,12 @@ int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double t
     const float d = a - b;
     return (std::max(d - lim, 0.0f) + std::min(d + lim, 0.0f)) * (1.0f / 9.0f);
   };
-  // Convergence is checked every few sweeps, outside the vectorised loop.
+  // Convergence is checked every few sweeps, by a separate vectorised pass.
   constexpr int kCheckEvery = 8;
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
-    if (sweep % kCheckEvery == 0 && max_excess(h, max_drop) <= tolerance) return sweep;
+    if (tolerance >= 0 && sweep % kCheckEvery == 0 && max_excess(h, max_drop) <= tolerance) {
+      return sweep;
+    }
     tbb::parallel_for(
         tbb::blocked_range<int>(0, rows, kRowBlock),
         [&](const tbb::blocked_range<int>& r) {

@@ -3,6 +3,8 @@
 // is (beyond paper 002, required by SPEC 2 so that slip faces form).
 #pragma once
 
+#include <vector>
+
 #include "terrain/grid.h"
 
 namespace drift::dunes {
@@ -16,8 +18,13 @@ namespace drift::dunes {
 // sweeps are Jacobi updates of antisymmetric edge fluxes, so mass is
 // conserved and the result is the same for any thread count. Stops when no
 // edge exceeds max_drop by more than `tolerance` (checked every 8 sweeps) or
-// after `max_sweeps`; returns the sweeps done.
+// after `max_sweeps`; returns the sweeps done. A negative tolerance skips the
+// checks (all `max_sweeps` run).
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance = 1e-4);
+// The same with caller-owned scratch for the new field (kept between calls,
+// so a run does not allocate and clear it every step).
+int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
+              std::vector<float>& scratch);
 
 // How far the steepest edge (of 8 neighbours) exceeds its limit (<= 0: none).
 double max_excess(const terrain::HeightField& h, double max_drop);

@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "dunes/avalanche.h"
+#include "dunes/wind_frame.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
 
@@ -43,19 +45,26 @@ void require_range(const char* name, double v, double lo, double hi) {
 
 // tanh by its [7/6] Pade approximant (Lambert's continued fraction), within
 // 2e-7 for |x| < 4.97 and clamped to +-1 beyond, where tanh is 1 within 1e-4:
-// a third of the time of libm's tanhf, and the same bits everywhere.
-float fast_tanh(float x) {
-  if (x > 4.97f) return 1.0f;
-  if (x < -4.97f) return -1.0f;
-  const float x2 = x * x;
-  const float p = x * (135135.0f + x2 * (17325.0f + x2 * (378.0f + x2)));
+// a third of the time of libm's tanhf, and the same bits everywhere. Branch
+// free (selects), so loops over it vectorise.
+inline float fast_tanh(float x) {
+  const float above = x > -4.97f ? x : -4.97f;
+  const float c = above < 4.97f ? above : 4.97f;
+  const float x2 = c * c;
+  const float p = c * (135135.0f + x2 * (17325.0f + x2 * (378.0f + x2)));
   const float q = 135135.0f + x2 * (62370.0f + x2 * (3150.0f + x2 * 28.0f));
-  return p / q;
+  const float r = p / q;
+  return std::fabs(x) > 4.97f ? std::copysign(1.0f, x) : r;
 }
 
 // The largest edge drop avalanching allows, in model height units.
 double max_drop(const SandOptions& o) {
   return std::tan(o.repose_deg * std::numbers::pi / 180.0) * o.cell_m / o.height_unit;
+}
+
+// The shadow line's fall per cell along the wind, in model height units.
+double shadow_drop(const SandOptions& o) {
+  return std::tan(o.shadow_deg * std::numbers::pi / 180.0) * o.cell_m / o.height_unit;
 }
 
 template <class Fn>
@@ -108,7 +117,9 @@ void validate(const SandOptions& o) {
     if (o.q <= o.b_prime) throw Error("dunes need --q > --b-prime, or the lift turns negative");
   }
   const std::uint64_t cells = static_cast<std::uint64_t>(o.size) * o.size;
-  require_memory(cells * (4 + 4 + 4), "the sand grid", "choose a smaller --size");
+  // Heights, the double accumulator of saltation, creep's next field, the
+  // wind shadow.
+  require_memory(cells * (4 + 8 + 4 + 2), "the sand grid", "choose a smaller --size");
 }
 
 terrain::HeightField initial_field(const SandOptions& o) {
@@ -121,164 +132,339 @@ terrain::HeightField initial_field(const SandOptions& o) {
   return h;
 }
 
-// The wind shadow of one row (wind along +x): every cell casts a line falling
-// `drop_per_cell` per cell downwind, and a cell below the line of the cells
-// upwind of it is shadowed. Two passes round the periodic row settle it.
-// `next_shadowed[x]` is the first shadowed cell after x, unwrapped (x + n if
-// none within a lap).
-void wind_shadow(const float* line, int n, double drop_per_cell, std::vector<char>& shadowed,
-                 std::vector<int>& next_shadowed) {
-  shadowed.assign(n, 0);
-  double carried = -1e300;
-  for (int pass = 0; pass < 2; ++pass) {
+namespace {
+
+// How saltation's landings are summed. A landing (x + L cos a, y + L sin a)
+// is shared among the 4 cells around it, so source row y writes rows y to
+// y + spill (t > 0) or y - spill to y (t < 0); spill = 0 for a wind along x.
+// Rows are cut into fixed blocks at least `spill` tall. A block sums its
+// sources' landings in double precision in a private window of its rows and
+// the spill rows beyond them, then writes its rows, except the `spill`
+// shared rows that its neighbour's landings reach: those, and its spill
+// rows, it keeps (still in double) until a second pass adds each neighbour's
+// spill to them. Every sum runs in a fixed order, so the bits do not depend
+// on the thread count (a 2-D scatter cannot be cut into independent rows),
+// and each cell is rounded to float once, so mass is kept to float rounding.
+struct Blocks {
+  int spill = 0;      // rows a landing may reach beyond its source row
+  int direction = 0;  // +1: landings reach rows below (t > 0); -1: above
+  int rows = 0, size = 0, count = 0;
+  int begin(int i) const { return i * size; }
+  int end(int i) const { return i + 1 == count ? rows : (i + 1) * size; }
+  // First row of block i's window (unwrapped) and its row count.
+  int window_begin(int i) const { return begin(i) - (direction < 0 ? spill : 0); }
+  int window_rows(int i) const { return end(i) - begin(i) + spill; }
+  // First of the rows of block i that a neighbour's landings reach, and the
+  // first row of the rows block i's landings reach beyond its own.
+  int shared_begin(int i) const { return direction > 0 ? begin(i) : end(i) - spill; }
+  int spill_begin(int i) const { return direction > 0 ? end(i) : begin(i) - spill; }
+  // The block whose spill lands on block i's shared rows.
+  int feeder(int i) const { return (i - direction + count) % count; }
+};
+
+double max_flight(const terrain::HeightField& h, const SandOptions& o) {
+  double longest = o.L0 + o.b;  // dunes: L0 - b tanh(.) <= L0 + b
+  if (o.model == Model::Ripples) {
+    const float top = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, h.size(), 1 << 16), -1e30f,
+        [&](const tbb::blocked_range<std::size_t>& r, float m) {
+          for (std::size_t i = r.begin(); i < r.end(); ++i) m = std::max(m, h.values()[i]);
+          return m;
+        },
+        [](float a, float b) { return std::max(a, b); });
+    longest = o.L0 + o.b * top;
+  }
+  return std::clamp(longest, 0.0, h.width() - 1.0);
+}
+
+// `longest`: the longest flight, cells along the wind.
+Blocks landing_blocks(const terrain::HeightField& h, double longest, const WindFrame& wind) {
+  Blocks b;
+  b.rows = h.height();
+  const double t = wind.rows_per_column();
+  if (t != 0.0) {
+    b.spill = static_cast<int>(longest * wind.cos_a * std::fabs(t)) + 1;
+    b.direction = t > 0 ? 1 : -1;
+  }
+  // Blocks twice the spill (or more) keep the kept rows under half the field.
+  b.size = b.spill == 0 ? kRowBlock : std::max(2 * kRowBlock, 2 * b.spill);
+  b.count = std::max(1, b.rows / b.size);
+  if (b.count == 1) b.size = b.rows;
+  // One block: its landings wrap onto itself, which needs them to stay
+  // within a lap of rows (square grids: flights are under a lap of columns).
+  if (b.spill > b.rows) {
+    throw Error("an oblique wind needs at least " + std::to_string(b.spill) +
+                " rows of sand for its longest flight; the grid has " + std::to_string(b.rows));
+  }
+  return b;
+}
+
+// Paper eq. 1 (ripples) or eqs. 2-3 (dunes) along one row: the flight of each
+// cell in columns (its length along the wind times cos a) and its lift.
+void launch_row(const terrain::HeightField& h, const SandOptions& o, const WindFrame& wind, int row,
+                double* __restrict columns, double* __restrict lift) {
+  const int n = h.width(), rows = h.height();
+  const float* __restrict c = &h(0, row);
+  // Options as locals (the outputs could alias them otherwise), and flights
+  // kept within a lap by selects: the loops vectorise.
+  const double longest = n - 1.0, cos_a = wind.cos_a, L0 = o.L0, b = o.b, q = o.q;
+  const double b_prime = o.b_prime;
+  auto along = [=](double flight) {
+    const double positive = flight > 0.0 ? flight : 0.0;
+    return (positive < longest ? positive : longest) * cos_a;
+  };
+  if (o.model == Model::Ripples) {
     for (int x = 0; x < n; ++x) {
-      carried -= drop_per_cell;
-      shadowed[x] = line[x] < carried;
-      carried = std::max(carried, static_cast<double>(line[x]));
+      columns[x] = along(L0 + b * c[x]);  // L = L0 + b H
+      lift[x] = q;
+    }
+    return;
+  }
+  // dH/dx of eqs. 2-3 is the slope along the wind: the gradient (central
+  // differences, periodic) dotted with the wind's direction.
+  const float* __restrict up = &h(0, row == 0 ? rows - 1 : row - 1);
+  const float* __restrict down = &h(0, row + 1 == rows ? 0 : row + 1);
+  const float cx = static_cast<float>(wind.cos_a), cy = static_cast<float>(wind.sin_a);
+  auto fill = [&](int x, int xl, int xr) {
+    const double g = fast_tanh(cx * (0.5f * (c[xr] - c[xl])) + cy * (0.5f * (down[x] - up[x])));
+    columns[x] = along(L0 - b * g);
+    lift[x] = q + b_prime * g;
+  };
+  fill(0, n - 1, 1);
+  for (int x = 1; x + 1 < n; ++x) fill(x, x - 1, x + 1);
+  fill(n - 1, n - 2, 0);
+}
+
+// Adds `lift` at (land_x, land_y) (cells; land_x >= 0, land_y relative to
+// the window's first row and inside it), shared bilinearly among the 4 cells
+// around it, wrapping round the columns. kOblique false: the wind is along
+// x and land_y a whole row (the same code without the row's share).
+template <bool kOblique>
+inline void deposit(double* window, int n, double land_x, double land_y, double lift) {
+  const int i0 = static_cast<int>(land_x);
+  const double fx = land_x - i0;
+  const int a = i0 >= n ? i0 - n : i0, b = a + 1 == n ? 0 : a + 1;
+  const int j0 = static_cast<int>(land_y);  // land_y >= 0: truncation floors
+  const double fy = kOblique ? land_y - j0 : 0.0;
+  double* top = window + static_cast<std::size_t>(j0) * n;
+  if (fy == 0.0) {  // on a row (always, for a wind along x): two cells
+    top[a] += lift * (1.0 - fx);
+    top[b] += lift * fx;
+    return;
+  }
+  double* bottom = top + n;
+  const double upper = lift * (1.0 - fy), lower = lift * fy;
+  top[a] += upper * (1.0 - fx);
+  top[b] += upper * fx;
+  bottom[a] += lower * (1.0 - fx);
+  bottom[b] += lower * fx;
+}
+
+// One source row's landings into the window (`y`: the row's place in it).
+// `crossings`: where the wind lines cross each column (rows modulo the field's).
+// Compiled twice: kOblique false drops the sideways arithmetic of a wind
+// along x (a third of the work of a ripple step), nothing else.
+template <bool kOblique>
+void saltate_row(const terrain::HeightField& h, const SandOptions& o, const WindFrame& wind,
+                 const ShadowMap* shadow, const Crossing* crossings, int row, int y, double* window,
+                 double* columns, double* lift) {
+  const int n = h.width();
+  const double t = wind.rows_per_column();
+  launch_row(h, o, wind, row, columns, lift);
+  double* source = window + static_cast<std::size_t>(y) * n;
+  if (!shadow) {
+    for (int x = 0; x < n; ++x) {
+      source[x] -= lift[x];
+      deposit<kOblique>(window, n, x + columns[x], y + columns[x] * t, lift[x]);
+    }
+    return;
+  }
+  for (int x = 0; x < n; ++x) {
+    // Werner (1995): the lee of a crest is out of the wind. Sand there is not
+    // lifted, and grains flying into it are caught at its edge. The cell's
+    // sand follows the two wind lines around it in proportion (one line, its
+    // row, for a wind along x).
+    const CellLines lines = cell_lines(crossings[x], row, h.height());
+    for (const auto& [line, share] :
+         {std::pair{lines.line_a, lines.weight_a}, std::pair{lines.line_b, 1.0 - lines.weight_a}}) {
+      if (share == 0.0) continue;
+      const std::uint16_t s = (*shadow)[static_cast<std::size_t>(line) * n + x];
+      if (shadowed(s)) continue;
+      const double part = lift[x] * share;
+      const double reach = std::min(columns[x], static_cast<double>(columns_to_shadow(s)));
+      source[x] -= part;
+      deposit<kOblique>(window, n, x + reach, y + reach * t, part);
     }
   }
-  next_shadowed.assign(n, 0);
-  int next = 2 * n;  // sentinel: no shadow seen yet
-  for (int pass = 0; pass < 2; ++pass) {
-    for (int x = n - 1; x >= 0; --x) {
-      const int at = x + (pass == 0 ? n : 0);
-      next_shadowed[x] = next;
-      if (shadowed[x]) next = at;
+}
+
+// What saltation needs to know once per step.
+struct SaltationPlan {
+  WindFrame wind;
+  Blocks blocks;
+  std::vector<Crossing> crossings;  // per column, rows modulo the field's
+  const ShadowMap* shadow = nullptr;
+  std::size_t kept_rows = 0;  // per block: its shared rows, then its spill rows
+};
+
+// Block i: its sources' landings summed in its window; rows nobody else
+// reaches go to `out` (rounded once), shared and spill rows to `kept`.
+void land_block(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p, int i,
+                double* kept, std::vector<float>& out) {
+  const int n = h.width();
+  const Blocks& b = p.blocks;
+  thread_local std::vector<double> window, columns, lift;
+  const int wb = b.window_begin(i), wrows = b.window_rows(i);
+  window.resize(static_cast<std::size_t>(wrows) * n);
+  columns.resize(n);
+  lift.resize(n);
+  // Own rows start from the heights, spill rows from 0.
+  for (int r = b.begin(i); r < b.end(i); ++r)
+    std::copy(&h(0, r), &h(0, r) + n, window.begin() + static_cast<std::size_t>(r - wb) * n);
+  const int spill_row = b.direction > 0 ? b.end(i) - wb : 0;
+  std::fill_n(window.begin() + static_cast<std::size_t>(spill_row) * n,
+              static_cast<std::size_t>(b.spill) * n, 0.0);
+  const bool oblique = p.wind.rows_per_column() != 0.0;
+  for (int r = b.begin(i); r < b.end(i); ++r) {
+    (oblique ? saltate_row<true> : saltate_row<false>)(h, o, p.wind, p.shadow, p.crossings.data(),
+                                                       r, r - wb, window.data(), columns.data(),
+                                                       lift.data());
+  }
+  for (int r = wb; r < wb + wrows; ++r) {
+    const double* from = window.data() + static_cast<std::size_t>(r - wb) * n;
+    const int shared = r - b.shared_begin(i), spilled = r - b.spill_begin(i);
+    if (shared >= 0 && shared < b.spill) {
+      std::copy(from, from + n, kept + static_cast<std::size_t>(shared) * n);
+    } else if (spilled >= 0 && spilled < b.spill) {
+      std::copy(from, from + n, kept + static_cast<std::size_t>(b.spill + spilled) * n);
+    } else {
+      float* to = &out[static_cast<std::size_t>(r) * n];
+      for (int x = 0; x < n; ++x) to[x] = static_cast<float>(from[x]);
     }
   }
-  for (int x = 0; x < n; ++x) next_shadowed[x] = std::min(next_shadowed[x], x + n);
+}
+
+// Block i's shared rows plus the spill its feeder landed on them, rounded once.
+void merge_shared_rows(int n, const SaltationPlan& p, int i, const std::vector<double>& kept,
+                       std::vector<float>& out) {
+  const Blocks& b = p.blocks;
+  const double* own = kept.data() + p.kept_rows * n * i;
+  const double* fed =
+      kept.data() + p.kept_rows * n * b.feeder(i) + static_cast<std::size_t>(b.spill) * n;
+  for (int s = 0; s < b.spill; ++s) {
+    const int row = (b.shared_begin(i) + s + b.rows) % b.rows;
+    float* to = &out[static_cast<std::size_t>(row) * n];
+    const std::size_t at = static_cast<std::size_t>(s) * n;
+    for (int x = 0; x < n; ++x) to[x] = static_cast<float>(own[at + x] + fed[at + x]);
+  }
+}
+
+}  // namespace
+
+void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
+  const int n = h.width();
+  SaltationPlan p;
+  p.wind = wind_frame(o.wind_from_deg);
+  const double t = p.wind.rows_per_column();
+  const bool shadows = o.shadow_deg > 0.0;
+  // The longest flight bounds how far landings reach sideways and how far
+  // ahead the shadow must be known (neither matters for a plain wind along x).
+  const double longest = t != 0.0 || shadows ? max_flight(h, o) : 0.0;
+  if (shadows) {
+    wind_shadow(h, t, shadow_drop(o), longest * p.wind.cos_a, w.shadow);
+    p.shadow = &w.shadow;
+  }
+  p.blocks = landing_blocks(h, longest, p.wind);
+  p.crossings.resize(n);
+  for (int x = 0; x < n; ++x) {
+    p.crossings[x] = crossing(t, x);
+    p.crossings[x].row = (p.crossings[x].row % h.height() + h.height()) % h.height();
+  }
+  p.kept_rows = 2 * static_cast<std::size_t>(p.blocks.spill);
+  w.kept.resize(p.kept_rows * n * p.blocks.count);
+  w.next.resize(h.size());
+  tbb::parallel_for(
+      0, p.blocks.count,
+      [&](int i) { land_block(h, o, p, i, w.kept.data() + p.kept_rows * n * i, w.next); },
+      tbb::simple_partitioner());
+  if (p.blocks.spill > 0) {
+    tbb::parallel_for(
+        0, p.blocks.count, [&](int i) { merge_shared_rows(n, p, i, w.kept, w.next); },
+        tbb::simple_partitioner());
+  }
+  std::swap(w.next, h.values());
 }
 
 void saltate(terrain::HeightField& h, const SandOptions& o) {
-  const int n = h.width();
-  const double max_flight = n - 1.0;
-  const bool shadows = o.shadow_deg > 0.0;
-  const double shadow_drop =
-      std::tan(o.shadow_deg * std::numbers::pi / 180.0) * o.cell_m / o.height_unit;
-  for_rows(h.height(), [&](int row) {
-    float* line = &h(0, row);
-    // Per-row double accumulator (thread-local scratch).
-    thread_local std::vector<double> acc;
-    thread_local std::vector<int> next_shadowed;
-    thread_local std::vector<char> shadowed;
-    acc.assign(line, line + n);
-    if (shadows) wind_shadow(line, n, shadow_drop, shadowed, next_shadowed);
-    for (int x = 0; x < n; ++x) {
-      double flight, lift;
-      if (o.model == Model::Ripples) {
-        flight = o.L0 + o.b * line[x];  // paper eq. 1: L = L0 + b H
-        lift = o.q;
-      } else {
-        // Paper eqs. 2-3 with the central slope along the wind.
-        const int xl = x == 0 ? n - 1 : x - 1, xr = x + 1 == n ? 0 : x + 1;
-        const double g = fast_tanh(0.5f * (line[xr] - line[xl]));
-        flight = o.L0 - o.b * g;
-        lift = o.q + o.b_prime * g;
-      }
-      flight = std::clamp(flight, 0.0, max_flight);
-      double land = x + flight;
-      if (shadows) {
-        // Werner (1995): the lee of a crest is out of the wind. Sand there is
-        // not lifted, and grains flying into it are caught at its edge.
-        if (shadowed[x]) lift = 0.0;
-        land = std::min(land, static_cast<double>(next_shadowed[x]));
-      }
-      const int i0 = static_cast<int>(land);
-      const double frac = land - i0;
-      const int a = i0 >= n ? i0 - n : i0;
-      const int b = a + 1 >= n ? a + 1 - n : a + 1;
-      acc[x] -= lift;
-      acc[a] += lift * (1.0 - frac);
-      acc[b] += lift * frac;
-    }
-    for (int x = 0; x < n; ++x) line[x] = static_cast<float>(acc[x]);
-  });
+  Workspace w;
+  saltate(h, o, w);
 }
 
 void creep(terrain::HeightField& h, double coefficient) {
+  Workspace w;
+  creep(h, coefficient, w);
+}
+
+void creep(terrain::HeightField& h, double coefficient, Workspace& ws) {
   const int w = h.width(), rows = h.height();
-  std::vector<float> next(h.size());
+  ws.next.resize(h.size());
   const float d = static_cast<float>(coefficient / 4.0);
   for_rows(rows, [&](int row) {
-    const float* c = &h(0, row);
-    const float* n = &h(0, row == 0 ? rows - 1 : row - 1);
-    const float* s = &h(0, row + 1 == rows ? 0 : row + 1);
-    float* out = &next[static_cast<std::size_t>(row) * w];
-    for (int x = 0; x < w; ++x) {
-      const int xl = x == 0 ? w - 1 : x - 1, xr = x + 1 == w ? 0 : x + 1;
-      // Sum of edge fluxes d * (neighbour - centre): antisymmetric per edge.
+    const float* __restrict c = &h(0, row);
+    const float* __restrict n = &h(0, row == 0 ? rows - 1 : row - 1);
+    const float* __restrict s = &h(0, row + 1 == rows ? 0 : row + 1);
+    float* __restrict out = &ws.next[static_cast<std::size_t>(row) * w];
+    // Sum of edge fluxes d * (neighbour - centre): antisymmetric per edge.
+    // The wrapped columns apart, so the loop between them vectorises.
+    auto cell = [&](int x, int xl, int xr) {
       out[x] = c[x] + d * ((c[xl] - c[x]) + (c[xr] - c[x]) + (n[x] - c[x]) + (s[x] - c[x]));
-    }
+    };
+    cell(0, w - 1, 1);
+    for (int x = 1; x + 1 < w; ++x) cell(x, x - 1, x + 1);
+    cell(w - 1, w - 2, 0);
   });
-  std::swap(next, h.values());
+  std::swap(ws.next, h.values());
+}
+
+void step(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
+  saltate(h, o, w);
+  creep(h, o.creep, w);
+  // Sweeps with nothing steeper than the limit move nothing (the fluxes are
+  // exactly 0), so checking first only saves time: worth it where slopes stay
+  // gentle (ripples), not while slip faces are active (dunes).
+  const bool check = !w.steep || w.steps % 8 == 0;
+  w.steep = avalanche(h, max_drop(o), kSweepsPerStep, check ? 1e-4 : -1.0, w.next) > 0;
+  ++w.steps;
 }
 
 void step(terrain::HeightField& h, const SandOptions& o) {
-  saltate(h, o);
-  creep(h, o.creep);
-  avalanche(h, max_drop(o), kSweepsPerStep);
+  Workspace w;
+  step(h, o, w);
 }
 
 terrain::HeightField run(const SandOptions& o, const ProgressFn& progress, int snapshot_every,
                          const SnapshotFn& snapshot) {
   validate(o);
   terrain::HeightField h = initial_field(o);
+  Workspace w;
   progress(0.0, "sand");
   for (int s = 0; s < o.steps; ++s) {
-    step(h, o);
+    step(h, o, w);
     if (snapshot_every > 0 && snapshot && (s + 1) % snapshot_every == 0) snapshot(s + 1, h);
     if ((s + 1) % 8 == 0 && !progress(static_cast<double>(s + 1) / o.steps, "")) {
       throw Cancelled();
     }
   }
-  if (o.steps > 0) avalanche(h, max_drop(o), kFinalSweeps, 1e-3 * max_drop(o));
+  if (o.steps > 0) avalanche(h, max_drop(o), kFinalSweeps, 1e-3 * max_drop(o), w.next);
   progress(1.0, "");
   return h;
 }
 
 terrain::HeightField to_ground(const terrain::HeightField& m, const SandOptions& o) {
-  const int n = m.width();
-  // Downwind direction as a compass azimuth; the model's +x must point there.
-  const double downwind = o.wind_from_deg + 180.0;
-  // Angle (clockwise, map view) that turns the model's east (+x) to downwind.
-  const double turn_deg = std::fmod(std::fmod(downwind - 90.0, 360.0) + 360.0, 360.0);
-  terrain::HeightField g(n, m.height(), 0.0f, terrain::local_georeference(o.cell_m));
+  terrain::HeightField g = turn_to_ground(m, wind_frame(o.wind_from_deg));
+  g.geo() = terrain::local_georeference(o.cell_m);
   const float scale = static_cast<float>(o.height_unit);
-  const double quarter = turn_deg / 90.0;
-  if (std::fabs(quarter - std::round(quarter)) < 1e-9) {
-    // Exact quarter turns (square grids): tileable.
-    const int turns = static_cast<int>(std::lround(quarter)) % 4;
-    for (int row = 0; row < n; ++row) {
-      for (int x = 0; x < n; ++x) {
-        // Ground (x, row) <- model cell turned back by `turns` clockwise quarters.
-        int mx = x, mr = row;
-        for (int t = 0; t < turns; ++t) {
-          const int px = mx;  // inverse of a clockwise quarter: (x, r) <- (r, n-1-x)
-          mx = mr;
-          mr = n - 1 - px;
-        }
-        g(x, row) = m(mx, mr) * scale;
-      }
-    }
-    return g;
-  }
-  // Any other azimuth: sample the periodic model field along turned axes.
-  const double a = turn_deg * std::numbers::pi / 180.0;
-  const double c = std::cos(a), s = std::sin(a);
-  const double half = 0.5 * (n - 1);
-  for (int row = 0; row < n; ++row) {
-    for (int x = 0; x < n; ++x) {
-      // Ground offsets (east, north) from the centre, turned back by -a.
-      const double e = x - half, north = half - row;
-      const double me = c * e - s * north, mn = s * e + c * north;
-      const double fx = me + half, fr = half - mn;
-      const int x0 = static_cast<int>(std::floor(fx)), r0 = static_cast<int>(std::floor(fr));
-      const float tx = static_cast<float>(fx - x0), tr = static_cast<float>(fr - r0);
-      g(x, row) =
-          scale * ((1 - tr) * ((1 - tx) * m.wrapped(x0, r0) + tx * m.wrapped(x0 + 1, r0)) +
-                   tr * ((1 - tx) * m.wrapped(x0, r0 + 1) + tx * m.wrapped(x0 + 1, r0 + 1)));
-    }
-  }
+  for (float& v : g.values()) v *= scale;
   return g;
 }
 

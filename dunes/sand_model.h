@@ -2,17 +2,21 @@
 // after Nishimori & Ouchi 1993, PRL 71:197): wind ripples and dunes from
 // saltation and creep, plus avalanching to the angle of repose (SPEC 2).
 //
-// Frames and units. The model runs in the wind's frame: the wind blows along
-// +x (columns), so every row saltates independently. Flight lengths are in
-// cells and heights in the model's dimensionless unit, as in the paper; one
-// model unit is `height_unit` metres and one cell `cell_m` metres, which fixes
-// the physical slopes that avalanching limits. simulate() turns the result to
-// the wind's azimuth and into metres.
+// Frames and units. The model runs in the wind's frame (dunes/wind_frame.h):
+// the ground grid turned by whole quarter turns so that the wind blows within
+// 45 degrees of +x (columns), along (cos a, sin a). Flights land anywhere on
+// the periodic grid, so every azimuth gives a tileable field. Flight lengths
+// are in cells and heights in the model's dimensionless unit, as in the paper;
+// one model unit is `height_unit` metres and one cell `cell_m` metres, which
+// fixes the physical slopes that avalanching limits. to_ground() turns the
+// result back by the quarter turns and into metres.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
+#include "dunes/wind_shadow.h"
 #include "terrain/grid.h"
 #include "terrain/progress.h"
 
@@ -56,17 +60,35 @@ void validate(const SandOptions& options);
 // The seeded random start in the wind's frame (model units).
 terrain::HeightField initial_field(const SandOptions& options);
 
-// Saltation along +x (paper eq. 1 or eqs. 2-3): every cell lifts q and drops it
-// L cells downwind, a non-integer landing shared linearly between the two
-// cells around it. Row by row in double precision: exact mass bookkeeping and
-// the same bits for any thread count.
+// Scratch memory of a run, kept from step to step (allocating it every step
+// costs page faults and clearing).
+struct Workspace {
+  std::vector<double> kept;  // saltation: rows that blocks share, summed last
+  ShadowMap shadow;          // the wind shadow
+  std::vector<float> next;   // the new field (saltation, creep, avalanching)
+  // Steps done, and whether the last step's avalanching found steep edges:
+  // while slip faces keep forming, the per-step check (a full pass) is
+  // skipped but every 8th step.
+  long long steps = 0;
+  bool steep = true;
+};
+
+// Saltation along the wind (paper eq. 1 or eqs. 2-3): every cell lifts q and
+// drops it L cells downwind, at (x + L cos a, y + L sin a) in the model frame;
+// a landing between cells is shared bilinearly among the 4 cells around it
+// (linearly between 2 for a wind along x, as the paper has it). Summed in
+// double precision in a fixed order: exact mass bookkeeping and the same bits
+// for any thread count.
+void saltate(terrain::HeightField& h, const SandOptions& options, Workspace& workspace);
 void saltate(terrain::HeightField& h, const SandOptions& options);
 
 // Creep: H += D/4 * (sum of the 4 neighbours - 4 H) (the paper's diffusion),
 // as antisymmetric fluxes across edges, so mass is conserved.
+void creep(terrain::HeightField& h, double coefficient, Workspace& workspace);
 void creep(terrain::HeightField& h, double coefficient);
 
-// One time step: saltate, creep, then `avalanche_sweeps` relaxation sweeps.
+// One time step: saltate, creep, then a few avalanche relaxation sweeps.
+void step(terrain::HeightField& h, const SandOptions& options, Workspace& workspace);
 void step(terrain::HeightField& h, const SandOptions& options);
 
 // The whole run in the wind's frame, in model units (for tests and snapshots).
@@ -75,10 +97,9 @@ using SnapshotFn = std::function<void(int step, const terrain::HeightField& mode
 terrain::HeightField run(const SandOptions& options, const ProgressFn& progress = no_progress,
                          int snapshot_every = 0, const SnapshotFn& snapshot = nullptr);
 
-// Model field (wind frame, model units) -> ground field: turned to the wind's
-// azimuth (north up) and in metres with a local georeference of cell_m.
-// Multiples of 90 degrees are exact and tileable; other azimuths resample the
-// periodic field bilinearly and are not tileable.
+// Model field (wind frame, model units) -> ground field: turned by the wind
+// frame's quarter turns (exact, tileable) and in metres with a local
+// georeference of cell_m.
 terrain::HeightField to_ground(const terrain::HeightField& model_field, const SandOptions& options);
 
 // run() then to_ground().

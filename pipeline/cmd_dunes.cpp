@@ -1,6 +1,6 @@
 // drift dunes: wind ripples or dunes by Nishimori-Ouchi saltation and creep
 // (paper 002) with avalanching, written as a float32 GeoTIFF height field in
-// metres (tileable when the wind blows along the grid's axes).
+// metres, tileable for every wind azimuth.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -91,7 +91,8 @@ void add_dunes_command(CLI::App& root) {
   sub->add_option("--steps", o.steps, "time steps [0, 1e7]; 0 writes the seeded start");
   sub->add_option("--wind", o.wind_from_deg,
                   "where the wind comes FROM, degrees clockwise from north, as in weather "
-                  "reports (270: a west wind). 0, 90, 180, 270 keep the field tileable");
+                  "reports (270: a west wind) [-360, 360]. Any azimuth: grains fly along it on the "
+                  "periodic grid, so the field always tiles");
   sub->add_option("--L0", o.L0, "base flight length in cells [0.5, 64]");
   sub->add_option("--b", o.b, "flight-length coefficient [0, 32]");
   sub->add_option("--q", o.q, "height lifted per cell and step (dunes: q0) [1e-4, 2]");

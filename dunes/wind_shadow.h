@@ -1,0 +1,65 @@
+// The wind shadow of a periodic height field for a wind along any direction
+// within 45 degrees of +x (after Werner 1995, "Eolian dunes: computer
+// simulations and attractor interpretation", Geology 23:1107; paper 002 has
+// none). The lee of a crest below a line falling at the shadow angle from it,
+// downwind, is out of the wind: no sand is lifted there and grains flying into
+// it are caught.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "terrain/grid.h"
+
+namespace drift::dunes {
+
+// Wind lines: line j runs through (x, j + t x) for every column x, t the rows
+// crossed per column (sin a / cos a, in [-1, 1]); the field is sampled on it
+// by linear interpolation between the two rows around it. Per line j and
+// column x, at [j * width + x]: bit 0 set if that sample is shadowed; the rest
+// (value >> 1) the columns to the first shadowed sample downwind on the line,
+// at most min(width, ceil(max_columns) + 1) (none that near). For t = 0 lines
+// are rows.
+//
+// Exact lines rather than digital (staircase) ones: a crest oblique to the
+// grid then casts the same shadow on every line, and dunes keep crests across
+// the wind instead of snapping to the grid's axes.
+using ShadowMap = std::vector<std::uint16_t>;
+
+// `drop_per_cell` (> 0): the shadow line's fall per cell of distance along
+// the wind, in height units. `max_columns`: the longest flight in columns;
+// distances beyond it are not needed. Lines are followed from as far upwind
+// as a shadow can reach (across the periodic edge) to that far downwind;
+// they are independent, so the result is the same for any thread count.
+void wind_shadow(const terrain::HeightField& h, double rows_per_column, double drop_per_cell,
+                 double max_columns, ShadowMap& shadow);
+
+inline bool shadowed(std::uint16_t s) { return (s & 1u) != 0; }
+inline int columns_to_shadow(std::uint16_t s) { return s >> 1; }
+
+// Where the wind lines cross column x (unwrapped): line j lies between rows
+// j + row and j + row + 1, `frac` of the way.
+struct Crossing {
+  int row;
+  double frac;
+};
+Crossing crossing(double rows_per_column, int x);
+
+// The two wind lines around cell (x, row) given column x's crossing (its row
+// taken modulo the field's rows, in [0, rows)), and the
+// weight of the first, so that a cell and the line samples near it share
+// weights the same way (linear interpolation and its adjoint). The second
+// line's weight is 1 - weight_a; it is 0 for t = 0, where a cell's line is
+// its row.
+struct CellLines {
+  int line_a, line_b;
+  double weight_a;
+};
+inline CellLines cell_lines(const Crossing& c, int row, int rows) {
+  // Line row - c.row passes c.frac below the cell, the one before it
+  // 1 - c.frac above.
+  const int a = row >= c.row ? row - c.row : row - c.row + rows;
+  return {a, a == 0 ? rows - 1 : a - 1, 1.0 - c.frac};
+}
+
+}  // namespace drift::dunes
