@@ -52,7 +52,7 @@ render::MaterialOverride read_material(Section& s, std::string& preset) {
   }
   const Eigen::Vector3f none = Eigen::Vector3f::Constant(-1.0f);
   if (const Eigen::Vector3f c = s.color("color", none); c != none) m.albedo = c;
-  if (const double r = s.number("roughness", -1.0, 0.0, 1.5); r >= 0.0)
+  if (const double r = s.number("roughness", -1.0, 0.0, render::kMaxRoughness); r >= 0.0)
     m.roughness = static_cast<float>(r);
   if (const double w = s.number("wetness", -1.0, 0.0, 1.0); w >= 0.0)
     m.wetness = static_cast<float>(w);
@@ -178,8 +178,8 @@ SceneFile read_scene_file(const fs::path& path) {
   if (const auto depth = snow.string("depth")) scene.snow_depth = resolve(*depth);
   if (const auto objects = snow.string("objects")) scene.snow_objects = resolve(*objects);
   in.surface.snow.albedo = snow.color("color", in.surface.snow.albedo);
-  in.surface.snow.roughness =
-      static_cast<float>(snow.number("roughness", in.surface.snow.roughness, 0.0, 1.5));
+  in.surface.snow.roughness = static_cast<float>(
+      snow.number("roughness", in.surface.snow.roughness, 0.0, render::kMaxRoughness));
   in.surface.snow.forward_scattering = static_cast<float>(
       snow.number("forward_scattering", in.surface.snow.forward_scattering, 0.0, 1.0));
   in.surface.snow_scattering =

@@ -20,6 +20,9 @@
 
 namespace drift::render {
 
+// Oren-Nayar sigma beyond which the model is not meant to be used (radians).
+constexpr float kMaxRoughness = 1.5f;
+
 struct Material {
   Eigen::Vector3f albedo{0.28f, 0.26f, 0.23f};
   float roughness = 0.0f;  // sigma of the facet slopes, radians; 0 is Lambert

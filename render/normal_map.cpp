@@ -1,6 +1,8 @@
 #include "render/normal_map.h"
 
+#include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "terrain/error.h"
 
@@ -25,22 +27,37 @@ SlopePyramid::SlopePyramid(const terrain::HeightField& tile, double texel_metres
                               (tile.wrapped(x, row - 1) - tile.wrapped(x, row + 1)) * inv);
     }
   }
+  terrain::Grid<float> second(tile.width(), tile.height(), 0.0f);
+  for (std::size_t i = 0; i < base.size(); ++i) second.values()[i] = base.values()[i].squaredNorm();
   levels_.push_back(std::move(base));
+  second_.push_back(std::move(second));
   while (levels_.back().width() > 1 || levels_.back().height() > 1) {
     levels_.push_back(halve_periodic(levels_.back()));
+    second_.push_back(halve_periodic(second_.back()));
   }
 }
 
-terrain::Grid<Vector2f> halve_periodic(const terrain::Grid<Vector2f>& level) {
+template <class T>
+terrain::Grid<T> halve_periodic(const terrain::Grid<T>& level) {
   const int w = std::max(1, level.width() / 2), h = std::max(1, level.height() / 2);
-  terrain::Grid<Vector2f> out(w, h, Vector2f::Zero());
+  // Eigen vectors are not zeroed by T{}.
+  T zero{};
+  if constexpr (requires { T::Zero(); }) zero = T::Zero();
+  terrain::Grid<T> out(w, h, zero);
   // Each coarse texel averages the fine texels it covers: 2x2, or the whole
   // span when a side is odd (a 5-wide level becomes 2 texels of 2.5 each).
   const double sx = static_cast<double>(level.width()) / w;
   const double sy = static_cast<double>(level.height()) / h;
   for (int row = 0; row < h; ++row) {
     for (int x = 0; x < w; ++x) {
-      Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+      // Summed in double: Vector2d for slopes, double for moments.
+      auto sum = [&] {
+        if constexpr (std::is_same_v<T, float>) {
+          return 0.0;
+        } else {
+          return Eigen::Vector2d::Zero().eval();
+        }
+      }();
       double weight = 0.0;
       const double x0 = x * sx, x1 = (x + 1) * sx, y0 = row * sy, y1 = (row + 1) * sy;
       for (int fy = static_cast<int>(std::floor(y0)); fy < static_cast<int>(std::ceil(y1)); ++fy) {
@@ -48,20 +65,35 @@ terrain::Grid<Vector2f> halve_periodic(const terrain::Grid<Vector2f>& level) {
         for (int fx = static_cast<int>(std::floor(x0)); fx < static_cast<int>(std::ceil(x1));
              ++fx) {
           const double wx = std::min<double>(fx + 1, x1) - std::max<double>(fx, x0);
-          sum += level.wrapped(fx, fy).cast<double>() * (wx * wy);
+          if constexpr (std::is_same_v<T, float>) {
+            sum += static_cast<double>(level.wrapped(fx, fy)) * (wx * wy);
+          } else {
+            sum += level.wrapped(fx, fy).template cast<double>() * (wx * wy);
+          }
           weight += wx * wy;
         }
       }
-      out(x, row) = (sum / weight).cast<float>();
+      if constexpr (std::is_same_v<T, float>) {
+        out(x, row) = static_cast<float>(sum / weight);
+      } else {
+        out(x, row) = (sum / weight).template cast<float>();
+      }
     }
   }
   return out;
 }
 
-Vector2f SlopePyramid::sample_level(int i, double u, double v) const {
-  const auto& g = levels_[static_cast<std::size_t>(i)];
-  // Texel centres of level i sit at (k + 0.5) * size; v runs north, rows south.
-  const double size_x = tile_metres_x() / g.width(), size_y = tile_metres_y() / g.height();
+template terrain::Grid<Vector2f> halve_periodic(const terrain::Grid<Vector2f>&);
+template terrain::Grid<float> halve_periodic(const terrain::Grid<float>&);
+
+namespace {
+
+// Bilinear sample of a periodic level of a tile `tile_x` x `tile_y` metres at
+// (u east, v north).
+template <class T>
+T bilinear(const terrain::Grid<T>& g, double tile_x, double tile_y, double u, double v) {
+  // Texel centres sit at (k + 0.5) * size; v runs north, rows south.
+  const double size_x = tile_x / g.width(), size_y = tile_y / g.height();
   const double fx = u / size_x - 0.5, fr = -v / size_y - 0.5;
   const double x0 = std::floor(fx), r0 = std::floor(fr);
   const float tx = static_cast<float>(fx - x0), tr = static_cast<float>(fr - r0);
@@ -72,15 +104,43 @@ Vector2f SlopePyramid::sample_level(int i, double u, double v) const {
          tr * ((1 - tx) * g.wrapped(xi, ri + 1) + tx * g.wrapped(xi + 1, ri + 1));
 }
 
-Vector2f SlopePyramid::sample(double u, double v, double footprint_metres) const {
+}  // namespace
+
+Vector2f SlopePyramid::sample_level(int i, double u, double v) const {
+  return bilinear(levels_[static_cast<std::size_t>(i)], tile_metres_x(), tile_metres_y(), u, v);
+}
+
+void SlopePyramid::choose_level(double footprint_metres, int& lo, float& t) const {
   // Level whose texel matches the footprint: log2(footprint / texel), clamped.
   const double lod =
       std::clamp(std::log2(std::max(footprint_metres, 1e-30) / texel_), 0.0, levels() - 1.0);
-  const int lo = static_cast<int>(lod);
-  const float t = static_cast<float>(lod - lo);
+  lo = static_cast<int>(lod);
+  t = lo + 1 < levels() ? static_cast<float>(lod - lo) : 0.0f;
+}
+
+Vector2f SlopePyramid::sample(double u, double v, double footprint_metres) const {
+  int lo = 0;
+  float t = 0.0f;
+  choose_level(footprint_metres, lo, t);
   Vector2f a = sample_level(lo, u, v);
-  if (t <= 0.0f || lo + 1 >= levels()) return a;
+  if (t <= 0.0f) return a;
   return (1 - t) * a + t * sample_level(lo + 1, u, v);
+}
+
+SlopePyramid::Moments SlopePyramid::sample_moments(double u, double v,
+                                                   double footprint_metres) const {
+  int lo = 0;
+  float t = 0.0f;
+  choose_level(footprint_metres, lo, t);
+  auto second_at = [&](int i) {
+    return bilinear(second_[static_cast<std::size_t>(i)], tile_metres_x(), tile_metres_y(), u, v);
+  };
+  Moments m;
+  m.slope = sample(u, v, footprint_metres);
+  float e2 = second_at(lo);
+  if (t > 0.0f) e2 = (1 - t) * e2 + t * second_at(lo + 1);
+  m.variance = std::max(0.0f, e2 - m.slope.squaredNorm());
+  return m;
 }
 
 }  // namespace drift::render

@@ -8,6 +8,13 @@
 // alike (no shimmer up close, no false flattening far away). The wind-ripple
 // normal maps of paper 002 (256, 128, 64, 32 levels chosen per quad by
 // distance) become this pyramid, with the level chosen per ray.
+//
+// Next to the slopes the pyramid keeps their second moment E[|g|^2], box
+// filtered the same way (moments average linearly too), as LEAN mapping does
+// (Olano & Baker 2010, "LEAN mapping"): at any footprint the variance
+// E[|g|^2] - |E[g]|^2 is the relief the filter averaged away, which the
+// renderer turns into roughness, so far ripples still darken and texture the
+// sand's shading at low sun instead of vanishing.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,16 +40,31 @@ class SlopePyramid {
   // Slope (dh/du, dh/dv) at tile coordinates (u east, v north, metres; the tile
   // repeats) averaged over a footprint `footprint_metres` wide.
   Eigen::Vector2f sample(double u, double v, double footprint_metres) const;
+  // The same mean slope and the variance of the slopes within the footprint,
+  // E[|g|^2] - |E[g]|^2 (>= 0): what the footprint does not resolve.
+  struct Moments {
+    Eigen::Vector2f slope{0, 0};
+    float variance = 0.0f;
+  };
+  Moments sample_moments(double u, double v, double footprint_metres) const;
   // Bilinear slope of one level (tests).
   Eigen::Vector2f sample_level(int level, double u, double v) const;
   const terrain::Grid<Eigen::Vector2f>& level(int i) const { return levels_[i]; }
+  // E[|g|^2] of level i's texels (tests).
+  const terrain::Grid<float>& second_moment(int i) const { return second_[i]; }
 
  private:
+  // The level of detail for a footprint: levels lo and lo + 1, blended by t.
+  void choose_level(double footprint_metres, int& lo, float& t) const;
+
   std::vector<terrain::Grid<Eigen::Vector2f>> levels_;
+  std::vector<terrain::Grid<float>> second_;
   double texel_ = 1.0;
 };
 
-// Halves a periodic slope grid by 2x2 box averages (odd sizes wrap around).
-terrain::Grid<Eigen::Vector2f> halve_periodic(const terrain::Grid<Eigen::Vector2f>& level);
+// Halves a periodic grid by 2x2 box averages (odd sizes wrap around); for
+// slopes (Eigen::Vector2f) and their second moments (float).
+template <class T>
+terrain::Grid<T> halve_periodic(const terrain::Grid<T>& level);
 
 }  // namespace drift::render

@@ -118,7 +118,15 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
       const double a = r.rotation_deg * std::numbers::pi / 180.0;
       const double c = std::cos(a), s = std::sin(a);
       const double u = c * x - s * y, v = s * x + c * y;
-      const Eigen::Vector2f g_tile = r.slopes.sample(u, v, footprint) * (r.strength * keep);
+      const SlopePyramid::Moments m = r.slopes.sample_moments(u, v, footprint);
+      const float scale = r.strength * keep;
+      const Eigen::Vector2f g_tile = m.slope * scale;
+      // The ripple relief the footprint averaged away roughens the sand
+      // (LEAN mapping): facets tilted by its rms slope, added in quadrature
+      // to the sand's own Oren-Nayar sigma.
+      const float rms_slope = std::sqrt(m.variance) * scale;
+      const float sigma = std::atan(rms_slope);
+      p.material.roughness = std::min(std::hypot(p.material.roughness, sigma), kMaxRoughness);
       // Slope back to ground axes (the inverse rotation).
       const Eigen::Vector2f g(static_cast<float>(c * g_tile.x() + s * g_tile.y()),
                               static_cast<float>(-s * g_tile.x() + c * g_tile.y()));

@@ -97,6 +97,51 @@ TEST(SlopePyramid, FineLevelGivesTheAnalyticSlopeAndFarAwayTheMean) {
       0.0f, 1e-5f);
 }
 
+TEST(SlopePyramid, VarianceIsTheReliefTheFootprintAveragesAway) {
+  // h = A sin(2 pi u / L): up close the footprint resolves the slope (no
+  // variance); over a whole tile the mean slope is 0 and the variance is the
+  // mean of g^2 = (A 2 pi / L)^2 / 2 (central differences: within 0.5 %).
+  const double texel = 0.05, amplitude = 0.02;
+  const SlopePyramid p(sine_tile(256, texel, 4, amplitude), texel);
+  const double g_max = amplitude * 2 * kPi / (256 * texel / 4);
+  const double texel_centre = 7.5 * texel;
+  EXPECT_LT(p.sample_moments(texel_centre, -0.5 * texel, 0.0).variance, 1e-6 * g_max * g_max);
+  const auto far = p.sample_moments(0.3, 0.2, 1000.0);
+  EXPECT_NEAR(far.slope.norm(), 0.0f, 1e-6f);
+  EXPECT_NEAR(far.variance, 0.5 * g_max * g_max, 5e-3 * 0.5 * g_max * g_max);
+  // E[|g|^2] is kept level to level (the mean of every level's second moment).
+  auto mean = [](const drift::terrain::Grid<float>& g) {
+    double s = 0.0;
+    for (float v : g.values()) s += v;
+    return s / static_cast<double>(g.size());
+  };
+  for (int i = 0; i + 1 < p.levels(); ++i)
+    EXPECT_NEAR(mean(p.second_moment(i)), mean(p.second_moment(i + 1)), 1e-6 * g_max * g_max);
+}
+
+TEST(Ripples, FarRipplesRoughenTheSand) {
+  // Far away (a footprint of many tiles) the ripples' mean tilt is gone but
+  // their relief becomes Oren-Nayar roughness: sigma = atan(strength x rms
+  // slope), in quadrature with the sand's own; up close nearly none is added.
+  TerrainSurface s;
+  s.ground.roughness = 0.3f;
+  RippleLayer layer;
+  const double texel = 0.05, amplitude = 0.02;
+  layer.slopes = SlopePyramid(sine_tile(256, texel, 4, amplitude), texel);
+  layer.strength = 2.0f;
+  s.ripples = layer;
+  const Eigen::Vector3f up(0, 0, 1);
+  const double g_rms = amplitude * 2 * kPi / (256 * texel / 4) / std::sqrt(2.0);
+  const float far = shade_terrain(s, 0.3, -0.2, up, 1000.0).material.roughness;
+  EXPECT_NEAR(far, std::hypot(0.3, std::atan(2.0 * g_rms)), 2e-3);
+  const float near = shade_terrain(s, 7.5 * texel, -0.5 * texel, up, 0.0).material.roughness;
+  EXPECT_NEAR(near, 0.3f, 1e-3f);
+  // No ripples on slip faces: no roughness from them either.
+  const float a = static_cast<float>(33.0 * kPi / 180.0);
+  const Eigen::Vector3f face(std::sin(a), 0.0f, std::cos(a));
+  EXPECT_FLOAT_EQ(shade_terrain(s, 0.3, -0.2, face, 1000.0).material.roughness, 0.3f);
+}
+
 TEST(SlopePyramid, RejectsBadTiles) {
   HeightField bad = noise_tile(8, 8);
   bad(3, 3) = NAN;
