@@ -43,12 +43,12 @@ render::MaterialOverride read_material(Section& s, std::string& preset) {
   preset.clear();
   if (const auto name = s.string("material")) {
     preset = *name;
-    const auto preset = render::material_preset(*name);
-    if (!preset) {
+    const auto found = render::material_preset(*name);
+    if (!found) {
       s.invalid("material",
                 "is '" + *name + "'; known materials: " + render::material_preset_names());
     }
-    m = render::full_override(*preset);
+    m = render::full_override(*found);
   }
   const Eigen::Vector3f none = Eigen::Vector3f::Constant(-1.0f);
   if (const Eigen::Vector3f c = s.color("color", none); c != none) m.albedo = c;
@@ -57,6 +57,14 @@ render::MaterialOverride read_material(Section& s, std::string& preset) {
   if (const double w = s.number("wetness", -1.0, 0.0, 1.0); w >= 0.0)
     m.wetness = static_cast<float>(w);
   return m;
+}
+
+// A rule or layer must set something.
+void require_material(const Section& s, const render::MaterialOverride& m) {
+  if (m.empty()) {
+    s.invalid_table("sets no material: give 'material' (" + render::material_preset_names() +
+                    ") or 'color', 'roughness' or 'wetness'");
+  }
 }
 
 // The coverage channel of a rule or layer (render/coverage.h): `name`, else
@@ -99,10 +107,7 @@ render::MaterialRule read_rule(const toml::table* table, const fs::path& file, s
   rule.slope = read_range(s, "slope", 0.0, 90.0, 5.0);
   rule.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
   s.finish();
-  if (rule.material.empty()) {
-    s.invalid_table("sets no material: give 'material' (" + render::material_preset_names() +
-                    ") or 'color', 'roughness' or 'wetness'");
-  }
+  require_material(s, rule.material);
   return rule;
 }
 
@@ -119,10 +124,7 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
   layer.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
   s.finish();
   if (!mask_file) s.invalid_table("needs 'mask' (a raster in [0, 1] in the DEM's CRS)");
-  if (layer.material.empty()) {
-    s.invalid_table("sets no material: give 'material' (" + render::material_preset_names() +
-                    ") or 'color', 'roughness' or 'wetness'");
-  }
+  require_material(s, layer.material);
   mask =
       fs::path(*mask_file).is_absolute() ? fs::path(*mask_file) : file.parent_path() / *mask_file;
   return layer;

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "render/brdf.h"
+#include "render/color.h"
 #include "render/sampling.h"
 
 namespace drift::render {
@@ -12,10 +13,6 @@ namespace drift::render {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-
-float luminance(const Eigen::Vector3f& c) {
-  return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z();
-}
 
 constexpr float kF0 = fresnel_f0(kWaterIor);
 // The film's hemispherical (cosine-weighted) reflectance from above with

@@ -41,9 +41,7 @@ const std::array<Preset, 5> kPresets = {{
 }  // namespace
 
 Material mix(const Material& a, const Material& b, float t) {
-  return {a.albedo * (1 - t) + b.albedo * t, a.roughness * (1 - t) + b.roughness * t,
-          a.wetness * (1 - t) + b.wetness * t,
-          a.forward_scattering * (1 - t) + b.forward_scattering * t};
+  return blend(a, full_override(b), t);
 }
 
 std::optional<Material> material_preset(std::string_view name) {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <type_traits>
 
 #include "terrain/error.h"
 
@@ -37,6 +36,16 @@ SlopePyramid::SlopePyramid(const terrain::HeightField& tile, double texel_metres
   }
 }
 
+namespace {
+
+// Sums run in double: slopes as Vector2d, moments as double.
+double widen(float v) { return v; }
+Eigen::Vector2d widen(const Vector2f& v) { return v.cast<double>(); }
+float narrow(double v) { return static_cast<float>(v); }
+Vector2f narrow(const Eigen::Vector2d& v) { return v.cast<float>(); }
+
+}  // namespace
+
 template <class T>
 terrain::Grid<T> halve_periodic(const terrain::Grid<T>& level) {
   const int w = std::max(1, level.width() / 2), h = std::max(1, level.height() / 2);
@@ -50,14 +59,7 @@ terrain::Grid<T> halve_periodic(const terrain::Grid<T>& level) {
   const double sy = static_cast<double>(level.height()) / h;
   for (int row = 0; row < h; ++row) {
     for (int x = 0; x < w; ++x) {
-      // Summed in double: Vector2d for slopes, double for moments.
-      auto sum = [&] {
-        if constexpr (std::is_same_v<T, float>) {
-          return 0.0;
-        } else {
-          return Eigen::Vector2d::Zero().eval();
-        }
-      }();
+      auto sum = widen(zero);
       double weight = 0.0;
       const double x0 = x * sx, x1 = (x + 1) * sx, y0 = row * sy, y1 = (row + 1) * sy;
       for (int fy = static_cast<int>(std::floor(y0)); fy < static_cast<int>(std::ceil(y1)); ++fy) {
@@ -65,19 +67,11 @@ terrain::Grid<T> halve_periodic(const terrain::Grid<T>& level) {
         for (int fx = static_cast<int>(std::floor(x0)); fx < static_cast<int>(std::ceil(x1));
              ++fx) {
           const double wx = std::min<double>(fx + 1, x1) - std::max<double>(fx, x0);
-          if constexpr (std::is_same_v<T, float>) {
-            sum += static_cast<double>(level.wrapped(fx, fy)) * (wx * wy);
-          } else {
-            sum += level.wrapped(fx, fy).template cast<double>() * (wx * wy);
-          }
+          sum += widen(level.wrapped(fx, fy)) * (wx * wy);
           weight += wx * wy;
         }
       }
-      if constexpr (std::is_same_v<T, float>) {
-        out(x, row) = static_cast<float>(sum / weight);
-      } else {
-        out(x, row) = (sum / weight).template cast<float>();
-      }
+      out(x, row) = narrow(decltype(sum)(sum / weight));
     }
   }
   return out;

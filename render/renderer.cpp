@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "render/brdf.h"
 #include "render/bsdf.h"
+#include "render/color.h"
 #include "render/light_shafts.h"
 #include "render/physical_sky.h"
 #include "render/random.h"
@@ -38,8 +38,6 @@ Vector3f direction_from_az_el(double azimuth_deg, double elevation_deg) {
 }
 
 float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCoeff()); }
-
-float luminance(const Vector3f& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
 struct PixelSample {
   Vector3f radiance{0, 0, 0};

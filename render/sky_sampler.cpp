@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "render/color.h"
+
 namespace drift::render {
 
 namespace {
@@ -43,9 +45,8 @@ SkySampler::SkySampler(const std::function<Eigen::Vector3f(const Eigen::Vector3f
     for (int c = 0; c < columns; ++c) {
       const float phi = 2.0f * kPi * (static_cast<float>(c) + 0.5f) / static_cast<float>(columns);
       const Eigen::Vector3f d(sin_t * std::cos(phi), sin_t * std::sin(phi), cos_t);
-      const Eigen::Vector3f l = radiance(d);
       // Luminance (Rec. 709) times the cell's solid-angle factor sin(theta).
-      f[c] = std::max(0.0f, 0.2126f * l.x() + 0.7152f * l.y() + 0.0722f * l.z()) * sin_t;
+      f[c] = std::max(0.0f, luminance(radiance(d))) * sin_t;
     }
     conditional_.emplace_back(std::move(f));
     row_integrals[r] = conditional_.back().integral();

@@ -46,7 +46,7 @@ struct TerrainSurface {
   std::string ground_name = "ground";  // its coverage channel (render/coverage.h)
   std::vector<MaterialRule> rules;
   std::vector<MaterialLayer> layers;
-  Material snow{{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f, 0.5f};  // the "snow" preset
+  Material snow = *material_preset("snow");
   // Kubelka-Munk scattering coefficient S of the snowpack, per metre: with a
   // depth raster, snow of depth d over the ground reflects layer_albedo(snow,
   // ground, S d) (render/material.h). 400/m: fresh snow of about 0.1 mm grains
