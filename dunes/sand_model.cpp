@@ -2,7 +2,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,9 +10,11 @@
 #include <vector>
 
 #include "dunes/avalanche.h"
+#include "dunes/height_range.h"
 #include "dunes/wind_frame.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
+#include "terrain/simd.h"
 
 namespace drift::dunes {
 
@@ -47,7 +48,7 @@ void require_range(const char* name, double v, double lo, double hi) {
 // 2e-7 for |x| < 4.97 and clamped to +-1 beyond, where tanh is 1 within 1e-4:
 // a third of the time of libm's tanhf, and the same bits everywhere. Branch
 // free (selects), so loops over it vectorise.
-inline float fast_tanh(float x) {
+DRIFT_SIMD_KERNEL float fast_tanh(float x) {
   const float above = x > -4.97f ? x : -4.97f;
   const float c = above < 4.97f ? above : 4.97f;
   const float x2 = c * c;
@@ -165,13 +166,7 @@ struct Blocks {
 double max_flight(const terrain::HeightField& h, const SandOptions& o) {
   double longest = o.L0 + o.b;  // dunes: L0 - b tanh(.) <= L0 + b
   if (o.model == Model::Ripples) {
-    const float top = tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, h.size(), 1 << 16), -1e30f,
-        [&](const tbb::blocked_range<std::size_t>& r, float m) {
-          for (std::size_t i = r.begin(); i < r.end(); ++i) m = std::max(m, h.values()[i]);
-          return m;
-        },
-        [](float a, float b) { return std::max(a, b); });
+    const float top = height_range(h).hi;
     longest = o.L0 + o.b * top;
   }
   return std::clamp(longest, 0.0, h.width() - 1.0);
@@ -199,103 +194,233 @@ Blocks landing_blocks(const terrain::HeightField& h, double longest, const WindF
   return b;
 }
 
-// Paper eq. 1 (ripples) or eqs. 2-3 (dunes) along one row: the flight of each
-// cell in columns (its length along the wind times cos a) and its lift.
-void launch_row(const terrain::HeightField& h, const SandOptions& o, const WindFrame& wind, int row,
-                double* __restrict columns, double* __restrict lift) {
-  const int n = h.width(), rows = h.height();
-  const float* __restrict c = &h(0, row);
-  // Options as locals (the outputs could alias them otherwise), and flights
-  // kept within a lap by selects: the loops vectorise.
-  const double longest = n - 1.0, cos_a = wind.cos_a, L0 = o.L0, b = o.b, q = o.q;
-  const double b_prime = o.b_prime;
-  auto along = [=](double flight) {
-    const double positive = flight > 0.0 ? flight : 0.0;
-    return (positive < longest ? positive : longest) * cos_a;
-  };
-  if (o.model == Model::Ripples) {
-    for (int x = 0; x < n; ++x) {
-      columns[x] = along(L0 + b * c[x]);  // L = L0 + b H
-      lift[x] = q;
-    }
-    return;
-  }
-  // dH/dx of eqs. 2-3 is the slope along the wind: the gradient (central
-  // differences, periodic) dotted with the wind's direction.
-  const float* __restrict up = &h(0, row == 0 ? rows - 1 : row - 1);
-  const float* __restrict down = &h(0, row + 1 == rows ? 0 : row + 1);
-  const float cx = static_cast<float>(wind.cos_a), cy = static_cast<float>(wind.sin_a);
+// A flight of `flight` cells along the wind in columns (times cos a), kept
+// within a lap (`longest` cells) by selects so that loops over it vectorise.
+DRIFT_SIMD_KERNEL double columns_along(double flight, double longest, double cos_a) {
+  const double positive = flight > 0.0 ? flight : 0.0;
+  return (positive < longest ? positive : longest) * cos_a;
+}
+
+// Eqs. 2-3 along a row c between rows up and down: dH/dx is the slope along
+// the wind, the gradient (central differences, periodic) dotted with the
+// wind's direction (cx, cy).
+struct DuneLaunch {
+  float cx, cy;
+  double L0, b, q, b_prime, longest, cos_a;
+};
+
+DRIFT_SIMD_KERNEL void launch_dunes_kernel(const float* __restrict c, const float* __restrict up,
+                                           const float* __restrict down, int n, const DuneLaunch& p,
+                                           double* __restrict columns, double* __restrict lift) {
+  // Parameters as locals: the outputs could alias them otherwise.
+  const float cx = p.cx, cy = p.cy;
+  const double L0 = p.L0, b = p.b, q = p.q, b_prime = p.b_prime, longest = p.longest;
+  const double cos_a = p.cos_a;
   auto fill = [&](int x, int xl, int xr) {
     const double g = fast_tanh(cx * (0.5f * (c[xr] - c[xl])) + cy * (0.5f * (down[x] - up[x])));
-    columns[x] = along(L0 - b * g);
+    columns[x] = columns_along(L0 - b * g, longest, cos_a);
     lift[x] = q + b_prime * g;
   };
   fill(0, n - 1, 1);
   for (int x = 1; x + 1 < n; ++x) fill(x, x - 1, x + 1);
   fill(n - 1, n - 2, 0);
 }
+DRIFT_SIMD_TWINS(launch_dunes, launch_dunes_kernel,
+                 (const float* c, const float* up, const float* down, int n, const DuneLaunch& p,
+                  double* columns, double* lift),
+                 (c, up, down, n, p, columns, lift))
 
-// Adds `lift` at (land_x, land_y) (cells; land_x >= 0, land_y relative to
-// the window's first row and inside it), shared bilinearly among the 4 cells
-// around it, wrapping round the columns. kOblique false: the wind is along
-// x and land_y a whole row (the same code without the row's share).
-template <bool kOblique>
-inline void deposit(double* window, int n, double land_x, double land_y, double lift) {
-  const int i0 = static_cast<int>(land_x);
-  const double fx = land_x - i0;
-  const int a = i0 >= n ? i0 - n : i0, b = a + 1 == n ? 0 : a + 1;
-  const int j0 = static_cast<int>(land_y);  // land_y >= 0: truncation floors
-  const double fy = kOblique ? land_y - j0 : 0.0;
-  double* top = window + static_cast<std::size_t>(j0) * n;
-  if (fy == 0.0) {  // on a row (always, for a wind along x): two cells
-    top[a] += lift * (1.0 - fx);
-    top[b] += lift * fx;
+// Paper eq. 1 (ripples) or eqs. 2-3 (dunes) along one row: the flight of each
+// cell in columns (its length along the wind times cos a) and its lift.
+void launch_row(const terrain::HeightField& h, const SandOptions& o, const WindFrame& wind, int row,
+                double* __restrict columns, double* __restrict lift) {
+  const int n = h.width(), rows = h.height();
+  const float* __restrict c = &h(0, row);
+  const double longest = n - 1.0, cos_a = wind.cos_a, L0 = o.L0, b = o.b, q = o.q;
+  if (o.model == Model::Ripples) {
+    for (int x = 0; x < n; ++x) {
+      columns[x] = columns_along(L0 + b * c[x], longest, cos_a);  // L = L0 + b H
+      lift[x] = q;
+    }
     return;
   }
-  double* bottom = top + n;
-  const double upper = lift * (1.0 - fy), lower = lift * fy;
-  top[a] += upper * (1.0 - fx);
-  top[b] += upper * fx;
-  bottom[a] += lower * (1.0 - fx);
-  bottom[b] += lower * fx;
+  const DuneLaunch p{.cx = static_cast<float>(wind.cos_a),
+                     .cy = static_cast<float>(wind.sin_a),
+                     .L0 = L0,
+                     .b = b,
+                     .q = q,
+                     .b_prime = o.b_prime,
+                     .longest = longest,
+                     .cos_a = cos_a};
+  launch_dunes(c, &h(0, row == 0 ? rows - 1 : row - 1), &h(0, row + 1 == rows ? 0 : row + 1), n, p,
+               columns, lift);
+}
+
+// Where each flight of a row lands in the window: the window index of the
+// cell left of the landing on its top row and of the one right of it
+// (columns wrap), and the sand each of the (up to) 4 cells around the
+// landing gets, shared bilinearly (linearly between 2 for a wind along x,
+// as the paper has it).
+struct Landings {
+  std::vector<std::int32_t> left, right;
+  std::vector<double> top_left, top_right, bottom_left, bottom_right;
+};
+
+// Per-row scratch of saltation: each cell's flight (columns) and lift, for
+// an oblique wind with shadows the flight and part along its second wind
+// line, and where they land.
+struct RowScratch {
+  std::vector<double> columns, lift, columns_b, lift_b;
+  Landings landings;
+  void resize(int n) {
+    for (auto* v : {&columns, &lift, &columns_b, &lift_b, &landings.top_left, &landings.top_right,
+                    &landings.bottom_left, &landings.bottom_right}) {
+      v->resize(n);
+    }
+    landings.left.resize(n);
+    landings.right.resize(n);
+  }
+};
+
+// Where the flights (`reach` columns downwind, carrying `part`) of the row
+// at window row y land: (x + reach, y + reach t), t = 0 for a wind along x
+// (kOblique false). Every landing stays inside the window (its rows reach
+// the longest flight beyond the block). Branch free, so it vectorises; the
+// scattering adds are left to fly().
+template <bool kOblique>
+DRIFT_SIMD_KERNEL void aim_kernel(int n, int y, double t, const double* __restrict reach,
+                                  const double* __restrict part, std::int32_t* __restrict left,
+                                  std::int32_t* __restrict right, double* __restrict top_left,
+                                  double* __restrict top_right, double* __restrict bottom_left,
+                                  double* __restrict bottom_right) {
+  for (int x = 0; x < n; ++x) {
+    const double land_x = x + reach[x];
+    const int i0 = static_cast<int>(land_x);
+    const double fx = land_x - i0;
+    const int a = i0 >= n ? i0 - n : i0, b = a + 1 == n ? 0 : a + 1;
+    int top = y * n;
+    double upper = part[x];
+    if (kOblique) {
+      const double land_y = y + reach[x] * t;
+      const int j0 = static_cast<int>(land_y);  // land_y >= 0: truncation floors
+      const double fy = land_y - j0;
+      top = j0 * n;
+      upper = part[x] * (1.0 - fy);
+      const double lower = part[x] * fy;
+      bottom_left[x] = lower * (1.0 - fx);
+      bottom_right[x] = lower * fx;
+    }
+    left[x] = top + a;
+    right[x] = top + b;
+    top_left[x] = upper * (1.0 - fx);
+    top_right[x] = upper * fx;
+  }
+}
+#define DRIFT_AIM_PARAMS                                                                \
+  (int n, int y, double t, const double* reach, const double* part, std::int32_t* left, \
+   std::int32_t* right, double* top_left, double* top_right, double* bottom_left,       \
+   double* bottom_right)
+#define DRIFT_AIM_ARGS \
+  (n, y, t, reach, part, left, right, top_left, top_right, bottom_left, bottom_right)
+DRIFT_SIMD_TWINS(aim_along_x, aim_kernel<false>, DRIFT_AIM_PARAMS, DRIFT_AIM_ARGS)
+DRIFT_SIMD_TWINS(aim_oblique, aim_kernel<true>, DRIFT_AIM_PARAMS, DRIFT_AIM_ARGS)
+#undef DRIFT_AIM_PARAMS
+#undef DRIFT_AIM_ARGS
+
+template <bool kOblique>
+void aim(int n, int y, double t, const double* reach, const double* part, Landings& l) {
+  (kOblique ? aim_oblique : aim_along_x)(n, y, t, reach, part, l.left.data(), l.right.data(),
+                                         l.top_left.data(), l.top_right.data(),
+                                         l.bottom_left.data(), l.bottom_right.data());
+}
+
+// Lifts `part` from each cell of the row at window row y and adds it where
+// aim() found it lands (a share of 0 on a landing exactly on a row adds
+// nothing).
+template <bool kOblique>
+void fly(int n, int y, const double* part, const Landings& l, double* window) {
+  double* source = window + static_cast<std::size_t>(y) * n;
+  for (int x = 0; x < n; ++x) {
+    source[x] -= part[x];
+    window[l.left[x]] += l.top_left[x];
+    window[l.right[x]] += l.top_right[x];
+    if (kOblique) {
+      window[l.left[x] + n] += l.bottom_left[x];
+      window[l.right[x] + n] += l.bottom_right[x];
+    }
+  }
+}
+
+// For a wind along x, shade_row's line is the row and the shadow map's row
+// is read straight through: a loop that vectorises.
+DRIFT_SIMD_KERNEL void shade_along_x_kernel(const std::uint16_t* __restrict shadow, int n,
+                                            double* __restrict columns, double* __restrict lift) {
+  for (int x = 0; x < n; ++x) {
+    const int s = shadow[x];
+    // Times 1 or 0 (lifts are >= 0): exact, and unlike a select GCC
+    // vectorises it.
+    lift[x] *= static_cast<double>(~s & 1);
+    columns[x] = std::min(columns[x], static_cast<double>(s >> 1));
+  }
+}
+DRIFT_SIMD_TWINS(shade_along_x, shade_along_x_kernel,
+                 (const std::uint16_t* shadow, int n, double* columns, double* lift),
+                 (shadow, n, columns, lift))
+
+// Where a row's sand flies when the lee of crests is out of the wind
+// (Werner 1995): sand there is not lifted, and grains flying into it are
+// caught at its edge. A cell's sand follows the two wind lines around it in
+// proportion (one line, its row, for a wind along x): on entry `lift` and
+// `columns` hold the cell's lift and flight; on return the part that flies
+// along the first line and how far it gets, and in `lift_b`, `columns_b`
+// the same for the second (kOblique only).
+template <bool kOblique>
+void shade_row(const ShadowMap& shadow, const Crossing* crossings, int n, int row, int rows,
+               double* __restrict columns, double* __restrict lift, double* __restrict columns_b,
+               double* __restrict lift_b) {
+  if (!kOblique) {
+    shade_along_x(&shadow[static_cast<std::size_t>(row) * n], n, columns, lift);
+    return;
+  }
+  for (int x = 0; x < n; ++x) {
+    const CellLines lines = cell_lines(crossings[x], row, rows);
+    const double flight = columns[x], sand = lift[x];
+    const int s_a = shadow[static_cast<std::size_t>(lines.line_a) * n + x];
+    const int s_b = shadow[static_cast<std::size_t>(lines.line_b) * n + x];
+    // Times 1 or 0, as in shade_along_x: no branches on the relief.
+    lift[x] = sand * lines.weight_a * static_cast<double>(~s_a & 1);
+    columns[x] = std::min(flight, static_cast<double>(s_a >> 1));
+    lift_b[x] = sand * (1.0 - lines.weight_a) * static_cast<double>(~s_b & 1);
+    columns_b[x] = std::min(flight, static_cast<double>(s_b >> 1));
+  }
 }
 
 // One source row's landings into the window (`y`: the row's place in it).
 // `crossings`: where the wind lines cross each column (rows modulo the field's).
 // Compiled twice: kOblique false drops the sideways arithmetic of a wind
-// along x (a third of the work of a ripple step), nothing else.
+// along x (a third of the work of a ripple step), nothing else. The flights
+// are worked out first, in loops that vectorise, then flown (a shadowed part
+// is 0 and adds nothing).
 template <bool kOblique>
 void saltate_row(const terrain::HeightField& h, const SandOptions& o, const WindFrame& wind,
                  const ShadowMap* shadow, const Crossing* crossings, int row, int y, double* window,
-                 double* columns, double* lift) {
+                 RowScratch& scratch) {
   const int n = h.width();
   const double t = wind.rows_per_column();
+  double* columns = scratch.columns.data();
+  double* lift = scratch.lift.data();
   launch_row(h, o, wind, row, columns, lift);
-  double* source = window + static_cast<std::size_t>(y) * n;
-  if (!shadow) {
-    for (int x = 0; x < n; ++x) {
-      source[x] -= lift[x];
-      deposit<kOblique>(window, n, x + columns[x], y + columns[x] * t, lift[x]);
-    }
-    return;
+  const bool two_lines = kOblique && shadow;
+  if (shadow) {
+    shade_row<kOblique>(*shadow, crossings, n, row, h.height(), columns, lift,
+                        scratch.columns_b.data(), scratch.lift_b.data());
   }
-  for (int x = 0; x < n; ++x) {
-    // Werner (1995): the lee of a crest is out of the wind. Sand there is not
-    // lifted, and grains flying into it are caught at its edge. The cell's
-    // sand follows the two wind lines around it in proportion (one line, its
-    // row, for a wind along x).
-    const CellLines lines = cell_lines(crossings[x], row, h.height());
-    for (const auto& [line, share] :
-         {std::pair{lines.line_a, lines.weight_a}, std::pair{lines.line_b, 1.0 - lines.weight_a}}) {
-      if (share == 0.0) continue;
-      const std::uint16_t s = (*shadow)[static_cast<std::size_t>(line) * n + x];
-      if (shadowed(s)) continue;
-      const double part = lift[x] * share;
-      const double reach = std::min(columns[x], static_cast<double>(columns_to_shadow(s)));
-      source[x] -= part;
-      deposit<kOblique>(window, n, x + reach, y + reach * t, part);
-    }
-  }
+  auto flights = [&](const double* reach, const double* part) {
+    aim<kOblique>(n, y, t, reach, part, scratch.landings);
+    fly<kOblique>(n, y, part, scratch.landings, window);
+  };
+  flights(columns, lift);
+  if (two_lines) flights(scratch.columns_b.data(), scratch.lift_b.data());
 }
 
 // What saltation needs to know once per step.
@@ -313,11 +438,11 @@ void land_block(const terrain::HeightField& h, const SandOptions& o, const Salta
                 double* kept, std::vector<float>& out) {
   const int n = h.width();
   const Blocks& b = p.blocks;
-  thread_local std::vector<double> window, columns, lift;
+  thread_local std::vector<double> window;
+  thread_local RowScratch scratch;
   const int wb = b.window_begin(i), wrows = b.window_rows(i);
   window.resize(static_cast<std::size_t>(wrows) * n);
-  columns.resize(n);
-  lift.resize(n);
+  scratch.resize(n);
   // Own rows start from the heights, spill rows from 0.
   for (int r = b.begin(i); r < b.end(i); ++r)
     std::copy(&h(0, r), &h(0, r) + n, window.begin() + static_cast<std::size_t>(r - wb) * n);
@@ -327,8 +452,7 @@ void land_block(const terrain::HeightField& h, const SandOptions& o, const Salta
   const bool oblique = p.wind.rows_per_column() != 0.0;
   for (int r = b.begin(i); r < b.end(i); ++r) {
     (oblique ? saltate_row<true> : saltate_row<false>)(h, o, p.wind, p.shadow, p.crossings.data(),
-                                                       r, r - wb, window.data(), columns.data(),
-                                                       lift.data());
+                                                       r, r - wb, window.data(), scratch);
   }
   for (int r = wb; r < wb + wrows; ++r) {
     const double* from = window.data() + static_cast<std::size_t>(r - wb) * n;

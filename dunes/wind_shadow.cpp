@@ -1,14 +1,15 @@
 #include "dunes/wind_shadow.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <type_traits>
 #include <utility>
+
+#include "dunes/height_range.h"
 
 namespace drift::dunes {
 
@@ -33,26 +34,50 @@ struct Span {
   int warm_up, ahead;
 };
 
-// Shadow flags of lines [j0, j1) at columns [0, n + ahead): each sample below
-// the shadow line cast by the samples upwind of it.
+// Where the lines stand at each column followed, unwrapped column
+// -warm_up + i: the column in the field and where the lines cross it (rows
+// modulo the field's), worked out once per field rather than per line
+// block (integer division is slow).
+struct Stop {
+  int column, row;
+  double frac;
+};
+
+std::vector<Stop> stops(int n, int rows, double t, Span span) {
+  std::vector<Stop> out;
+  const int count = span.warm_up + n + span.ahead;  // under 3 laps of a width <= 32767
+  out.reserve(static_cast<std::size_t>(count));
+  for (int x = -span.warm_up; x < n + span.ahead; ++x) {
+    const Crossing c = crossing(t, x);
+    out.push_back({wrap(x, n), wrap(c.row, rows), c.frac});
+  }
+  return out;
+}
+
+// Shadow flags of lines [j0, j0 + kLines) at columns [0, n + ahead): each
+// sample below the shadow line cast by the samples upwind of it, at
 // flags[x * kLineBlock + (j - j0)].
-void mark_shadowed(const terrain::HeightField& h, double t, double drop_per_column, Span span,
-                   int j0, int j1, std::vector<std::uint8_t>& flags) {
+template <int kLines>
+void mark_shadowed(const terrain::HeightField& h, double drop_per_column, Span span,
+                   const std::vector<Stop>& path, int j0, std::uint8_t* flags) {
   const int n = h.width(), rows = h.height();
-  std::array<double, kLineBlock> carried;
+  // The lines' shadow heights, in registers: kLines is a constant, so the
+  // loop over lines unrolls.
+  std::array<double, kLines> carried;
   carried.fill(-1e300);
   const float* data = h.data();
   for (int x = -span.warm_up; x < n + span.ahead; ++x) {
-    const int column = wrap(x, n);
-    const Crossing c = crossing(t, x);
-    const int first = wrap(j0 + c.row, rows);
-    std::uint8_t* flag = &flags[static_cast<std::size_t>(x < 0 ? 0 : x) * kLineBlock];
-    for (int k = 0; k < j1 - j0; ++k) {
+    const int stop = x + span.warm_up;
+    const Stop& c = path[static_cast<std::size_t>(stop)];
+    const int first = j0 + c.row < rows ? j0 + c.row : j0 + c.row - rows;
+    std::uint8_t* flag = flags + static_cast<std::size_t>(x < 0 ? 0 : x) * kLineBlock;
+#pragma GCC unroll 8
+    for (int k = 0; k < kLines; ++k) {
       const int row = first + k < rows ? first + k : first + k - rows;
-      const float* at = data + static_cast<std::size_t>(row) * n + column;
+      const float* at = data + static_cast<std::size_t>(row) * n + c.column;
       double v = *at;
       if (c.frac != 0.0) {
-        const float* below = row + 1 == rows ? data + column : at + n;
+        const float* below = row + 1 == rows ? data + c.column : at + n;
         v = (1.0 - c.frac) * v + c.frac * *below;
       }
       double& line = carried[k];
@@ -63,42 +88,59 @@ void mark_shadowed(const terrain::HeightField& h, double t, double drop_per_colu
   }
 }
 
+// The same for a wind along x, where lines are rows: each row is read
+// straight through, in three runs that need no wrapping (the warm-up at the
+// end of the row, the row, then its start again for the distances ahead).
+template <int kLines>
+void mark_shadowed_rows(const terrain::HeightField& h, double drop_per_column, Span span, int j0,
+                        std::uint8_t* flags) {
+  const int n = h.width();
+  std::array<const float*, kLines> rows;
+  for (int k = 0; k < kLines; ++k) rows[k] = &h(0, j0 + k);
+  std::array<double, kLines> carried;
+  carried.fill(-1e300);
+  auto walk = [&](int begin, int end, int column_offset, bool record) {
+    for (int x = begin; x < end; ++x) {
+      std::uint8_t* flag = flags + static_cast<std::size_t>(x < 0 ? 0 : x) * kLineBlock;
+#pragma GCC unroll 8
+      for (int k = 0; k < kLines; ++k) {
+        const double v = rows[k][x + column_offset];
+        const double line = carried[k] - drop_per_column;
+        if (record) flag[k] = v < line;
+        carried[k] = std::max(line, v);
+      }
+    }
+  };
+  walk(-span.warm_up, 0, n, false);
+  walk(0, n, 0, true);
+  walk(n, n + span.ahead, -n, true);
+}
+
 // Per sample of lines [j0, j1) at columns [0, n): its flag and the columns to
-// the next shadowed sample downwind, at most `limit`.
+// the next shadowed sample downwind, at most `limit`. Branch free (the flags
+// follow the relief, which no predictor guesses).
 void measure_reach(int n, int limit, Span span, int j0, int j1,
                    const std::vector<std::uint8_t>& flags, ShadowMap& shadow) {
   for (int j = j0; j < j1; ++j) {
     int next = 1 << 30;  // no shadow seen yet
-    for (int x = n + span.ahead - 1; x >= 0; --x) {
-      const bool flagged = flags[static_cast<std::size_t>(x) * kLineBlock + (j - j0)] != 0;
-      if (x < n) {
-        const int reach = std::min(next - x, limit);
-        shadow[static_cast<std::size_t>(j) * n + x] =
-            static_cast<std::uint16_t>((reach << 1) | (flagged ? 1 : 0));
-      }
-      if (flagged) next = x;
+    std::uint16_t* out = &shadow[static_cast<std::size_t>(j) * n];
+    const std::uint8_t* flag = &flags[static_cast<std::size_t>(j - j0)];
+    for (int x = n + span.ahead - 1; x >= n; --x) {
+      next = flag[static_cast<std::size_t>(x) * kLineBlock] != 0 ? x : next;
+    }
+    for (int x = n - 1; x >= 0; --x) {
+      const int flagged = flag[static_cast<std::size_t>(x) * kLineBlock] != 0 ? 1 : 0;
+      const int reach = std::min(next - x, limit);
+      out[x] = static_cast<std::uint16_t>((reach << 1) | flagged);
+      next = flagged != 0 ? x : next;
     }
   }
 }
 
 // Columns before column 0 that a line must be followed for.
 int warm_up_columns(const terrain::HeightField& h, double drop_per_column) {
-  using Range = std::pair<float, float>;
-  const Range range = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, h.size(), 1 << 16), Range{1e30f, -1e30f},
-      [&](const tbb::blocked_range<std::size_t>& r, Range m) {
-        float lo = m.first, hi = m.second;  // selects: the loop vectorises
-        for (std::size_t i = r.begin(); i < r.end(); ++i) {
-          const float v = h.values()[i];
-          lo = v < lo ? v : lo;
-          hi = v > hi ? v : hi;
-        }
-        return Range{lo, hi};
-      },
-      [](Range a, Range b) {
-        return Range{std::min(a.first, b.first), std::max(a.second, b.second)};
-      });
-  const double columns = (static_cast<double>(range.second) - range.first) / drop_per_column + 2;
+  const HeightRange range = height_range(h);
+  const double columns = (static_cast<double>(range.hi) - range.lo) / drop_per_column + 2;
   return static_cast<int>(std::min<double>(h.width(), columns));
 }
 
@@ -113,13 +155,32 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
   const double drop_per_column = drop_per_cell * std::sqrt(1.0 + rows_per_column * rows_per_column);
   const int limit = static_cast<int>(std::min<double>(n, std::ceil(max_columns) + 1));
   const Span span{warm_up_columns(h, drop_per_column), limit};
+  const std::vector<Stop> path = stops(n, rows, rows_per_column, span);
+  // Blocks of kLineBlock lines side by side, the last one a line at a time
+  // if rows are not a multiple of kLineBlock.
+  const int blocks = (rows + kLineBlock - 1) / kLineBlock;
   tbb::parallel_for(
-      tbb::blocked_range<int>(0, rows, kLineBlock),
-      [&](const tbb::blocked_range<int>& r) {
+      0, blocks,
+      [&](int block) {
+        const int j0 = block * kLineBlock, j1 = std::min(rows, j0 + kLineBlock);
         thread_local std::vector<std::uint8_t> flags;
         flags.resize(static_cast<std::size_t>(n + span.ahead) * kLineBlock);
-        mark_shadowed(h, rows_per_column, drop_per_column, span, r.begin(), r.end(), flags);
-        measure_reach(n, limit, span, r.begin(), r.end(), flags, shadow);
+        auto mark = [&](auto lines, int first, std::uint8_t* at) {
+          constexpr int kLines = decltype(lines)::value;
+          if (rows_per_column == 0.0) {
+            mark_shadowed_rows<kLines>(h, drop_per_column, span, first, at);
+          } else {
+            mark_shadowed<kLines>(h, drop_per_column, span, path, first, at);
+          }
+        };
+        if (j1 - j0 == kLineBlock) {
+          mark(std::integral_constant<int, kLineBlock>{}, j0, flags.data());
+        } else {
+          for (int j = j0; j < j1; ++j) {
+            mark(std::integral_constant<int, 1>{}, j, flags.data() + (j - j0));
+          }
+        }
+        measure_reach(n, limit, span, j0, j1, flags, shadow);
       },
       tbb::simple_partitioner());
 }

@@ -1,0 +1,145 @@
+// The vectorised kernels of a sand step against their plain definitions:
+// one avalanche sweep against the 8-neighbour sum cell by cell, the wind
+// shadow along rows against the shadow line cast by every sample upwind, the
+// height range against std::minmax_element, and the AVX2 compilations
+// against the baseline ones, bit for bit.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <random>
+
+#include "dunes/avalanche.h"
+#include "dunes/height_range.h"
+#include "dunes/sand_model.h"
+#include "dunes/wind_shadow.h"
+#include "terrain/simd.h"
+
+using namespace drift::dunes;
+using drift::terrain::HeightField;
+
+namespace {
+
+// Uniform heights in [lo, hi) with a few tall spikes, on purpose at the
+// wrapped edges and corners too.
+HeightField spiky_field(int w, int h, float lo, float hi, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(lo, hi);
+  HeightField f(w, h);
+  for (float& v : f.values()) v = u(rng);
+  for (auto [x, y] : {std::pair{0, 0}, {w - 1, 0}, {0, h - 1}, {w - 1, h - 1}, {w / 2, h / 3}}) {
+    f(x, y) += 40.0f;
+  }
+  return f;
+}
+
+// One Jacobi sweep as the avalanche's doc defines it: every cell sums, over
+// its 8 neighbours in the order W, E, N, S, NW, NE, SW, SE, a ninth of the
+// excess drop across each edge (limit sqrt 2 times larger on diagonals).
+HeightField reference_sweep(const HeightField& h, float limit) {
+  const float diagonal = static_cast<float>(std::numbers::sqrt2 * limit);
+  auto flux = [](float a, float b, float lim) {
+    const float d = a - b;
+    return (std::max(d - lim, 0.0f) + std::min(d + lim, 0.0f)) * (1.0f / 9.0f);
+  };
+  const int w = h.width(), rows = h.height();
+  HeightField out(w, rows);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < w; ++x) {
+      auto at = [&](int dx, int dy) { return h((x + dx + w) % w, (y + dy + rows) % rows); };
+      const float v = h(x, y);
+      const float axis = flux(v, at(-1, 0), limit) + flux(v, at(1, 0), limit) +
+                         flux(v, at(0, -1), limit) + flux(v, at(0, 1), limit);
+      const float diag = flux(v, at(-1, -1), diagonal) + flux(v, at(1, -1), diagonal) +
+                         flux(v, at(-1, 1), diagonal) + flux(v, at(1, 1), diagonal);
+      out(x, y) = v - (axis + diag);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Kernels, AvalancheSweepsAreTheEightNeighbourSum) {
+  // Odd, non-square sizes: the wrapped columns and a short last row block.
+  for (auto [w, h] : {std::pair{37, 23}, {64, 64}, {9, 40}}) {
+    const float limit = 0.7f;
+    HeightField fast = spiky_field(w, h, 0.0f, 3.0f, 7);
+    HeightField slow = fast;
+    for (int sweep = 0; sweep < 5; ++sweep) {
+      avalanche(fast, limit, 1, -1.0);
+      slow = reference_sweep(slow, limit);
+      ASSERT_EQ(fast.values(), slow.values()) << w << "x" << h << ", sweep " << sweep;
+    }
+  }
+}
+
+TEST(Kernels, TheShadowAlongRowsIsCastByEverySampleUpwind) {
+  // Heights and drop in halves: every shadow line height is exact, so the
+  // definition can be evaluated directly. A sample is shadowed if some
+  // sample k columns upwind (periodic) stands more than k drops above it.
+  const int w = 48, rows = 11;
+  const double drop = 0.5;
+  std::mt19937 rng(3);
+  HeightField h(w, rows);
+  for (float& v : h.values()) v = 0.5f * static_cast<float>(rng() % 24);
+  ShadowMap shadow;
+  const int max_columns = 9;
+  wind_shadow(h, 0.0, drop, max_columns, shadow);
+  for (int row = 0; row < rows; ++row) {
+    std::vector<bool> expected(w, false);
+    for (int x = 0; x < w; ++x) {
+      for (int k = 1; k < w; ++k) {
+        if (h((x - k + w) % w, row) - k * drop > h(x, row)) expected[x] = true;
+      }
+    }
+    for (int x = 0; x < w; ++x) {
+      const std::uint16_t s = shadow[static_cast<std::size_t>(row) * w + x];
+      ASSERT_EQ(shadowed(s), expected[x]) << "row " << row << ", column " << x;
+      // Columns to the first shadowed sample downwind, at most the longest
+      // flight plus one.
+      int reach = 1;
+      while (reach < max_columns + 1 && !expected[(x + reach) % w]) ++reach;
+      EXPECT_EQ(columns_to_shadow(s), reach) << "row " << row << ", column " << x;
+    }
+  }
+}
+
+TEST(Kernels, HeightRangeIsTheSmallestAndLargestValue) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-50.0f, 50.0f);
+  for (auto [w, h] : {std::pair{1, 1}, {3, 5}, {17, 9}, {300, 301}}) {
+    HeightField f(w, h);
+    for (float& v : f.values()) v = u(rng);
+    const auto [lo, hi] = std::minmax_element(f.values().begin(), f.values().end());
+    const HeightRange r = height_range(f);
+    EXPECT_EQ(r.lo, *lo) << w << "x" << h;
+    EXPECT_EQ(r.hi, *hi) << w << "x" << h;
+  }
+}
+
+TEST(Kernels, TheAvx2TwinsGiveTheBaselineBits) {
+  if (drift::simd::active() != drift::simd::Isa::Avx2) {
+    GTEST_SKIP() << "this CPU has no AVX2 (or DRIFT_SIMD=sse2): one compilation runs";
+  }
+  for (double wind : {270.0, 300.0}) {
+    for (Model model : {Model::Dunes, Model::Ripples}) {
+      SandOptions o = default_options(model);
+      o.size = 72;
+      o.steps = 80;
+      o.wind_from_deg = wind;
+      const HeightField wide = run(o);
+      HeightField baseline;
+      {
+        const drift::simd::Limit sse2(drift::simd::Isa::Sse2);
+        ASSERT_EQ(drift::simd::active(), drift::simd::Isa::Sse2);
+        baseline = run(o);
+      }
+      EXPECT_EQ(drift::simd::active(), drift::simd::Isa::Avx2);
+      EXPECT_EQ(wide.values(), baseline.values())
+          << "wind " << wind << ", model " << static_cast<int>(model);
+    }
+  }
+}
