@@ -164,10 +164,14 @@ int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double t
           // south fluxes), its south edges and its east edges. The block's
           // first row needs the south fluxes of the row above it.
           thread_local std::vector<float> buffers;
-          buffers.resize(6 * static_cast<std::size_t>(w));
-          float* above[3] = {buffers.data(), buffers.data() + w, buffers.data() + 2 * w};
-          float* below[3] = {buffers.data() + 3 * w, buffers.data() + 4 * w,
-                             buffers.data() + 5 * w};
+          // Each buffer 32 floats further on than a multiple of the row: a
+          // load that trails a store by 4 KiB looks to the CPU like it
+          // depends on it (4K aliasing) and waits.
+          const std::size_t stride = static_cast<std::size_t>(w) + 32;
+          buffers.resize(6 * stride);
+          float* above[3] = {buffers.data(), buffers.data() + stride, buffers.data() + 2 * stride};
+          float* below[3] = {buffers.data() + 3 * stride, buffers.data() + 4 * stride,
+                             buffers.data() + 5 * stride};
           const int first = r.begin();
           south_fluxes(&h(0, first == 0 ? rows - 1 : first - 1), &h(0, first), w, limit, diagonal,
                        above[0], above[1], above[2]);
