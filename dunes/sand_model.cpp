@@ -95,6 +95,7 @@ SandOptions default_options(Model model) {
     o.initial_amplitude = 2.0;
     o.steps = 3000;
     o.shadow_deg = 15.0;
+    o.reattach = 1.0;
   }
   return o;
 }
@@ -113,14 +114,15 @@ void validate(const SandOptions& o) {
   require_range("repose", o.repose_deg, 1, 89);
   require_range("wind", o.wind_from_deg, -360, 360);
   require_range("shadow", o.shadow_deg, 0, 89);
+  require_range("reattach", o.reattach, 0, 16);
   if (o.model == Model::Dunes) {
     if (o.L0 <= o.b) throw Error("dunes need --L0 > --b, or windward flights go backwards");
     if (o.q <= o.b_prime) throw Error("dunes need --q > --b-prime, or the lift turns negative");
   }
   const std::uint64_t cells = static_cast<std::uint64_t>(o.size) * o.size;
   // Heights, the double accumulator of saltation, creep's next field, the
-  // wind shadow.
-  require_memory(cells * (4 + 8 + 4 + 2), "the sand grid", "choose a smaller --size");
+  // wind shadow and the lift's recovery past it.
+  require_memory(cells * (4 + 8 + 4 + 2 + 4), "the sand grid", "choose a smaller --size");
 }
 
 terrain::HeightField initial_field(const SandOptions& o) {
@@ -374,53 +376,36 @@ DRIFT_SIMD_TWINS(shade_along_x, shade_along_x_kernel,
 // `columns` hold the cell's lift and flight; on return the part that flies
 // along the first line and how far it gets, and in `lift_b`, `columns_b`
 // the same for the second (kOblique only).
+//
+// `recovery` (may be null: none): the share of the lift the wind takes up
+// past a shadow's end (shadow_recovery()), per line sample.
 template <bool kOblique>
-void shade_row(const ShadowMap& shadow, const Crossing* crossings, int n, int row, int rows,
-               double* __restrict columns, double* __restrict lift, double* __restrict columns_b,
-               double* __restrict lift_b) {
+void shade_row(const ShadowMap& shadow, const std::vector<float>* recovery,
+               const Crossing* crossings, int n, int row, int rows, double* __restrict columns,
+               double* __restrict lift, double* __restrict columns_b, double* __restrict lift_b) {
   if (!kOblique) {
-    shade_along_x(&shadow[static_cast<std::size_t>(row) * n], n, columns, lift);
+    const std::size_t at = static_cast<std::size_t>(row) * n;
+    shade_along_x(&shadow[at], n, columns, lift);
+    if (recovery) {
+      const float* r = &(*recovery)[at];
+      for (int x = 0; x < n; ++x) lift[x] *= r[x];
+    }
     return;
   }
   for (int x = 0; x < n; ++x) {
     const CellLines lines = cell_lines(crossings[x], row, rows);
     const double flight = columns[x], sand = lift[x];
-    const int s_a = shadow[static_cast<std::size_t>(lines.line_a) * n + x];
-    const int s_b = shadow[static_cast<std::size_t>(lines.line_b) * n + x];
+    const std::size_t at_a = static_cast<std::size_t>(lines.line_a) * n + x;
+    const std::size_t at_b = static_cast<std::size_t>(lines.line_b) * n + x;
+    const int s_a = shadow[at_a], s_b = shadow[at_b];
+    const double r_a = recovery ? (*recovery)[at_a] : 1.0;
+    const double r_b = recovery ? (*recovery)[at_b] : 1.0;
     // Times 1 or 0, as in shade_along_x: no branches on the relief.
-    lift[x] = sand * lines.weight_a * static_cast<double>(~s_a & 1);
+    lift[x] = sand * lines.weight_a * static_cast<double>(~s_a & 1) * r_a;
     columns[x] = std::min(flight, static_cast<double>(s_a >> 1));
-    lift_b[x] = sand * (1.0 - lines.weight_a) * static_cast<double>(~s_b & 1);
+    lift_b[x] = sand * (1.0 - lines.weight_a) * static_cast<double>(~s_b & 1) * r_b;
     columns_b[x] = std::min(flight, static_cast<double>(s_b >> 1));
   }
-}
-
-// One source row's landings into the window (`y`: the row's place in it).
-// `crossings`: where the wind lines cross each column (rows modulo the field's).
-// Compiled twice: kOblique false drops the sideways arithmetic of a wind
-// along x (a third of the work of a ripple step), nothing else. The flights
-// are worked out first, in loops that vectorise, then flown (a shadowed part
-// is 0 and adds nothing).
-template <bool kOblique>
-void saltate_row(const terrain::HeightField& h, const SandOptions& o, const WindFrame& wind,
-                 const ShadowMap* shadow, const Crossing* crossings, int row, int y, double* window,
-                 RowScratch& scratch) {
-  const int n = h.width();
-  const double t = wind.rows_per_column();
-  double* columns = scratch.columns.data();
-  double* lift = scratch.lift.data();
-  launch_row(h, o, wind, row, columns, lift);
-  const bool two_lines = kOblique && shadow;
-  if (shadow) {
-    shade_row<kOblique>(*shadow, crossings, n, row, h.height(), columns, lift,
-                        scratch.columns_b.data(), scratch.lift_b.data());
-  }
-  auto flights = [&](const double* reach, const double* part) {
-    aim<kOblique>(n, y, t, reach, part, scratch.landings);
-    fly<kOblique>(n, y, part, scratch.landings, window);
-  };
-  flights(columns, lift);
-  if (two_lines) flights(scratch.columns_b.data(), scratch.lift_b.data());
 }
 
 // What saltation needs to know once per step.
@@ -429,8 +414,35 @@ struct SaltationPlan {
   Blocks blocks;
   std::vector<Crossing> crossings;  // per column, rows modulo the field's
   const ShadowMap* shadow = nullptr;
-  std::size_t kept_rows = 0;  // per block: its shared rows, then its spill rows
+  const std::vector<float>* recovery = nullptr;  // with a shadow: see shadow_recovery()
+  std::size_t kept_rows = 0;                     // per block: its shared rows, then its spill rows
 };
+
+// One source row's landings into the window (`y`: the row's place in it).
+// Compiled twice: kOblique false drops the sideways arithmetic of a wind
+// along x (a third of the work of a ripple step), nothing else. The flights
+// are worked out first, in loops that vectorise, then flown (a shadowed part
+// is 0 and adds nothing).
+template <bool kOblique>
+void saltate_row(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p,
+                 int row, int y, double* window, RowScratch& scratch) {
+  const int n = h.width();
+  const double t = p.wind.rows_per_column();
+  double* columns = scratch.columns.data();
+  double* lift = scratch.lift.data();
+  launch_row(h, o, p.wind, row, columns, lift);
+  const bool two_lines = kOblique && p.shadow;
+  if (p.shadow) {
+    shade_row<kOblique>(*p.shadow, p.recovery, p.crossings.data(), n, row, h.height(), columns,
+                        lift, scratch.columns_b.data(), scratch.lift_b.data());
+  }
+  auto flights = [&](const double* reach, const double* part) {
+    aim<kOblique>(n, y, t, reach, part, scratch.landings);
+    fly<kOblique>(n, y, part, scratch.landings, window);
+  };
+  flights(columns, lift);
+  if (two_lines) flights(scratch.columns_b.data(), scratch.lift_b.data());
+}
 
 // Block i: its sources' landings summed in its window; rows nobody else
 // reaches go to `out` (rounded once), shared and spill rows to `kept`.
@@ -451,8 +463,7 @@ void land_block(const terrain::HeightField& h, const SandOptions& o, const Salta
               static_cast<std::size_t>(b.spill) * n, 0.0);
   const bool oblique = p.wind.rows_per_column() != 0.0;
   for (int r = b.begin(i); r < b.end(i); ++r) {
-    (oblique ? saltate_row<true> : saltate_row<false>)(h, o, p.wind, p.shadow, p.crossings.data(),
-                                                       r, r - wb, window.data(), scratch);
+    (oblique ? saltate_row<true> : saltate_row<false>)(h, o, p, r, r - wb, window.data(), scratch);
   }
   for (int r = wb; r < wb + wrows; ++r) {
     const double* from = window.data() + static_cast<std::size_t>(r - wb) * n;
@@ -497,6 +508,10 @@ void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
   if (shadows) {
     wind_shadow(h, t, shadow_drop(o), longest * p.wind.cos_a, w.shadow);
     p.shadow = &w.shadow;
+    if (o.reattach > 0.0) {
+      shadow_recovery(w.shadow, n, o.reattach, w.recovery);
+      p.recovery = &w.recovery;
+    }
   }
   p.blocks = landing_blocks(h, longest, p.wind);
   p.crossings.resize(n);

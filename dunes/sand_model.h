@@ -49,6 +49,12 @@ struct SandOptions {
   // Anderson 1987) makes them migrate downwind, but their crests come out
   // shorter and less regular than without. 0 turns it off.
   double shadow_deg = 0.0;
+  // With a shadow: past its end the lift rises linearly from 0 to full over
+  // this many times the shadow's length (the flow reattaching and the flux
+  // saturating; see shadow_recovery()). Dunes 1: gentle windward faces and
+  // crescent slip faces; 2 and more: separate crescents (barchanoid dunes);
+  // 0: the full lift at once, which scours pits with steep windward walls.
+  double reattach = 0.0;
 };
 
 // The defaults of each model (documented in `drift dunes --help`).
@@ -63,9 +69,10 @@ terrain::HeightField initial_field(const SandOptions& options);
 // Scratch memory of a run, kept from step to step (allocating it every step
 // costs page faults and clearing).
 struct Workspace {
-  std::vector<double> kept;  // saltation: rows that blocks share, summed last
-  ShadowMap shadow;          // the wind shadow
-  std::vector<float> next;   // the new field (saltation, creep, avalanching)
+  std::vector<double> kept;     // saltation: rows that blocks share, summed last
+  ShadowMap shadow;             // the wind shadow
+  std::vector<float> recovery;  // the lift's recovery past shadows
+  std::vector<float> next;      // the new field (saltation, creep, avalanching)
   // Steps done, and whether the last step's avalanching found steep edges:
   // while slip faces keep forming, the per-step check (a full pass) is
   // skipped but every 8th step.

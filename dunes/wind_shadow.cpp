@@ -185,6 +185,43 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
       tbb::simple_partitioner());
 }
 
+void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
+                     std::vector<float>& recovery) {
+  assert(ratio > 0 && width > 0);
+  const int n = width, lines = static_cast<int>(shadow.size() / static_cast<std::size_t>(n));
+  recovery.resize(shadow.size());
+  tbb::parallel_for(
+      0, lines,
+      [&](int j) {
+        const std::uint16_t* s = &shadow[static_cast<std::size_t>(j) * n];
+        float* out = &recovery[static_cast<std::size_t>(j) * n];
+        // Lines are periodic: start from the last shadow before column 0,
+        // the line's last shadowed run (if any) counted back from its end.
+        int last = n - 1;
+        while (last >= 0 && !shadowed(s[last])) --last;
+        if (last < 0) {
+          std::fill(out, out + n, 1.0f);
+          return;
+        }
+        int run = 0;  // length of the shadow last left behind, samples
+        for (int x = last; x >= 0 && shadowed(s[x]); --x) ++run;
+        int since = n - 1 - last;  // samples since that shadow
+        // The ramp's slope, worked out once per shadow left behind.
+        float slope = 1.0f / static_cast<float>(ratio * run);
+        for (int x = 0; x < n; ++x) {
+          if (shadowed(s[x])) {
+            run = since == 0 ? run + 1 : 1;
+            since = 0;
+            out[x] = 0.0f;
+            continue;
+          }
+          if (since++ == 0) slope = 1.0f / static_cast<float>(ratio * run);
+          out[x] = std::min(1.0f, static_cast<float>(since) * slope);
+        }
+      },
+      tbb::simple_partitioner());
+}
+
 Crossing crossing(double rows_per_column, int x) {
   const double y = rows_per_column * x;
   const double row = std::floor(y);

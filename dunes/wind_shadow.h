@@ -34,6 +34,20 @@ using ShadowMap = std::vector<std::uint16_t>;
 void wind_shadow(const terrain::HeightField& h, double rows_per_column, double drop_per_cell,
                  double max_columns, ShadowMap& shadow);
 
+// Beyond a shadow the wind does not take up sand at once: the flow
+// reattaches behind the separation bubble and the sand flux then saturates
+// over a distance (Kroy, Sauermann & Herrmann 2002, "Minimal model for sand
+// dunes", PRL 88:054301, the saturation length; paper 002 and Werner 1995
+// have neither). Per line sample, in the shadow map's layout: the share of
+// the full lift the wind takes up there, rising linearly from 0 at the end
+// of a shadow to 1 at `ratio` times that shadow's length (in samples) past
+// it; 0 inside shadows, 1 on lines without any. A lift that jumps to full at
+// the shadow's end scours a pit there whose downwind wall stands at the
+// angle of repose facing the wind; the ramp keeps windward faces gentle.
+// `shadow` as wind_shadow() filled it for the same field and lines.
+void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
+                     std::vector<float>& recovery);
+
 inline bool shadowed(std::uint16_t s) { return (s & 1u) != 0; }
 inline int columns_to_shadow(std::uint16_t s) { return s >> 1; }
 

@@ -48,6 +48,7 @@ void run_dunes(const DunesCommand& c, const CLI::App& sub) {
   if (given("--amplitude")) o.initial_amplitude = g.initial_amplitude;
   if (given("--repose")) o.repose_deg = g.repose_deg;
   if (given("--shadow")) o.shadow_deg = g.shadow_deg;
+  if (given("--reattach")) o.reattach = g.reattach;
   o.seed = c.seed;
   dunes::validate(o);
   const std::filesystem::path out = c.output;
@@ -76,7 +77,8 @@ void add_dunes_command(CLI::App& root) {
   sub->footer(
       "Defaults (ripples | dunes): --cell 0.015 | 1 m, --height-unit 0.0025 | 0.25 m, --steps "
       "500 | 3000,\n--L0 5 | 20, --b 2 | 1, --q 0.1 | 0.2, --b-prime - | 0.02, --creep 0.25, "
-      "--amplitude 1 | 2, --shadow 0 | 15.\nRipples: L = L0 + b H (cells, H in height units); "
+      "--amplitude 1 | 2, --shadow 0 | 15, --reattach - | 1.\nRipples: L = L0 + b H (cells, H in "
+      "height units); "
       "dunes: L = L0 - b "
       "tanh(dH/dx),\nq = q0 + b' tanh(dH/dx). Ripples form at about L0 + 1 cells; see "
       "docs/dunes.md.");
@@ -102,6 +104,9 @@ void add_dunes_command(CLI::App& root) {
   sub->add_option("--repose", o.repose_deg, "angle of repose of dry sand, degrees (34)");
   sub->add_option("--shadow", o.shadow_deg,
                   "wind-shadow angle behind crests, degrees (ripples 0, dunes 15; 0 = none)");
+  sub->add_option("--reattach", o.reattach,
+                  "with a shadow: the lift past it recovers over this many times the shadow's "
+                  "length [0, 16] (dunes 1: transverse dunes; 2+: crescents; 0: at once)");
   sub->add_option("--snapshot-every", c->snapshot_every,
                   "also write OUT_<step>.tif every K steps (for animations)")
       ->check(CLI::Range(1, 10000000));

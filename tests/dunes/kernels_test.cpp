@@ -143,3 +143,28 @@ TEST(Kernels, TheAvx2TwinsGiveTheBaselineBits) {
     }
   }
 }
+
+TEST(Kernels, TheLiftRecoversLinearlyOverTheShadowsLengthTimesTheRatio) {
+  // One line of 40 samples: a shadow over columns 10-13 (4 long), another
+  // over 36-39 running on into 0-1 across the periodic edge (6 long), and a
+  // line without shadow. Ratio 1.5: ramps of 6 and 9 samples.
+  const int n = 40;
+  ShadowMap shadow(2 * n, std::uint16_t{2});  // unshadowed, reach 1
+  auto shade = [&](int x) { shadow[x] |= 1u; };
+  for (int x = 10; x <= 13; ++x) shade(x);
+  for (int x : {36, 37, 38, 39, 0, 1}) shade(x);
+  std::vector<float> recovery;
+  shadow_recovery(shadow, n, 1.5, recovery);
+  for (int x = 0; x < n; ++x) {
+    double expected = 1.0;
+    if (shadowed(shadow[x])) {
+      expected = 0.0;
+    } else if (x >= 2 && x < 10) {
+      expected = std::min(1.0, (x - 1) / 9.0);
+    } else if (x >= 14 && x < 36) {
+      expected = std::min(1.0, (x - 13) / 6.0);
+    }
+    EXPECT_FLOAT_EQ(recovery[x], static_cast<float>(expected)) << "column " << x;
+    EXPECT_EQ(recovery[n + x], 1.0f) << "column " << x << " of the line without shadow";
+  }
+}
