@@ -354,20 +354,31 @@ void fly(int n, int y, const double* part, const Landings& l, double* window) {
 }
 
 // For a wind along x, shade_row's line is the row and the shadow map's row
-// is read straight through: a loop that vectorises.
-DRIFT_SIMD_KERNEL void shade_along_x_kernel(const std::uint16_t* __restrict shadow, int n,
+// (and the recovery's, if not null) is read straight through: a loop that
+// vectorises.
+DRIFT_SIMD_KERNEL void shade_along_x_kernel(const std::uint16_t* __restrict shadow,
+                                            const float* __restrict recovery, int n,
                                             double* __restrict columns, double* __restrict lift) {
+  // Times 1 or 0 (lifts are >= 0): exact, and unlike a select GCC
+  // vectorises it.
+  if (recovery) {
+    for (int x = 0; x < n; ++x) {
+      const int s = shadow[x];
+      lift[x] = lift[x] * static_cast<double>(~s & 1) * recovery[x];
+      columns[x] = std::min(columns[x], static_cast<double>(s >> 1));
+    }
+    return;
+  }
   for (int x = 0; x < n; ++x) {
     const int s = shadow[x];
-    // Times 1 or 0 (lifts are >= 0): exact, and unlike a select GCC
-    // vectorises it.
     lift[x] *= static_cast<double>(~s & 1);
     columns[x] = std::min(columns[x], static_cast<double>(s >> 1));
   }
 }
 DRIFT_SIMD_TWINS(shade_along_x, shade_along_x_kernel,
-                 (const std::uint16_t* shadow, int n, double* columns, double* lift),
-                 (shadow, n, columns, lift))
+                 (const std::uint16_t* shadow, const float* recovery, int n, double* columns,
+                  double* lift),
+                 (shadow, recovery, n, columns, lift))
 
 // Where a row's sand flies when the lee of crests is out of the wind
 // (Werner 1995): sand there is not lifted, and grains flying into it are
@@ -385,11 +396,7 @@ void shade_row(const ShadowMap& shadow, const std::vector<float>* recovery,
                double* __restrict lift, double* __restrict columns_b, double* __restrict lift_b) {
   if (!kOblique) {
     const std::size_t at = static_cast<std::size_t>(row) * n;
-    shade_along_x(&shadow[at], n, columns, lift);
-    if (recovery) {
-      const float* r = &(*recovery)[at];
-      for (int x = 0; x < n; ++x) lift[x] *= r[x];
-    }
+    shade_along_x(&shadow[at], recovery ? &(*recovery)[at] : nullptr, n, columns, lift);
     return;
   }
   for (int x = 0; x < n; ++x) {
@@ -506,12 +513,11 @@ void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
   // ahead the shadow must be known (neither matters for a plain wind along x).
   const double longest = t != 0.0 || shadows ? max_flight(h, o) : 0.0;
   if (shadows) {
-    wind_shadow(h, t, shadow_drop(o), longest * p.wind.cos_a, w.shadow);
+    const bool recovers = o.reattach > 0.0;
+    wind_shadow(h, t, shadow_drop(o), longest * p.wind.cos_a, w.shadow, o.reattach,
+                recovers ? &w.recovery : nullptr);
     p.shadow = &w.shadow;
-    if (o.reattach > 0.0) {
-      shadow_recovery(w.shadow, n, o.reattach, w.recovery);
-      p.recovery = &w.recovery;
-    }
+    if (recovers) p.recovery = &w.recovery;
   }
   p.blocks = landing_blocks(h, longest, p.wind);
   p.crossings.resize(n);

@@ -9,6 +9,10 @@
 #include <type_traits>
 #include <utility>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "dunes/height_range.h"
 
 namespace drift::dunes {
@@ -144,13 +148,67 @@ int warm_up_columns(const terrain::HeightField& h, double drop_per_column) {
   return static_cast<int>(std::min<double>(h.width(), columns));
 }
 
+// The first sample in [from, n) of a line of the shadow map whose shadow
+// flag is `flag`, or n. Eight samples at a time where SSE2 is there: runs in
+// and out of shadow are tens of samples long.
+int next_with_flag(const std::uint16_t* s, int from, int n, bool flag) {
+  int i = from;
+#if defined(__SSE2__)
+  const __m128i one = _mm_set1_epi16(1);
+  const __m128i wanted = flag ? one : _mm_setzero_si128();
+  for (; i + 8 <= n; i += 8) {
+    const __m128i bits =
+        _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(s + i)), one);
+    const int found = _mm_movemask_epi8(_mm_cmpeq_epi16(bits, wanted));
+    if (found != 0) return i + (__builtin_ctz(static_cast<unsigned>(found)) >> 1);
+  }
+#endif
+  while (i < n && shadowed(s[i]) != flag) ++i;
+  return i;
+}
+
+// The lift's recovery along one periodic line of n samples of the shadow
+// map (see shadow_recovery()).
+void recover_line(const std::uint16_t* s, int n, double ratio, float* out) {
+  // Start from the last shadow before column 0: the line's last shadowed
+  // run (if any), counted back from its end.
+  int last = n - 1;
+  while (last >= 0 && !shadowed(s[last])) --last;
+  if (last < 0) {
+    std::fill(out, out + n, 1.0f);
+    return;
+  }
+  int run = 0;  // length of the shadow last left behind, samples
+  for (int x = last; x >= 0 && shadowed(s[x]); --x) ++run;
+  int since = n - 1 - last;  // samples since that shadow
+  // Run by run: the scans take eight samples at a time, the fills vectorise.
+  for (int x = 0; x < n;) {
+    const bool in_shadow = shadowed(s[x]);
+    const int end = next_with_flag(s, x + 1, n, !in_shadow);
+    if (in_shadow) {
+      std::fill(out + x, out + end, 0.0f);
+      // A shadow at column 0 may continue the one at the line's end.
+      run = x == 0 && since == 0 ? run + end : end - x;
+      since = 0;
+    } else {
+      const float slope = 1.0f / static_cast<float>(ratio * run);
+      const int first = since + 1 - x;  // samples since the shadow at column x, minus x
+      for (int i = x; i < end; ++i) out[i] = std::min(1.0f, static_cast<float>(first + i) * slope);
+      since += end - x;
+    }
+    x = end;
+  }
+}
+
 }  // namespace
 
 void wind_shadow(const terrain::HeightField& h, double rows_per_column, double drop_per_cell,
-                 double max_columns, ShadowMap& shadow) {
+                 double max_columns, ShadowMap& shadow, double recovery_ratio,
+                 std::vector<float>* recovery) {
   assert(std::fabs(rows_per_column) <= 1.0 && h.width() <= 32767 && drop_per_cell > 0);
   const int n = h.width(), rows = h.height();
   shadow.resize(h.size());
+  if (recovery) recovery->resize(h.size());
   // A column step is sqrt(1 + t^2) cells along the wind.
   const double drop_per_column = drop_per_cell * std::sqrt(1.0 + rows_per_column * rows_per_column);
   const int limit = static_cast<int>(std::min<double>(n, std::ceil(max_columns) + 1));
@@ -181,6 +239,12 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
           }
         }
         measure_reach(n, limit, span, j0, j1, flags, shadow);
+        // The recovery while the block's lines of the map are at hand in
+        // cache, rather than in a pass of its own.
+        for (int j = j0; recovery && j < j1; ++j) {
+          const std::size_t at = static_cast<std::size_t>(j) * n;
+          recover_line(&shadow[at], n, recovery_ratio, &(*recovery)[at]);
+        }
       },
       tbb::simple_partitioner());
 }
@@ -193,31 +257,8 @@ void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
   tbb::parallel_for(
       0, lines,
       [&](int j) {
-        const std::uint16_t* s = &shadow[static_cast<std::size_t>(j) * n];
-        float* out = &recovery[static_cast<std::size_t>(j) * n];
-        // Lines are periodic: start from the last shadow before column 0,
-        // the line's last shadowed run (if any) counted back from its end.
-        int last = n - 1;
-        while (last >= 0 && !shadowed(s[last])) --last;
-        if (last < 0) {
-          std::fill(out, out + n, 1.0f);
-          return;
-        }
-        int run = 0;  // length of the shadow last left behind, samples
-        for (int x = last; x >= 0 && shadowed(s[x]); --x) ++run;
-        int since = n - 1 - last;  // samples since that shadow
-        // The ramp's slope, worked out once per shadow left behind.
-        float slope = 1.0f / static_cast<float>(ratio * run);
-        for (int x = 0; x < n; ++x) {
-          if (shadowed(s[x])) {
-            run = since == 0 ? run + 1 : 1;
-            since = 0;
-            out[x] = 0.0f;
-            continue;
-          }
-          if (since++ == 0) slope = 1.0f / static_cast<float>(ratio * run);
-          out[x] = std::min(1.0f, static_cast<float>(since) * slope);
-        }
+        const std::size_t at = static_cast<std::size_t>(j) * n;
+        recover_line(&shadow[at], n, ratio, &recovery[at]);
       },
       tbb::simple_partitioner());
 }

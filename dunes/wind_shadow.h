@@ -31,8 +31,11 @@ using ShadowMap = std::vector<std::uint16_t>;
 // distances beyond it are not needed. Lines are followed from as far upwind
 // as a shadow can reach (across the periodic edge) to that far downwind;
 // they are independent, so the result is the same for any thread count.
+// `recovery` (if not null): also shadow_recovery(shadow, width,
+// recovery_ratio, *recovery), worked out on the way.
 void wind_shadow(const terrain::HeightField& h, double rows_per_column, double drop_per_cell,
-                 double max_columns, ShadowMap& shadow);
+                 double max_columns, ShadowMap& shadow, double recovery_ratio = 0.0,
+                 std::vector<float>* recovery = nullptr);
 
 // Beyond a shadow the wind does not take up sand at once: the flow
 // reattaches behind the separation bubble and the sand flux then saturates

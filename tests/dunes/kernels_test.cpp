@@ -168,3 +168,21 @@ TEST(Kernels, TheLiftRecoversLinearlyOverTheShadowsLengthTimesTheRatio) {
     EXPECT_EQ(recovery[n + x], 1.0f) << "column " << x << " of the line without shadow";
   }
 }
+
+TEST(Kernels, TheShadowPassWorksOutTheSameRecoveryAsTheShadowMap) {
+  // wind_shadow() works out the recovery from its flags on the way; it must
+  // equal shadow_recovery() of the map it writes, along rows and obliquely.
+  HeightField h = spiky_field(96, 64, 0.0f, 6.0f, 5);
+  for (double t : {0.0, std::tan(30.0 * std::numbers::pi / 180.0)}) {
+    ShadowMap shadow;
+    std::vector<float> on_the_way, from_the_map;
+    wind_shadow(h, t, 0.3, 20, shadow, 1.5, &on_the_way);
+    shadow_recovery(shadow, h.width(), 1.5, from_the_map);
+    EXPECT_EQ(on_the_way, from_the_map) << "t = " << t;
+    const auto zeros = std::count(on_the_way.begin(), on_the_way.end(), 0.0f);
+    const auto ramps = std::count_if(on_the_way.begin(), on_the_way.end(),
+                                     [](float r) { return r > 0.0f && r < 1.0f; });
+    EXPECT_GT(zeros, 0) << "t = " << t;
+    EXPECT_GT(ramps, 0) << "t = " << t;
+  }
+}
