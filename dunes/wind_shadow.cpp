@@ -33,13 +33,22 @@ int wrap(int i, int n) {
 // The columns a line is followed: `warm_up` before column 0 (a lap at most:
 // no sample further upwind can still cast a shadow, as the shadow line falls
 // by more than the field's height range over them), then the field's width
-// and `ahead` more for the distances.
+// and `ahead` more for the distances. For the lift's recovery on oblique
+// lines, which do not close on themselves after a lap, also `history`
+// columns before 0 whose shadows are followed (after their own warm-up).
 struct Span {
-  int warm_up, ahead;
+  int warm_up, ahead, history = 0;
+  int before() const { return warm_up + history; }
+};
+
+// Where the lift's recovery stands on a line at column 0: the samples since
+// the last shadow before it and that shadow's length.
+struct LineStart {
+  int since = 1 << 29, run = 0;  // no shadow seen
 };
 
 // Where the lines stand at each column followed, unwrapped column
-// -warm_up + i: the column in the field and where the lines cross it (rows
+// -span.before() + i: the column in the field and where the lines cross it (rows
 // modulo the field's), worked out once per field rather than per line
 // block (integer division is slow).
 struct Stop {
@@ -49,9 +58,9 @@ struct Stop {
 
 std::vector<Stop> stops(int n, int rows, double t, Span span) {
   std::vector<Stop> out;
-  const int count = span.warm_up + n + span.ahead;  // under 3 laps of a width <= 32767
+  const int count = span.before() + n + span.ahead;
   out.reserve(static_cast<std::size_t>(count));
-  for (int x = -span.warm_up; x < n + span.ahead; ++x) {
+  for (int x = -span.before(); x < n + span.ahead; ++x) {
     const Crossing c = crossing(t, x);
     out.push_back({wrap(x, n), wrap(c.row, rows), c.frac});
   }
@@ -60,18 +69,21 @@ std::vector<Stop> stops(int n, int rows, double t, Span span) {
 
 // Shadow flags of lines [j0, j0 + kLines) at columns [0, n + ahead): each
 // sample below the shadow line cast by the samples upwind of it, at
-// flags[x * kLineBlock + (j - j0)].
+// flags[x * kLineBlock + (j - j0)]. With `starts`, also where the recovery
+// stands at column 0 on each line, from the shadows of the `history` columns
+// before it.
 template <int kLines>
 void mark_shadowed(const terrain::HeightField& h, double drop_per_column, Span span,
-                   const std::vector<Stop>& path, int j0, std::uint8_t* flags) {
+                   const std::vector<Stop>& path, int j0, std::uint8_t* flags, LineStart* starts) {
   const int n = h.width(), rows = h.height();
   // The lines' shadow heights, in registers: kLines is a constant, so the
   // loop over lines unrolls.
   std::array<double, kLines> carried;
   carried.fill(-1e300);
+  std::array<LineStart, kLines> start;
   const float* data = h.data();
-  for (int x = -span.warm_up; x < n + span.ahead; ++x) {
-    const int stop = x + span.warm_up;
+  for (int x = -span.before(); x < n + span.ahead; ++x) {
+    const int stop = x + span.before();
     const Stop& c = path[static_cast<std::size_t>(stop)];
     const int first = j0 + c.row < rows ? j0 + c.row : j0 + c.row - rows;
     std::uint8_t* flag = flags + static_cast<std::size_t>(x < 0 ? 0 : x) * kLineBlock;
@@ -86,10 +98,18 @@ void mark_shadowed(const terrain::HeightField& h, double drop_per_column, Span s
       }
       double& line = carried[k];
       line -= drop_per_column;
-      if (x >= 0) flag[k] = v < line;
+      const bool shadow = v < line;
+      if (x >= 0) {
+        flag[k] = shadow;
+      } else if (x >= -span.history) {
+        LineStart& s = start[k];
+        s.run = shadow ? (s.since == 0 ? s.run + 1 : 1) : s.run;
+        s.since = shadow ? 0 : s.since + 1;
+      }
       line = std::max(line, v);
     }
   }
+  if (starts) std::copy(start.begin(), start.end(), starts);
 }
 
 // The same for a wind along x, where lines are rows: each row is read
@@ -167,20 +187,26 @@ int next_with_flag(const std::uint16_t* s, int from, int n, bool flag) {
   return i;
 }
 
-// The lift's recovery along one periodic line of n samples of the shadow
-// map (see shadow_recovery()).
-void recover_line(const std::uint16_t* s, int n, double ratio, float* out) {
-  // Start from the last shadow before column 0: the line's last shadowed
-  // run (if any), counted back from its end.
-  int last = n - 1;
-  while (last >= 0 && !shadowed(s[last])) --last;
-  if (last < 0) {
-    std::fill(out, out + n, 1.0f);
-    return;
+// The lift's recovery along one line of n samples of the shadow map (see
+// shadow_recovery()), from where it stands at column 0: `start`, or if null
+// the line's own end (a line that closes on itself after a lap).
+void recover_line(const std::uint16_t* s, int n, double ratio, const LineStart* start, float* out) {
+  int since = 0, run = 0;
+  if (start) {
+    since = start->since;
+    run = start->run;
+  } else {
+    // The last shadow before column 0 is the line's last shadowed run (if
+    // any), counted back from its end.
+    int last = n - 1;
+    while (last >= 0 && !shadowed(s[last])) --last;
+    if (last < 0) {
+      std::fill(out, out + n, 1.0f);
+      return;
+    }
+    for (int x = last; x >= 0 && shadowed(s[x]); --x) ++run;
+    since = n - 1 - last;
   }
-  int run = 0;  // length of the shadow last left behind, samples
-  for (int x = last; x >= 0 && shadowed(s[x]); --x) ++run;
-  int since = n - 1 - last;  // samples since that shadow
   // Run by run: the scans take eight samples at a time, the fills vectorise.
   for (int x = 0; x < n;) {
     const bool in_shadow = shadowed(s[x]);
@@ -191,7 +217,8 @@ void recover_line(const std::uint16_t* s, int n, double ratio, float* out) {
       run = x == 0 && since == 0 ? run + end : end - x;
       since = 0;
     } else {
-      const float slope = 1.0f / static_cast<float>(ratio * run);
+      // No shadow seen yet (run 0): since is huge, the factor 1.
+      const float slope = run > 0 ? 1.0f / static_cast<float>(ratio * run) : 1.0f;
       const int first = since + 1 - x;  // samples since the shadow at column x, minus x
       for (int i = x; i < end; ++i) out[i] = std::min(1.0f, static_cast<float>(first + i) * slope);
       since += end - x;
@@ -212,7 +239,15 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
   // A column step is sqrt(1 + t^2) cells along the wind.
   const double drop_per_column = drop_per_cell * std::sqrt(1.0 + rows_per_column * rows_per_column);
   const int limit = static_cast<int>(std::min<double>(n, std::ceil(max_columns) + 1));
-  const Span span{warm_up_columns(h, drop_per_column), limit};
+  Span span{warm_up_columns(h, drop_per_column), limit};
+  // Rows close on themselves after a lap, so the recovery at column 0 can
+  // start from a row's own end. Oblique lines do not: follow each back over
+  // the history its recovery needs, the ramp after the longest shadow
+  // (no longer than the warm-up) and that shadow itself.
+  const bool oblique = rows_per_column != 0.0;
+  if (recovery && oblique) {
+    span.history = static_cast<int>(std::ceil((recovery_ratio + 1.0) * span.warm_up)) + 1;
+  }
   const std::vector<Stop> path = stops(n, rows, rows_per_column, span);
   // Blocks of kLineBlock lines side by side, the last one a line at a time
   // if rows are not a multiple of kLineBlock.
@@ -223,27 +258,30 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
         const int j0 = block * kLineBlock, j1 = std::min(rows, j0 + kLineBlock);
         thread_local std::vector<std::uint8_t> flags;
         flags.resize(static_cast<std::size_t>(n + span.ahead) * kLineBlock);
-        auto mark = [&](auto lines, int first, std::uint8_t* at) {
+        std::array<LineStart, kLineBlock> starts;
+        LineStart* starts_at = recovery && oblique ? starts.data() : nullptr;
+        auto mark = [&](auto lines, int first) {
           constexpr int kLines = decltype(lines)::value;
-          if (rows_per_column == 0.0) {
+          std::uint8_t* at = flags.data() + (first - j0);
+          if (!oblique) {
             mark_shadowed_rows<kLines>(h, drop_per_column, span, first, at);
           } else {
-            mark_shadowed<kLines>(h, drop_per_column, span, path, first, at);
+            mark_shadowed<kLines>(h, drop_per_column, span, path, first, at,
+                                  starts_at ? starts_at + (first - j0) : nullptr);
           }
         };
         if (j1 - j0 == kLineBlock) {
-          mark(std::integral_constant<int, kLineBlock>{}, j0, flags.data());
+          mark(std::integral_constant<int, kLineBlock>{}, j0);
         } else {
-          for (int j = j0; j < j1; ++j) {
-            mark(std::integral_constant<int, 1>{}, j, flags.data() + (j - j0));
-          }
+          for (int j = j0; j < j1; ++j) mark(std::integral_constant<int, 1>{}, j);
         }
         measure_reach(n, limit, span, j0, j1, flags, shadow);
         // The recovery while the block's lines of the map are at hand in
         // cache, rather than in a pass of its own.
         for (int j = j0; recovery && j < j1; ++j) {
           const std::size_t at = static_cast<std::size_t>(j) * n;
-          recover_line(&shadow[at], n, recovery_ratio, &(*recovery)[at]);
+          recover_line(&shadow[at], n, recovery_ratio, starts_at ? starts_at + (j - j0) : nullptr,
+                       &(*recovery)[at]);
         }
       },
       tbb::simple_partitioner());
@@ -258,7 +296,7 @@ void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
       0, lines,
       [&](int j) {
         const std::size_t at = static_cast<std::size_t>(j) * n;
-        recover_line(&shadow[at], n, ratio, &recovery[at]);
+        recover_line(&shadow[at], n, ratio, nullptr, &recovery[at]);
       },
       tbb::simple_partitioner());
 }

@@ -31,8 +31,11 @@ using ShadowMap = std::vector<std::uint16_t>;
 // distances beyond it are not needed. Lines are followed from as far upwind
 // as a shadow can reach (across the periodic edge) to that far downwind;
 // they are independent, so the result is the same for any thread count.
-// `recovery` (if not null): also shadow_recovery(shadow, width,
-// recovery_ratio, *recovery), worked out on the way.
+// `recovery` (if not null): also the lift's recovery past shadows (see
+// shadow_recovery()) with ratio `recovery_ratio`, worked out on the way. An
+// oblique line does not close on itself after a lap, so its recovery at
+// column 0 comes from the shadows of the line arriving there, followed back
+// across the periodic edge.
 void wind_shadow(const terrain::HeightField& h, double rows_per_column, double drop_per_cell,
                  double max_columns, ShadowMap& shadow, double recovery_ratio = 0.0,
                  std::vector<float>* recovery = nullptr);
@@ -47,7 +50,9 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
 // it; 0 inside shadows, 1 on lines without any. A lift that jumps to full at
 // the shadow's end scours a pit there whose downwind wall stands at the
 // angle of repose facing the wind; the ramp keeps windward faces gentle.
-// `shadow` as wind_shadow() filled it for the same field and lines.
+// `shadow` as wind_shadow() filled it for the same field and lines; each line
+// is taken to close on itself after a lap (true of rows, a wind along the
+// grid; wind_shadow() handles oblique lines).
 void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
                      std::vector<float>& recovery);
 
