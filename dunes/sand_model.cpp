@@ -273,8 +273,10 @@ struct Landings {
 // line, and where they land.
 struct RowScratch {
   std::vector<double> columns, lift, columns_b, lift_b;
+  std::vector<float> recovery;
   Landings landings;
   void resize(int n) {
+    recovery.resize(n);
     for (auto* v : {&columns, &lift, &columns_b, &lift_b, &landings.top_left, &landings.top_right,
                     &landings.bottom_left, &landings.bottom_right}) {
       v->resize(n);
@@ -388,15 +390,19 @@ DRIFT_SIMD_TWINS(shade_along_x, shade_along_x_kernel,
 // along the first line and how far it gets, and in `lift_b`, `columns_b`
 // the same for the second (kOblique only).
 //
-// `recovery` (may be null: none): the share of the lift the wind takes up
-// past a shadow's end (shadow_recovery()), per line sample.
+// With `reattach` > 0 the lift recovers past a shadow's end
+// (shadow_recovery()): along x worked out here for the row, into
+// `row_recovery` (a row that stays in cache, not a map through memory);
+// obliquely read from `recovery`, which wind_shadow() filled.
 template <bool kOblique>
-void shade_row(const ShadowMap& shadow, const std::vector<float>* recovery,
+void shade_row(const ShadowMap& shadow, double reattach, const std::vector<float>* recovery,
                const Crossing* crossings, int n, int row, int rows, double* __restrict columns,
-               double* __restrict lift, double* __restrict columns_b, double* __restrict lift_b) {
+               double* __restrict lift, double* __restrict columns_b, double* __restrict lift_b,
+               float* row_recovery) {
   if (!kOblique) {
-    const std::size_t at = static_cast<std::size_t>(row) * n;
-    shade_along_x(&shadow[at], recovery ? &(*recovery)[at] : nullptr, n, columns, lift);
+    const std::uint16_t* line = &shadow[static_cast<std::size_t>(row) * n];
+    if (reattach > 0.0) line_recovery(line, n, reattach, row_recovery);
+    shade_along_x(line, reattach > 0.0 ? row_recovery : nullptr, n, columns, lift);
     return;
   }
   for (int x = 0; x < n; ++x) {
@@ -421,7 +427,8 @@ struct SaltationPlan {
   Blocks blocks;
   std::vector<Crossing> crossings;  // per column, rows modulo the field's
   const ShadowMap* shadow = nullptr;
-  const std::vector<float>* recovery = nullptr;  // with a shadow: see shadow_recovery()
+  double reattach = 0.0;                         // with a shadow: see shadow_recovery()
+  const std::vector<float>* recovery = nullptr;  // oblique winds: worked out by wind_shadow()
   std::size_t kept_rows = 0;                     // per block: its shared rows, then its spill rows
 };
 
@@ -440,8 +447,9 @@ void saltate_row(const terrain::HeightField& h, const SandOptions& o, const Salt
   launch_row(h, o, p.wind, row, columns, lift);
   const bool two_lines = kOblique && p.shadow;
   if (p.shadow) {
-    shade_row<kOblique>(*p.shadow, p.recovery, p.crossings.data(), n, row, h.height(), columns,
-                        lift, scratch.columns_b.data(), scratch.lift_b.data());
+    shade_row<kOblique>(*p.shadow, p.reattach, p.recovery, p.crossings.data(), n, row, h.height(),
+                        columns, lift, scratch.columns_b.data(), scratch.lift_b.data(),
+                        scratch.recovery.data());
   }
   auto flights = [&](const double* reach, const double* part) {
     aim<kOblique>(n, y, t, reach, part, scratch.landings);
@@ -513,11 +521,15 @@ void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
   // ahead the shadow must be known (neither matters for a plain wind along x).
   const double longest = t != 0.0 || shadows ? max_flight(h, o) : 0.0;
   if (shadows) {
-    const bool recovers = o.reattach > 0.0;
+    // The recovery along oblique lines comes with the shadow (a line's
+    // start needs the line arriving across the periodic edge); rows work
+    // theirs out as they are shaded.
+    const bool map_recovery = o.reattach > 0.0 && t != 0.0;
     wind_shadow(h, t, shadow_drop(o), longest * p.wind.cos_a, w.shadow, o.reattach,
-                recovers ? &w.recovery : nullptr);
+                map_recovery ? &w.recovery : nullptr);
     p.shadow = &w.shadow;
-    if (recovers) p.recovery = &w.recovery;
+    p.reattach = o.reattach;
+    if (map_recovery) p.recovery = &w.recovery;
   }
   p.blocks = landing_blocks(h, longest, p.wind);
   p.crossings.resize(n);

@@ -191,40 +191,42 @@ int next_with_flag(const std::uint16_t* s, int from, int n, bool flag) {
 // shadow_recovery()), from where it stands at column 0: `start`, or if null
 // the line's own end (a line that closes on itself after a lap).
 void recover_line(const std::uint16_t* s, int n, double ratio, const LineStart* start, float* out) {
-  int since = 0, run = 0;
+  // The previous shadow: where it ended (the first sample past it, <= 0 for
+  // one before column 0) and its length (0: none).
+  int prev_end = 0, prev_run = 0;
   if (start) {
-    since = start->since;
-    run = start->run;
+    prev_end = -start->since;
+    prev_run = start->run;
   } else {
-    // The last shadow before column 0 is the line's last shadowed run (if
-    // any), counted back from its end.
+    // The line's last shadowed run, counted back from its end.
     int last = n - 1;
     while (last >= 0 && !shadowed(s[last])) --last;
-    if (last < 0) {
-      std::fill(out, out + n, 1.0f);
-      return;
-    }
-    for (int x = last; x >= 0 && shadowed(s[x]); --x) ++run;
-    since = n - 1 - last;
+    for (int x = last; x >= 0 && shadowed(s[x]); --x) ++prev_run;
+    prev_end = last + 1 - n;
   }
-  // Run by run: the scans take eight samples at a time, the fills vectorise.
-  for (int x = 0; x < n;) {
-    const bool in_shadow = shadowed(s[x]);
-    const int end = next_with_flag(s, x + 1, n, !in_shadow);
-    if (in_shadow) {
-      std::fill(out + x, out + end, 0.0f);
-      // A shadow at column 0 may continue the one at the line's end.
-      run = x == 0 && since == 0 ? run + end : end - x;
-      since = 0;
-    } else {
-      // No shadow seen yet (run 0): since is huge, the factor 1.
-      const float slope = run > 0 ? 1.0f / static_cast<float>(ratio * run) : 1.0f;
-      const int first = since + 1 - x;  // samples since the shadow at column x, minus x
-      for (int i = x; i < end; ++i) out[i] = std::min(1.0f, static_cast<float>(first + i) * slope);
-      since += end - x;
+  // Mostly 1: shadows are a few samples long and their ramps short, so fill,
+  // then visit the shadows (found eight samples at a time) and the ramps
+  // behind them.
+  std::fill(out, out + n, 1.0f);
+  auto ramp = [&](int until) {  // after the previous shadow, up to `until`
+    if (prev_run == 0) return;
+    const float slope = 1.0f / static_cast<float>(ratio * prev_run);
+    for (int x = std::max(prev_end, 0); x < until; ++x) {
+      const float f = static_cast<float>(x - prev_end + 1) * slope;
+      if (f >= 1.0f) break;
+      out[x] = f;
     }
-    x = end;
+  };
+  for (int a = next_with_flag(s, 0, n, true); a < n;) {
+    const int b = next_with_flag(s, a + 1, n, false);
+    ramp(a);
+    std::fill(out + a, out + b, 0.0f);
+    // A shadow at column 0 may continue the one before it.
+    prev_run = a == prev_end ? prev_run + (b - a) : b - a;
+    prev_end = b;
+    a = next_with_flag(s, b, n, true);
   }
+  ramp(n);
 }
 
 }  // namespace
@@ -285,6 +287,11 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
         }
       },
       tbb::simple_partitioner());
+}
+
+void line_recovery(const std::uint16_t* line, int width, double ratio, float* out) {
+  assert(ratio > 0 && width > 0);
+  recover_line(line, width, ratio, nullptr, out);
 }
 
 void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
