@@ -71,7 +71,7 @@ terrain::HeightField initial_field(const SandOptions& options);
 struct Workspace {
   std::vector<double> kept;     // saltation: rows that blocks share, summed last
   ShadowMap shadow;             // the wind shadow
-  std::vector<float> recovery;  // the lift's recovery past shadows
+  std::vector<float> recovery;  // oblique winds: the lift's recovery past shadows
   std::vector<float> next;      // the new field (saltation, creep, avalanching)
   // Steps done, and whether the last step's avalanching found steep edges:
   // while slip faces keep forming, the per-step check (a full pass) is

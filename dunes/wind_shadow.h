@@ -53,11 +53,12 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
 // `shadow` as wind_shadow() filled it for the same field and lines; each line
 // is taken to close on itself after a lap (true of rows, a wind along the
 // grid; wind_shadow() handles oblique lines).
+void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
+                     std::vector<float>& recovery);
+
 // The same for one line of the map that closes on itself (a row, for a wind
 // along the grid): `line` its `width` samples, `out` as many.
 void line_recovery(const std::uint16_t* line, int width, double ratio, float* out);
-void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
-                     std::vector<float>& recovery);
 
 inline bool shadowed(std::uint16_t s) { return (s & 1u) != 0; }
 inline int columns_to_shadow(std::uint16_t s) { return s >> 1; }
