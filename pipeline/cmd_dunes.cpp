@@ -104,9 +104,10 @@ void add_dunes_command(CLI::App& root) {
   sub->add_option("--repose", o.repose_deg, "angle of repose of dry sand, degrees (34)");
   sub->add_option("--shadow", o.shadow_deg,
                   "wind-shadow angle behind crests, degrees (ripples 0, dunes 15; 0 = none)");
-  sub->add_option("--reattach", o.reattach,
-                  "with a shadow: the lift past it recovers over this many times the shadow's "
-                  "length [0, 16] (dunes 1: transverse dunes; 2+: crescents; 0: at once)");
+  sub->add_option(
+      "--reattach", o.reattach,
+      "with a shadow: the lift past it recovers over this many times the shadow's "
+      "length [0, 16] (dunes 1: gentle windward faces; 2+: separate crescents; 0: at once)");
   sub->add_option("--snapshot-every", c->snapshot_every,
                   "also write OUT_<step>.tif every K steps (for animations)")
       ->check(CLI::Range(1, 10000000));
