@@ -168,24 +168,50 @@ int warm_up_columns(const terrain::HeightField& h, double drop_per_column) {
   return static_cast<int>(std::min<double>(h.width(), columns));
 }
 
-// The first sample in [from, n) of a line of the shadow map whose shadow
-// flag is `flag`, or n. Eight samples at a time where SSE2 is there: runs in
-// and out of shadow are tens of samples long.
-int next_with_flag(const std::uint16_t* s, int from, int n, bool flag) {
-  int i = from;
+// A line's shadow flags as bits (bit x % 64 of word x / 64), so that runs
+// in and out of shadow are found a word at a time: a line has some thirty
+// shadows, mostly a few samples long.
+class ShadowBits {
+ public:
+  // Lines of up to 16384 samples (the grid's limit) in a fixed array: no
+  // allocation per line.
+  ShadowBits(const std::uint16_t* s, int n) : n_(n), count_((n + 63) / 64) {
+    assert(count_ <= static_cast<int>(words_.size()));
+    std::fill_n(words_.begin(), count_, std::uint64_t{0});
+    int i = 0;
 #if defined(__SSE2__)
-  const __m128i one = _mm_set1_epi16(1);
-  const __m128i wanted = flag ? one : _mm_setzero_si128();
-  for (; i + 8 <= n; i += 8) {
-    const __m128i bits =
-        _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(s + i)), one);
-    const int found = _mm_movemask_epi8(_mm_cmpeq_epi16(bits, wanted));
-    if (found != 0) return i + (__builtin_ctz(static_cast<unsigned>(found)) >> 1);
-  }
+    // Sixteen flags per step: compare, narrow to bytes, one bit each.
+    const __m128i one = _mm_set1_epi16(1);
+    for (; i + 16 <= n; i += 16) {
+      const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + i));
+      const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + i + 8));
+      const __m128i flags = _mm_packs_epi16(_mm_cmpeq_epi16(_mm_and_si128(a, one), one),
+                                            _mm_cmpeq_epi16(_mm_and_si128(b, one), one));
+      const auto mask = static_cast<std::uint64_t>(_mm_movemask_epi8(flags) & 0xffff);
+      words_[static_cast<std::size_t>(i >> 6)] |= mask << (i & 63);
+    }
 #endif
-  while (i < n && shadowed(s[i]) != flag) ++i;
-  return i;
-}
+    for (; i < n; ++i) {
+      if (shadowed(s[i])) words_[static_cast<std::size_t>(i >> 6)] |= std::uint64_t{1} << (i & 63);
+    }
+  }
+
+  // The first sample in [from, n) whose flag is `flag`, or n.
+  int next(int from, bool flag) const {
+    std::size_t w = static_cast<std::size_t>(from >> 6);
+    if (from >= n_) return n_;
+    std::uint64_t word = (flag ? words_[w] : ~words_[w]) & (~std::uint64_t{0} << (from & 63));
+    while (word == 0) {
+      if (++w == static_cast<std::size_t>(count_)) return n_;
+      word = flag ? words_[w] : ~words_[w];
+    }
+    return std::min(n_, static_cast<int>(w * 64) + __builtin_ctzll(word));
+  }
+
+ private:
+  int n_, count_;
+  std::array<std::uint64_t, 256> words_;
+};
 
 // The lift's recovery along one line of n samples of the shadow map (see
 // shadow_recovery()), from where it stands at column 0: `start`, or if null
@@ -205,9 +231,10 @@ void recover_line(const std::uint16_t* s, int n, double ratio, const LineStart* 
     prev_end = last + 1 - n;
   }
   // Mostly 1: shadows are a few samples long and their ramps short, so fill,
-  // then visit the shadows (found eight samples at a time) and the ramps
+  // then visit the shadows (found a word of flags at a time) and the ramps
   // behind them.
   std::fill(out, out + n, 1.0f);
+  const ShadowBits bits(s, n);
   auto ramp = [&](int until) {  // after the previous shadow, up to `until`
     if (prev_run == 0) return;
     const float slope = 1.0f / static_cast<float>(ratio * prev_run);
@@ -217,14 +244,14 @@ void recover_line(const std::uint16_t* s, int n, double ratio, const LineStart* 
       out[x] = f;
     }
   };
-  for (int a = next_with_flag(s, 0, n, true); a < n;) {
-    const int b = next_with_flag(s, a + 1, n, false);
+  for (int a = bits.next(0, true); a < n;) {
+    const int b = bits.next(a + 1, false);
     ramp(a);
-    std::fill(out + a, out + b, 0.0f);
+    for (int x = a; x < b; ++x) out[x] = 0.0f;
     // A shadow at column 0 may continue the one before it.
     prev_run = a == prev_end ? prev_run + (b - a) : b - a;
     prev_end = b;
-    a = next_with_flag(s, b, n, true);
+    a = bits.next(b, true);
   }
   ramp(n);
 }
