@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <type_traits>
@@ -205,7 +206,7 @@ class ShadowBits {
       if (++w == static_cast<std::size_t>(count_)) return n_;
       word = flag ? words_[w] : ~words_[w];
     }
-    return std::min(n_, static_cast<int>(w * 64) + __builtin_ctzll(word));
+    return std::min(n_, static_cast<int>(w * 64) + std::countr_zero(word));
   }
 
  private:
