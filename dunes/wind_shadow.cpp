@@ -199,8 +199,8 @@ class ShadowBits {
 
   // The first sample in [from, n) whose flag is `flag`, or n.
   int next(int from, bool flag) const {
-    std::size_t w = static_cast<std::size_t>(from >> 6);
     if (from >= n_) return n_;
+    std::size_t w = static_cast<std::size_t>(from >> 6);
     std::uint64_t word = (flag ? words_[w] : ~words_[w]) & (~std::uint64_t{0} << (from & 63));
     while (word == 0) {
       if (++w == static_cast<std::size_t>(count_)) return n_;
@@ -278,7 +278,10 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
   if (recovery && oblique) {
     span.history = static_cast<int>(std::ceil((recovery_ratio + 1.0) * span.warm_up)) + 1;
   }
-  const std::vector<Stop> path = stops(n, rows, rows_per_column, span);
+  // Rows are read straight through (mark_shadowed_rows); only oblique lines
+  // need the path.
+  const std::vector<Stop> path =
+      oblique ? stops(n, rows, rows_per_column, span) : std::vector<Stop>{};
   // Blocks of kLineBlock lines side by side, the last one a line at a time
   // if rows are not a multiple of kLineBlock.
   const int blocks = (rows + kLineBlock - 1) / kLineBlock;
