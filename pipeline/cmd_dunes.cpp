@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "dunes/sand_model.h"
+#include "dunes/wind_frame.h"
 #include "pipeline/cli.h"
 #include "pipeline/progress_bar.h"
 #include "terrain/raster_io.h"
@@ -51,6 +52,14 @@ void run_dunes(const DunesCommand& c, const CLI::App& sub) {
   if (given("--reattach")) o.reattach = g.reattach;
   o.seed = c.seed;
   dunes::validate(o);
+  if (o.shadow_deg > 0.0 && dunes::wind_frame(o.wind_from_deg).sin_a != 0.0) {
+    std::fprintf(stderr,
+                 "drift dunes: note: --wind %g is oblique to the grid; with a wind shadow "
+                 "(--shadow %g) the dunes come out with cliffs along columns and steep windward "
+                 "faces (a known defect, docs/dunes.md). Winds from 0, 90, 180 or 270 give the "
+                 "best dunes; turn the scene instead.\n",
+                 o.wind_from_deg, o.shadow_deg);
+  }
   const std::filesystem::path out = c.output;
   const std::string description = c.model + " height (m)";
   auto snapshot = [&](int step, const terrain::HeightField& field) {
@@ -91,10 +100,12 @@ void add_dunes_command(CLI::App& root) {
   sub->add_option("--height-unit", o.height_unit,
                   "metres per model height unit [1e-6, 1000]: sets the physical slopes");
   sub->add_option("--steps", o.steps, "time steps [0, 1e7]; 0 writes the seeded start");
-  sub->add_option("--wind", o.wind_from_deg,
-                  "where the wind comes FROM, degrees clockwise from north, as in weather "
-                  "reports (270: a west wind) [-360, 360]. Any azimuth: grains fly along it on the "
-                  "periodic grid, so the field always tiles");
+  sub->add_option(
+      "--wind", o.wind_from_deg,
+      "where the wind comes FROM, degrees clockwise from north, as in weather "
+      "reports (270: a west wind) [-360, 360]. Any azimuth: grains fly along it on the "
+      "periodic grid, so the field always tiles (dunes with a shadow: best along the axes, "
+      "see docs/dunes.md)");
   sub->add_option("--L0", o.L0, "base flight length in cells [0.5, 64]");
   sub->add_option("--b", o.b, "flight-length coefficient [0, 32]");
   sub->add_option("--q", o.q, "height lifted per cell and step (dunes: q0) [1e-4, 2]");

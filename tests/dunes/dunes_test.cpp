@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <complex>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <numbers>
@@ -206,29 +207,36 @@ TEST(Sand, DunesMigrateDownwind) {
 }
 
 TEST(Sand, DunesHaveGentleWindwardFacesAndSteepLeeFaces) {
-  // The desert scene's settings on a 256 field. Along the wind (+x in the
+  // The desert scene's settings on a 128 field, run until the dunes have
+  // grown to the field's size (at 6000 steps some seeds are still mid-way,
+  // with windward faces as steep as lee faces). Along the wind (+x in the
   // model frame): faces rising downwind face the wind, faces falling are lee
   // faces. Real transverse and barchan dunes have windward slopes of 5-15
-  // degrees and slip faces at the angle of repose. Without the lift's
-  // recovery past shadows, pits scoured at the shadows' ends gave as much
-  // area of windward faces over 25 degrees as of lee faces (17 % each here).
-  SandOptions o = small(Model::Dunes, 256, 6000);
-  o.creep = 0.5;
-  const HeightField h = run(o);
-  const int n = h.width();
-  const double steep = std::tan(25.0 * std::numbers::pi / 180.0);
-  int windward = 0, lee = 0;
-  for (int row = 0; row < n; ++row) {
-    for (int x = 0; x < n; ++x) {
-      const double slope =
-          (h((x + 1) % n, row) - h((x + n - 1) % n, row)) * 0.5 * o.height_unit / o.cell_m;
-      windward += slope > steep;
-      lee += slope < -steep;
+  // degrees and slip faces at the angle of repose. Measured: 17 % of the area
+  // is lee face over 25 degrees and none is windward face, for seeds 1-5.
+  // Without the lift's recovery past shadows, pits scoured at the shadows'
+  // ends give as much area of windward faces over 25 degrees as of lee faces
+  // (24 % each).
+  for (std::uint64_t seed : {1u, 2u}) {
+    SandOptions o = small(Model::Dunes, 128, 12000);
+    o.creep = 0.5;
+    o.seed = seed;
+    const HeightField h = run(o);
+    const int n = h.width();
+    const double steep = std::tan(25.0 * std::numbers::pi / 180.0);
+    int windward = 0, lee = 0;
+    for (int row = 0; row < n; ++row) {
+      for (int x = 0; x < n; ++x) {
+        const double slope =
+            (h((x + 1) % n, row) - h((x + n - 1) % n, row)) * 0.5 * o.height_unit / o.cell_m;
+        windward += slope > steep;
+        lee += slope < -steep;
+      }
     }
+    const double cells = static_cast<double>(n) * n;
+    EXPECT_GT(lee / cells, 0.05) << "slip faces, seed " << seed;
+    EXPECT_LT(windward / cells, 0.2 * lee / cells) << "steep windward faces, seed " << seed;
   }
-  const double cells = static_cast<double>(n) * n;
-  EXPECT_GT(lee / cells, 0.05) << "slip faces";
-  EXPECT_LT(windward / cells, 0.2 * lee / cells) << "steep windward faces";
 }
 
 TEST(Sand, RipplesWithAWindShadowMigrateDownwind) {
@@ -310,6 +318,43 @@ TEST(Sand, WindsAQuarterTurnApartGiveTurnedFieldsAtAnyAzimuth) {
   EXPECT_NEAR(f.sin_a, 0.5, 1e-12);  // 30 degrees clockwise of east: towards +rows
   EXPECT_EQ(wind_frame(270.0).sin_a, 0.0);
   EXPECT_EQ(wind_frame(0.0).quarter_turns, 1);
+}
+
+TEST(Sand, WindsMirroredAboutTheGridGiveMirroredFields) {
+  // A wind 30 degrees to one side of +x (from 300) on a field, and 30
+  // degrees to the other (from 240) on the field mirrored across the rows,
+  // must give mirrored fields: nothing in saltation, the wind shadow, the
+  // lift's recovery, creep or avalanching may prefer a side. The two runs
+  // sum in other orders, so they agree to float rounding, not bit for bit.
+  for (Model model : {Model::Dunes, Model::Ripples}) {
+    SandOptions right = small(model, 64, 0);
+    SandOptions left = right;
+    right.wind_from_deg = 300.0;
+    left.wind_from_deg = 240.0;
+    ASSERT_EQ(wind_frame(240.0).quarter_turns, 0);
+    ASSERT_NEAR(wind_frame(240.0).sin_a, -wind_frame(300.0).sin_a, 1e-15);
+    HeightField a = initial_field(right);
+    const int n = a.width();
+    auto mirrored = [n](const HeightField& h) {
+      HeightField m = h;
+      for (int row = 0; row < n; ++row)
+        for (int x = 0; x < n; ++x) m(x, row) = h(x, n - 1 - row);
+      return m;
+    };
+    HeightField b = mirrored(a);
+    Workspace wa, wb;
+    for (int s = 0; s < 30; ++s) {
+      step(a, right, wa);
+      step(b, left, wb);
+    }
+    const HeightField back = mirrored(b);
+    double worst = 0, top = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      worst = std::max(worst, static_cast<double>(std::fabs(a.values()[i] - back.values()[i])));
+      top = std::max(top, static_cast<double>(std::fabs(a.values()[i])));
+    }
+    EXPECT_LT(worst, 1e-5 * std::max(top, 1.0)) << "model " << static_cast<int>(model);
+  }
 }
 
 TEST(Sand, AQuarterTurnOfTheWindTurnsTheField) {
