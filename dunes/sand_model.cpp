@@ -438,7 +438,8 @@ void shade_row(const ShadowMap& shadow, double reattach, const std::vector<float
 struct SaltationPlan {
   WindFrame wind;
   Blocks blocks;
-  std::vector<Crossing> crossings;  // per column, rows modulo the field's
+  // Oblique winds with a shadow: per column, rows modulo the field's.
+  std::vector<Crossing> crossings;
   const ShadowMap* shadow = nullptr;
   double reattach = 0.0;                         // with a shadow: see shadow_recovery()
   const std::vector<float>* recovery = nullptr;  // oblique winds: worked out by wind_shadow()
@@ -543,13 +544,17 @@ void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
     p.shadow = &w.shadow;
     p.reattach = o.reattach;
     if (map_recovery) p.recovery = &w.recovery;
+    // Only oblique lines need to know where they cross each column (rows
+    // are their own lines).
+    if (t != 0.0) {
+      p.crossings.resize(n);
+      for (int x = 0; x < n; ++x) {
+        p.crossings[x] = crossing(t, x);
+        p.crossings[x].row = (p.crossings[x].row % h.height() + h.height()) % h.height();
+      }
+    }
   }
   p.blocks = landing_blocks(h, longest, p.wind);
-  p.crossings.resize(n);
-  for (int x = 0; x < n; ++x) {
-    p.crossings[x] = crossing(t, x);
-    p.crossings[x].row = (p.crossings[x].row % h.height() + h.height()) % h.height();
-  }
   p.kept_rows = 2 * static_cast<std::size_t>(p.blocks.spill);
   w.kept.resize(p.kept_rows * n * p.blocks.count);
   w.next.resize(h.size());

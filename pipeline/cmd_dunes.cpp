@@ -84,13 +84,11 @@ void add_dunes_command(CLI::App& root) {
   *self = sub;
   dunes::SandOptions& o = c->given;
   sub->footer(
-      "Defaults (ripples | dunes): --cell 0.015 | 1 m, --height-unit 0.0025 | 0.25 m, --steps "
-      "500 | 3000,\n--L0 5 | 20, --b 2 | 1, --q 0.1 | 0.2, --b-prime - | 0.02, --creep 0.25, "
-      "--amplitude 1 | 2, --shadow 0 | 15, --reattach - | 1.\nRipples: L = L0 + b H (cells, H in "
-      "height units); "
-      "dunes: L = L0 - b "
-      "tanh(dH/dx),\nq = q0 + b' tanh(dH/dx). Ripples form at about L0 + 1 cells; see "
-      "docs/dunes.md.");
+      "Defaults (ripples | dunes): --cell 0.015 | 1 m, --height-unit 0.0025 | 0.25 m,\n"
+      "--steps 500 | 3000, --L0 5 | 20, --b 2 | 1, --q 0.1 | 0.2, --b-prime - | 0.02,\n"
+      "--creep 0.25, --amplitude 1 | 2, --shadow 0 | 15, --reattach - | 1.\n"
+      "Ripples: L = L0 + b H (cells, H in height units); dunes: L = L0 - b tanh(dH/dx),\n"
+      "q = q0 + b' tanh(dH/dx). Ripples form at about L0 + 1 cells; see docs/dunes.md.");
   sub->add_option("--model", c->model, "ripples or dunes")
       ->check(CLI::IsMember({"ripples", "dunes"}))
       ->capture_default_str();
