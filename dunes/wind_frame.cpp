@@ -21,6 +21,13 @@ WindFrame wind_frame(double wind_from_deg) {
     const double a = residual_deg * std::numbers::pi / 180.0;
     f.cos_a = std::cos(a);
     f.sin_a = std::sin(a);
+    // A diagonal too: sin / cos of 45 degrees is 0.9999999999999999 in
+    // double, which puts every wind line a hair off the cell centres it runs
+    // through and splits each cell between two lines.
+    if (std::fabs(std::fabs(residual_deg) - 45.0) < 1e-9) {
+      f.cos_a = std::numbers::sqrt2 / 2.0;
+      f.sin_a = std::copysign(f.cos_a, residual_deg);
+    }
   }
   return f;
 }

@@ -318,6 +318,9 @@ TEST(Sand, WindsAQuarterTurnApartGiveTurnedFieldsAtAnyAzimuth) {
   EXPECT_NEAR(f.sin_a, 0.5, 1e-12);  // 30 degrees clockwise of east: towards +rows
   EXPECT_EQ(wind_frame(270.0).sin_a, 0.0);
   EXPECT_EQ(wind_frame(0.0).quarter_turns, 1);
+  // Diagonal winds cross exactly one row per column.
+  for (const double diagonal : {45.0, 135.0, 225.0, 315.0})
+    EXPECT_EQ(std::fabs(wind_frame(diagonal).rows_per_column()), 1.0) << diagonal;
 }
 
 TEST(Sand, WindsMirroredAboutTheGridGiveMirroredFields) {
