@@ -11,24 +11,23 @@ WindFrame wind_frame(double wind_from_deg) {
   // clockwise angle from east to there, in [0, 360).
   const double turn_deg = std::fmod(std::fmod(wind_from_deg + 180.0 - 90.0, 360.0) + 360.0, 360.0);
   const double quarters = std::round(turn_deg / 90.0);
-  double residual_deg = turn_deg - 90.0 * quarters;  // [-45, 45]
-  // Quarter turns given in degrees must stay exact (sin 0 = 0, not 1e-17).
-  if (std::fabs(residual_deg) < 1e-9) residual_deg = 0.0;
+  const double residual_deg = turn_deg - 90.0 * quarters;  // [-45, 45]
   WindFrame f;
   f.quarter_turns = static_cast<int>(quarters) % 4;
-  if (residual_deg != 0.0) {
-    // Clockwise in map view with rows running south: +rows is clockwise of +x.
-    const double a = residual_deg * std::numbers::pi / 180.0;
-    f.cos_a = std::cos(a);
-    f.sin_a = std::sin(a);
-    // A diagonal too: sin / cos of 45 degrees is 0.9999999999999999 in
-    // double, which puts every wind line a hair off the cell centres it runs
-    // through and splits each cell between two lines.
-    if (std::fabs(std::fabs(residual_deg) - 45.0) < 1e-9) {
-      f.cos_a = std::numbers::sqrt2 / 2.0;
-      f.sin_a = std::copysign(f.cos_a, residual_deg);
-    }
+  // Quarter turns and diagonals given in degrees stay exact: sin 0 is 0,
+  // not 1e-17, and sin / cos of 45 degrees is 1, not 0.9999999999999999
+  // (which put every diagonal wind line a hair off the cell centres it runs
+  // through and split each cell between two lines).
+  if (std::fabs(residual_deg) < 1e-9) return f;
+  if (std::fabs(std::fabs(residual_deg) - 45.0) < 1e-9) {
+    f.cos_a = std::numbers::sqrt2 / 2.0;
+    f.sin_a = std::copysign(f.cos_a, residual_deg);
+    return f;
   }
+  // Clockwise in map view with rows running south: +rows is clockwise of +x.
+  const double a = residual_deg * std::numbers::pi / 180.0;
+  f.cos_a = std::cos(a);
+  f.sin_a = std::sin(a);
   return f;
 }
 
