@@ -12,6 +12,7 @@
 #include <numbers>
 #include <vector>
 
+#include "dunes/lattice.h"
 #include "terrain/simd.h"
 
 namespace drift::dunes {
@@ -21,6 +22,23 @@ namespace {
 // Rows [begin, end) in fixed blocks: the partition (and so every float
 // operation) does not depend on the number of threads.
 constexpr int kRowBlock = 16;
+
+// The largest drops across the 4 kinds of edge of the wind lattice, each
+// max_drop times the edge's length on the model grid: lattice point (x, r)
+// sits at (x, r + t x), so a step of dx columns and dr rows is
+// sqrt(dx^2 + (dr + t dx)^2) cells long. For t = 0, 1, 1 and sqrt(2).
+struct EdgeLimits {
+  float along;       // (x, r) - (x + 1, r): along the wind line
+  float across;      // (x, r) - (x, r + 1): along the grid's column
+  float south_east;  // (x, r) - (x + 1, r + 1)
+  float south_west;  // (x, r) - (x - 1, r + 1)
+};
+
+EdgeLimits edge_limits(double max_drop, double t) {
+  return {static_cast<float>(max_drop * std::sqrt(1.0 + t * t)), static_cast<float>(max_drop),
+          static_cast<float>(max_drop * std::sqrt(1.0 + (1.0 + t) * (1.0 + t))),
+          static_cast<float>(max_drop * std::sqrt(1.0 + (1.0 - t) * (1.0 - t)))};
+}
 
 // Flux from a down to b across an edge whose drop may be at most `lim`: a
 // ninth of the excess (8 edges: no overshoot). d - clamp(d) is d - lim above
@@ -37,20 +55,22 @@ DRIFT_SIMD_KERNEL float flux(float a, float b, float lim) {
 // The fluxes across the edges between row c and the row s south of it, per
 // column x: to (x, south) in `south`, to (x + 1, south) in `south_east`, to
 // (x - 1, south) in `south_west` (columns wrap).
+// The wrapped diagonals (south-east of the last column, south-west of the
+// first) are left out: only the wrapped cells would read them, and those
+// work their fluxes out from the heights (relax_row).
 DRIFT_SIMD_KERNEL void south_fluxes_kernel(const float* __restrict c, const float* __restrict s,
-                                           int w, float limit, float diagonal,
-                                           float* __restrict south, float* __restrict south_east,
+                                           int w, const EdgeLimits& lim, float* __restrict south,
+                                           float* __restrict south_east,
                                            float* __restrict south_west) {
-  for (int x = 0; x < w; ++x) south[x] = flux(c[x], s[x], limit);
-  for (int x = 0; x + 1 < w; ++x) south_east[x] = flux(c[x], s[x + 1], diagonal);
-  south_east[w - 1] = flux(c[w - 1], s[0], diagonal);
-  south_west[0] = flux(c[0], s[w - 1], diagonal);
-  for (int x = 1; x < w; ++x) south_west[x] = flux(c[x], s[x - 1], diagonal);
+  const float across = lim.across, se = lim.south_east, sw = lim.south_west;
+  for (int x = 0; x < w; ++x) south[x] = flux(c[x], s[x], across);
+  for (int x = 0; x + 1 < w; ++x) south_east[x] = flux(c[x], s[x + 1], se);
+  for (int x = 1; x < w; ++x) south_west[x] = flux(c[x], s[x - 1], sw);
 }
 DRIFT_SIMD_TWINS(south_fluxes, south_fluxes_kernel,
-                 (const float* c, const float* s, int w, float limit, float diagonal, float* south,
+                 (const float* c, const float* s, int w, const EdgeLimits& lim, float* south,
                   float* south_east, float* south_west),
-                 (c, s, w, limit, diagonal, south, south_east, south_west))
+                 (c, s, w, lim, south, south_east, south_west))
 
 // Cells [begin, end) of row c, given the fluxes across their north edges
 // (`a_`: the row above's south fluxes): their new heights, and their south
@@ -59,79 +79,96 @@ DRIFT_SIMD_TWINS(south_fluxes, south_fluxes_kernel,
 // so the same bits): cheaper than a pass through memory. The sum runs in the
 // order of the 8 neighbours W, E, N, S, NW, NE, SW, SE.
 DRIFT_SIMD_KERNEL void relax_span(const float* __restrict c, const float* __restrict s, int begin,
-                                  int end, float limit, float diagonal, const float* __restrict a_s,
+                                  int end, const EdgeLimits& lim, const float* __restrict a_s,
                                   const float* __restrict a_se, const float* __restrict a_sw,
                                   float* __restrict south, float* __restrict south_east,
                                   float* __restrict south_west, float* __restrict out) {
   // One level of inlining, no lambda: either loses `restrict` for GCC, which
   // then does not vectorise the loop.
+  const float along = lim.along, across = lim.across, se = lim.south_east, sw = lim.south_west;
   for (int x = begin; x < end; ++x) {
-    const float to_s = flux(c[x], s[x], limit);
-    const float to_se = flux(c[x], s[x + 1], diagonal);
-    const float to_sw = flux(c[x], s[x - 1], diagonal);
+    const float to_s = flux(c[x], s[x], across);
+    const float to_se = flux(c[x], s[x + 1], se);
+    const float to_sw = flux(c[x], s[x - 1], sw);
     south[x] = to_s;
     south_east[x] = to_se;
     south_west[x] = to_sw;
-    const float axis = -flux(c[x - 1], c[x], limit) + flux(c[x], c[x + 1], limit) + -a_s[x] + to_s;
+    const float axis = -flux(c[x - 1], c[x], along) + flux(c[x], c[x + 1], along) + -a_s[x] + to_s;
     const float diag = -a_se[x - 1] + -a_sw[x + 1] + to_sw + to_se;
     out[x] = c[x] - (axis + diag);
   }
 }
 
-// A whole row: the inner columns in place, each wrapped column through a
-// 3-column copy of its neighbourhood, so that every cell runs the same code.
-DRIFT_SIMD_KERNEL void relax_row_kernel(const float* c, const float* s, int w, float limit,
-                                        float diagonal, const float* a_s, const float* a_se,
-                                        const float* a_sw, float* south, float* south_east,
-                                        float* south_west, float* out) {
-  relax_span(c, s, 1, w - 1, limit, diagonal, a_s, a_se, a_sw, south, south_east, south_west, out);
+// A whole row: the inner columns in place; each wrapped column from a 3 x 3
+// copy of its lattice neighbourhood (dunes/lattice.h), its fluxes across
+// the north edges worked out from the heights (the very expression its
+// neighbours evaluate, so the same bits), so that every cell runs the same
+// code. `row` and `h` locate the wrapped neighbours.
+DRIFT_SIMD_KERNEL void relax_inner_kernel(const float* c, const float* s, int w,
+                                          const EdgeLimits& lim, const float* a_s,
+                                          const float* a_se, const float* a_sw, float* south,
+                                          float* south_east, float* south_west, float* out) {
+  relax_span(c, s, 1, w - 1, lim, a_s, a_se, a_sw, south, south_east, south_west, out);
+}
+DRIFT_SIMD_TWINS(relax_inner, relax_inner_kernel,
+                 (const float* c, const float* s, int w, const EdgeLimits& lim, const float* a_s,
+                  const float* a_se, const float* a_sw, float* south, float* south_east,
+                  float* south_west, float* out),
+                 (c, s, w, lim, a_s, a_se, a_sw, south, south_east, south_west, out))
+
+void relax_row(const terrain::HeightField& h, int row, int shear, const EdgeLimits& lim,
+               const float* a_s, const float* a_se, const float* a_sw, float* south,
+               float* south_east, float* south_west, float* out) {
+  const int w = h.width(), rows = h.height();
+  const float* c = &h(0, row);
+  const float* s = &h(0, row + 1 == rows ? 0 : row + 1);
+  relax_inner(c, s, w, lim, a_s, a_se, a_sw, south, south_east, south_west, out);
   for (const int x : {0, w - 1}) {
-    const int l = x == 0 ? w - 1 : x - 1, r = x + 1 == w ? 0 : x + 1;
-    const float c3[3] = {c[l], c[x], c[r]}, s3[3] = {s[l], s[x], s[r]};
-    const float a_s3[3] = {0.0f, a_s[x], 0.0f}, a_se3[3] = {a_se[l], 0.0f, 0.0f};
-    const float a_sw3[3] = {0.0f, 0.0f, a_sw[r]};
+    const Neighbourhood nb = neighbourhood(h, x, row, shear);
+    const float a_s3[3] = {0.0f, flux(nb[0][1], nb[1][1], lim.across), 0.0f};
+    const float a_se3[3] = {flux(nb[0][0], nb[1][1], lim.south_east), 0.0f, 0.0f};
+    const float a_sw3[3] = {0.0f, 0.0f, flux(nb[0][2], nb[1][1], lim.south_west)};
     float south3[3], south_east3[3], south_west3[3], out3[3];
-    relax_span(c3, s3, 1, 2, limit, diagonal, a_s3, a_se3, a_sw3, south3, south_east3, south_west3,
-               out3);
+    relax_span(nb[1].data(), nb[2].data(), 1, 2, lim, a_s3, a_se3, a_sw3, south3, south_east3,
+               south_west3, out3);
     south[x] = south3[1];
     south_east[x] = south_east3[1];
     south_west[x] = south_west3[1];
     out[x] = out3[1];
   }
 }
-DRIFT_SIMD_TWINS(relax_row, relax_row_kernel,
-                 (const float* c, const float* s, int w, float limit, float diagonal,
-                  const float* a_s, const float* a_se, const float* a_sw, float* south,
-                  float* south_east, float* south_west, float* out),
-                 (c, s, w, limit, diagonal, a_s, a_se, a_sw, south, south_east, south_west, out))
 
 }  // namespace
 
-double max_excess(const terrain::HeightField& h, double max_drop) {
+double max_excess(const terrain::HeightField& h, double max_drop, int shear) {
   const int w = h.width(), rows = h.height();
-  const float limit = static_cast<float>(max_drop);
-  const float diagonal = static_cast<float>(std::numbers::sqrt2 * max_drop);
+  const EdgeLimits lim = edge_limits(max_drop, static_cast<double>(shear) / w);
   // Excesses clamped at 0 are non-negative floats, whose bits order like
   // integers: an integer max reduction, which vectorises (a float one does
   // not without -ffast-math).
-  auto excess = [](float a, float b, float lim) {
-    const float e = std::fabs(a - b) - lim;
+  auto excess = [](float a, float b, float l) {
+    const float e = std::fabs(a - b) - l;
     return std::bit_cast<std::int32_t>(e > 0.0f ? e : 0.0f);
   };
   auto larger = [](std::int32_t a, std::int32_t b) { return a > b ? a : b; };
+  // Each edge once: east, south, south-east, south-west.
+  auto edges = [&](float c, float e, float s, float se, float sw) {
+    return larger(larger(excess(c, e, lim.along), excess(c, s, lim.across)),
+                  larger(excess(c, se, lim.south_east), excess(c, sw, lim.south_west)));
+  };
   const std::int32_t bits = tbb::parallel_reduce(
       tbb::blocked_range<int>(0, rows, kRowBlock), std::int32_t{0},
       [&](const tbb::blocked_range<int>& r, std::int32_t m) {
         for (int row = r.begin(); row < r.end(); ++row) {
           const float* __restrict c = &h(0, row);
           const float* __restrict s = &h(0, row + 1 == rows ? 0 : row + 1);
-          // Each edge once: east, south, south-east, south-west.
-          auto cell = [&](int x, int xl, int xr) {
-            return larger(larger(excess(c[x], c[xr], limit), excess(c[x], s[x], limit)),
-                          larger(excess(c[x], s[xr], diagonal), excess(c[x], s[xl], diagonal)));
-          };
-          std::int32_t row_max = larger(cell(0, w - 1, 1), cell(w - 1, w - 2, 0));
-          for (int x = 1; x + 1 < w; ++x) row_max = larger(row_max, cell(x, x - 1, x + 1));
+          std::int32_t row_max = 0;
+          for (const int x : {0, w - 1}) {
+            const Neighbourhood nb = neighbourhood(h, x, row, shear);
+            row_max = larger(row_max, edges(nb[1][1], nb[1][2], nb[2][1], nb[2][2], nb[2][0]));
+          }
+          for (int x = 1; x + 1 < w; ++x)
+            row_max = larger(row_max, edges(c[x], c[x + 1], s[x], s[x + 1], s[x - 1]));
           m = larger(m, row_max);
         }
         return m;
@@ -140,21 +177,21 @@ double max_excess(const terrain::HeightField& h, double max_drop) {
   return static_cast<double>(std::bit_cast<float>(bits));
 }
 
-int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance) {
+int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
+              int shear) {
   std::vector<float> scratch;
-  return avalanche(h, max_drop, max_sweeps, tolerance, scratch);
+  return avalanche(h, max_drop, max_sweeps, tolerance, scratch, shear);
 }
 
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
-              std::vector<float>& next) {
+              std::vector<float>& next, int shear) {
   const int w = h.width(), rows = h.height();
   next.resize(h.size());
-  const float limit = static_cast<float>(max_drop);
-  const float diagonal = static_cast<float>(std::numbers::sqrt2 * max_drop);
+  const EdgeLimits lim = edge_limits(max_drop, static_cast<double>(shear) / w);
   // Convergence is checked every few sweeps, by a separate vectorised pass.
   constexpr int kCheckEvery = 8;
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
-    if (tolerance >= 0 && sweep % kCheckEvery == 0 && max_excess(h, max_drop) <= tolerance) {
+    if (tolerance >= 0 && sweep % kCheckEvery == 0 && max_excess(h, max_drop, shear) <= tolerance) {
       return sweep;
     }
     tbb::parallel_for(
@@ -173,12 +210,11 @@ int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double t
           float* below[3] = {buffers.data() + 3 * stride, buffers.data() + 4 * stride,
                              buffers.data() + 5 * stride};
           const int first = r.begin();
-          south_fluxes(&h(0, first == 0 ? rows - 1 : first - 1), &h(0, first), w, limit, diagonal,
-                       above[0], above[1], above[2]);
+          south_fluxes(&h(0, first == 0 ? rows - 1 : first - 1), &h(0, first), w, lim, above[0],
+                       above[1], above[2]);
           for (int row = first; row < r.end(); ++row) {
-            relax_row(&h(0, row), &h(0, row + 1 == rows ? 0 : row + 1), w, limit, diagonal,
-                      above[0], above[1], above[2], below[0], below[1], below[2],
-                      &next[static_cast<std::size_t>(row) * w]);
+            relax_row(h, row, shear, lim, above[0], above[1], above[2], below[0], below[1],
+                      below[2], &next[static_cast<std::size_t>(row) * w]);
             std::swap(above, below);
           }
         },

@@ -20,13 +20,18 @@ namespace drift::dunes {
 // edge exceeds max_drop by more than `tolerance` (checked every 8 sweeps) or
 // after `max_sweeps`; returns the sweeps done. A negative tolerance skips the
 // checks (all `max_sweeps` run).
-int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance = 1e-4);
+//
+// `shear` != 0: h is the wind lattice of that shear (dunes/wind_frame.h),
+// its 8 neighbours wrapping across the column edge a lap of rows on, each
+// edge's limit max_drop times its length on the model grid.
+int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance = 1e-4,
+              int shear = 0);
 // The same with caller-owned scratch for the new field (kept between calls,
 // so a run does not allocate and clear it every step).
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
-              std::vector<float>& scratch);
+              std::vector<float>& scratch, int shear = 0);
 
 // How far the steepest edge (of 8 neighbours) exceeds its limit (<= 0: none).
-double max_excess(const terrain::HeightField& h, double max_drop);
+double max_excess(const terrain::HeightField& h, double max_drop, int shear = 0);
 
 }  // namespace drift::dunes

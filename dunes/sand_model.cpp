@@ -11,6 +11,7 @@
 
 #include "dunes/avalanche.h"
 #include "dunes/height_range.h"
+#include "dunes/lattice.h"
 #include "dunes/wind_frame.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
@@ -120,9 +121,11 @@ void validate(const SandOptions& o) {
     if (o.q <= o.b_prime) throw Error("dunes need --q > --b-prime, or the lift turns negative");
   }
   const std::uint64_t cells = static_cast<std::uint64_t>(o.size) * o.size;
-  // Heights, the double accumulator of saltation, creep's next field, the
-  // wind shadow and the lift's recovery past it.
-  require_memory(cells * (4 + 8 + 4 + 2 + 4), "the sand grid", "choose a smaller --size");
+  // Heights, the next field (saltation, creep, avalanching), the wind
+  // shadow, the lift's recovery past it, saltation's columns kept in double
+  // (at most two per point, for the longest flights on a sheared lattice)
+  // and the field turned from the lattice onto the grid.
+  require_memory(cells * (4 + 4 + 2 + 4 + 16 + 4), "the sand grid", "choose a smaller --size");
 }
 
 terrain::HeightField initial_field(const SandOptions& o) {
@@ -137,33 +140,17 @@ terrain::HeightField initial_field(const SandOptions& o) {
 
 namespace {
 
-// How saltation's landings are summed. A landing (x + L cos a, y + L sin a)
-// is shared among the 4 cells around it, so source row y writes rows y to
-// y + spill (t > 0) or y - spill to y (t < 0); spill = 0 for a wind along x.
-// Rows are cut into fixed blocks at least `spill` tall. A block sums its
-// sources' landings in double precision in a private window of its rows and
-// the spill rows beyond them, then writes its rows, except the `spill`
-// shared rows that its neighbour's landings reach: those, and its spill
-// rows, it keeps (still in double) until a second pass adds each neighbour's
-// spill to them. Every sum runs in a fixed order, so the bits do not depend
-// on the thread count (a 2-D scatter cannot be cut into independent rows),
-// and each cell is rounded to float once, so mass is kept to float rounding.
-struct Blocks {
-  int spill = 0;      // rows a landing may reach beyond its source row
-  int direction = 0;  // +1: landings reach rows below (t > 0); -1: above
-  int rows = 0, size = 0, count = 0;
-  int begin(int i) const { return i * size; }
-  int end(int i) const { return i + 1 == count ? rows : (i + 1) * size; }
-  // First row of block i's window (unwrapped) and its row count.
-  int window_begin(int i) const { return begin(i) - (direction < 0 ? spill : 0); }
-  int window_rows(int i) const { return end(i) - begin(i) + spill; }
-  // First of the rows of block i that a neighbour's landings reach, and the
-  // first row of the rows block i's landings reach beyond its own.
-  int shared_begin(int i) const { return direction > 0 ? begin(i) : end(i) - spill; }
-  int spill_begin(int i) const { return direction > 0 ? end(i) : begin(i) - spill; }
-  // The block whose spill lands on block i's shared rows.
-  int feeder(int i) const { return (i - direction + count) % count; }
-};
+// How saltation's landings are summed. The sand lives on the wind lattice
+// (dunes/wind_frame.h), whose rows are the wind lines, so a flight lands on
+// its own row, shared linearly between the two points around the landing
+// (as the paper has it along x). Rows are cut into fixed blocks; a block sums
+// its rows' landings in double precision in a private window, and each point
+// is rounded to float once, so mass is kept to float rounding and the bits
+// do not depend on the thread count. Along x a flight past the last column
+// wraps onto its row. On a sheared lattice it lands on the row a lap on
+// (row + shear): the window's rows run `wrap_columns` past the last column,
+// and those columns, with the first `wrap_columns` of every row that they
+// feed, are kept in double until a second pass adds them up in a fixed order.
 
 double max_flight(const terrain::HeightField& h, const SandOptions& o) {
   double longest = o.L0 + o.b;  // dunes: L0 - b tanh(.) <= L0 + b
@@ -174,28 +161,6 @@ double max_flight(const terrain::HeightField& h, const SandOptions& o) {
   return std::clamp(longest, 0.0, h.width() - 1.0);
 }
 
-// `longest`: the longest flight, cells along the wind.
-Blocks landing_blocks(const terrain::HeightField& h, double longest, const WindFrame& wind) {
-  Blocks b;
-  b.rows = h.height();
-  const double t = wind.rows_per_column();
-  if (t != 0.0) {
-    b.spill = static_cast<int>(longest * wind.cos_a * std::fabs(t)) + 1;
-    b.direction = t > 0 ? 1 : -1;
-  }
-  // Blocks twice the spill (or more) keep the kept rows under half the field.
-  b.size = b.spill == 0 ? kRowBlock : std::max(2 * kRowBlock, 2 * b.spill);
-  b.count = std::max(1, b.rows / b.size);
-  if (b.count == 1) b.size = b.rows;
-  // One block: its landings wrap onto itself, which needs them to stay
-  // within a lap of rows (square grids: flights are under a lap of columns).
-  if (b.spill > b.rows) {
-    throw Error("an oblique wind needs at least " + std::to_string(b.spill) +
-                " rows of sand for its longest flight; the grid has " + std::to_string(b.rows));
-  }
-  return b;
-}
-
 // A flight of `flight` cells along the wind in columns (times cos a), kept
 // within a lap (`longest` cells) by selects so that loops over it vectorise.
 DRIFT_SIMD_KERNEL double columns_along(double flight, double longest, double cos_a) {
@@ -203,51 +168,44 @@ DRIFT_SIMD_KERNEL double columns_along(double flight, double longest, double cos
   return (positive < longest ? positive : longest) * cos_a;
 }
 
-// Eqs. 2-3 along a row c: dH/dx is the slope along the wind line through
-// each cell, between the points a column up- and downwind on it, (x -+ 1,
-// y -+ t), each interpolated between the two rows around it: `ahead` is the
-// row the line reaches downwind (below for t > 0), `behind` the one it comes
-// from, `t_abs` = |t|. For t = 0 this is the row's central difference; for
-// t = +-1 the diagonal's. The gradient of the 4 neighbours dotted with the
-// wind would instead take an oblique slope from the neighbouring wind lines
-// only, blind to the cell's own (odd-even decoupling): at a wind from 300,
-// steep windward faces then covered 45 % as much area as steep lee faces,
-// against 17 % with the slope along the line (docs/dunes.md).
+// Eqs. 2-3 along a row c of the lattice, a wind line: dH/dx is the central
+// difference between its neighbours on the line, a column step (1 / cos a
+// cells) either side; `before` is the point before the first column and
+// `after` the one after the last (across the periodic edge: on a sheared
+// lattice a lap of rows back and on). The line's own points: the gradient of
+// 4 grid neighbours dotted with the wind would take an oblique slope from
+// the neighbouring lines only, blind to the point's own (docs/dunes.md).
 struct DuneLaunch {
-  float t_abs, cos_a_f;  // cos_a_f: cos a, columns per cell along the wind
+  float cos_a_f;  // cos a: columns per cell along the wind
   double L0, b, q, b_prime, longest, cos_a;
 };
 
-DRIFT_SIMD_KERNEL void launch_dunes_kernel(const float* __restrict c,
-                                           const float* __restrict behind,
-                                           const float* __restrict ahead, int n,
-                                           const DuneLaunch& p, double* __restrict columns,
-                                           double* __restrict lift) {
+DRIFT_SIMD_KERNEL void launch_dunes_kernel(const float* __restrict c, int n, float before,
+                                           float after, const DuneLaunch& p,
+                                           double* __restrict columns, double* __restrict lift) {
   // Parameters as locals: the outputs could alias them otherwise.
-  const float a = p.t_abs, stay = 1.0f - p.t_abs, per_cell = p.cos_a_f;
+  const float per_cell = p.cos_a_f;
   const double L0 = p.L0, b = p.b, q = p.q, b_prime = p.b_prime, longest = p.longest;
   const double cos_a = p.cos_a;
-  auto fill = [&](int x, int xl, int xr) {
-    const float downwind = stay * c[xr] + a * ahead[xr];
-    const float upwind = stay * c[xl] + a * behind[xl];
+  auto fill = [&](int x, float upwind, float downwind) {
     const double g = fast_tanh(per_cell * (0.5f * (downwind - upwind)));
     columns[x] = columns_along(L0 - b * g, longest, cos_a);
     lift[x] = q + b_prime * g;
   };
-  fill(0, n - 1, 1);
-  for (int x = 1; x + 1 < n; ++x) fill(x, x - 1, x + 1);
-  fill(n - 1, n - 2, 0);
+  fill(0, before, c[1]);
+  for (int x = 1; x + 1 < n; ++x) fill(x, c[x - 1], c[x + 1]);
+  fill(n - 1, c[n - 2], after);
 }
 DRIFT_SIMD_TWINS(launch_dunes, launch_dunes_kernel,
-                 (const float* c, const float* behind, const float* ahead, int n,
-                  const DuneLaunch& p, double* columns, double* lift),
-                 (c, behind, ahead, n, p, columns, lift))
+                 (const float* c, int n, float before, float after, const DuneLaunch& p,
+                  double* columns, double* lift),
+                 (c, n, before, after, p, columns, lift))
 
 // Paper eq. 1 (ripples) or eqs. 2-3 (dunes) along one row: the flight of each
-// cell in columns (its length along the wind times cos a) and its lift.
+// point in columns (its length along the wind times cos a) and its lift.
 void launch_row(const terrain::HeightField& h, const SandOptions& o, const WindFrame& wind, int row,
                 double* __restrict columns, double* __restrict lift) {
-  const int n = h.width(), rows = h.height();
+  const int n = h.width();
   const float* __restrict c = &h(0, row);
   const double longest = n - 1.0, cos_a = wind.cos_a, L0 = o.L0, b = o.b, q = o.q;
   if (o.model == Model::Ripples) {
@@ -257,125 +215,94 @@ void launch_row(const terrain::HeightField& h, const SandOptions& o, const WindF
     }
     return;
   }
-  const double t = wind.rows_per_column();
-  const DuneLaunch p{.t_abs = static_cast<float>(std::fabs(t)),
-                     .cos_a_f = static_cast<float>(wind.cos_a),
+  const DuneLaunch p{.cos_a_f = static_cast<float>(wind.cos_a),
                      .L0 = L0,
                      .b = b,
                      .q = q,
                      .b_prime = o.b_prime,
                      .longest = longest,
                      .cos_a = cos_a};
-  const float* up = &h(0, row == 0 ? rows - 1 : row - 1);
-  const float* down = &h(0, row + 1 == rows ? 0 : row + 1);
-  launch_dunes(c, t > 0 ? up : down, t > 0 ? down : up, n, p, columns, lift);
+  launch_dunes(c, n, lattice_at(h, -1, row, wind.shear), lattice_at(h, n, row, wind.shear), p,
+               columns, lift);
 }
 
 // Where each flight of a row lands in the window: the window index of the
-// cell left of the landing on its top row and of the one right of it
-// (columns wrap), and the sand each of the (up to) 4 cells around the
-// landing gets, shared bilinearly (linearly between 2 for a wind along x,
-// as the paper has it).
+// point left of the landing and of the one right of it, and the sand each
+// gets, shared linearly.
 struct Landings {
   std::vector<std::int32_t> left, right;
-  std::vector<double> top_left, top_right, bottom_left, bottom_right;
+  std::vector<double> to_left, to_right;
 };
 
-// Per-row scratch of saltation: each cell's flight (columns) and lift, for
-// an oblique wind with shadows the flight and part along its second wind
-// line, and where they land.
+// Per-row scratch of saltation: each point's flight (columns) and lift, the
+// lift's recovery past shadows along x, and where the flights land.
 struct RowScratch {
-  std::vector<double> columns, lift, columns_b, lift_b;
+  std::vector<double> columns, lift;
   std::vector<float> recovery;
   Landings landings;
   void resize(int n) {
     recovery.resize(n);
-    for (auto* v : {&columns, &lift, &columns_b, &lift_b, &landings.top_left, &landings.top_right,
-                    &landings.bottom_left, &landings.bottom_right}) {
-      v->resize(n);
-    }
+    for (auto* v : {&columns, &lift, &landings.to_left, &landings.to_right}) v->resize(n);
     landings.left.resize(n);
     landings.right.resize(n);
   }
 };
 
 // Where the flights (`reach` columns downwind, carrying `part`) of the row
-// at window row y land: (x + reach, y + reach t), t = 0 for a wind along x
-// (kOblique false). Every landing stays inside the window (its rows reach
-// the longest flight beyond the block). Branch free, so it vectorises; the
+// at window row y (`stride` values a row) land: column x + reach, wrapped
+// onto the row along x (kPastEdge false), or in the window's columns past
+// the last on a sheared lattice. Branch free, so it vectorises; the
 // scattering adds are left to fly().
-template <bool kOblique>
-DRIFT_SIMD_KERNEL void aim_kernel(int n, int y, double t, const double* __restrict reach,
+template <bool kPastEdge>
+DRIFT_SIMD_KERNEL void aim_kernel(int n, int stride, int y, const double* __restrict reach,
                                   const double* __restrict part, std::int32_t* __restrict left,
-                                  std::int32_t* __restrict right, double* __restrict top_left,
-                                  double* __restrict top_right, double* __restrict bottom_left,
-                                  double* __restrict bottom_right) {
+                                  std::int32_t* __restrict right, double* __restrict to_left,
+                                  double* __restrict to_right) {
+  const int first = y * stride;
   for (int x = 0; x < n; ++x) {
     const double land_x = x + reach[x];
     const int i0 = static_cast<int>(land_x);
     const double fx = land_x - i0;
-    const int a = i0 >= n ? i0 - n : i0, b = a + 1 == n ? 0 : a + 1;
-    int top = y * n;
-    double upper = part[x];
-    if (kOblique) {
-      const double land_y = y + reach[x] * t;
-      const int j0 = static_cast<int>(land_y);  // land_y >= 0: truncation floors
-      const double fy = land_y - j0;
-      top = j0 * n;
-      upper = part[x] * (1.0 - fy);
-      const double lower = part[x] * fy;
-      bottom_left[x] = lower * (1.0 - fx);
-      bottom_right[x] = lower * fx;
+    int a = i0, b = i0 + 1;
+    if (!kPastEdge) {
+      a = i0 >= n ? i0 - n : i0;
+      b = a + 1 == n ? 0 : a + 1;
     }
-    left[x] = top + a;
-    right[x] = top + b;
-    top_left[x] = upper * (1.0 - fx);
-    top_right[x] = upper * fx;
+    left[x] = first + a;
+    right[x] = first + b;
+    to_left[x] = part[x] * (1.0 - fx);
+    to_right[x] = part[x] * fx;
   }
 }
-#define DRIFT_AIM_PARAMS                                                                \
-  (int n, int y, double t, const double* reach, const double* part, std::int32_t* left, \
-   std::int32_t* right, double* top_left, double* top_right, double* bottom_left,       \
-   double* bottom_right)
-#define DRIFT_AIM_ARGS \
-  (n, y, t, reach, part, left, right, top_left, top_right, bottom_left, bottom_right)
-DRIFT_SIMD_TWINS(aim_along_x, aim_kernel<false>, DRIFT_AIM_PARAMS, DRIFT_AIM_ARGS)
-DRIFT_SIMD_TWINS(aim_oblique, aim_kernel<true>, DRIFT_AIM_PARAMS, DRIFT_AIM_ARGS)
+#define DRIFT_AIM_PARAMS                                                                  \
+  (int n, int stride, int y, const double* reach, const double* part, std::int32_t* left, \
+   std::int32_t* right, double* to_left, double* to_right)
+#define DRIFT_AIM_ARGS (n, stride, y, reach, part, left, right, to_left, to_right)
+DRIFT_SIMD_TWINS(aim_wrapping, aim_kernel<false>, DRIFT_AIM_PARAMS, DRIFT_AIM_ARGS)
+DRIFT_SIMD_TWINS(aim_past_edge, aim_kernel<true>, DRIFT_AIM_PARAMS, DRIFT_AIM_ARGS)
 #undef DRIFT_AIM_PARAMS
 #undef DRIFT_AIM_ARGS
 
-template <bool kOblique>
-void aim(int n, int y, double t, const double* reach, const double* part, Landings& l) {
-  (kOblique ? aim_oblique : aim_along_x)(n, y, t, reach, part, l.left.data(), l.right.data(),
-                                         l.top_left.data(), l.top_right.data(),
-                                         l.bottom_left.data(), l.bottom_right.data());
-}
-
-// Lifts `part` from each cell of the row at window row y and adds it where
-// aim() found it lands (a share of 0 on a landing exactly on a row adds
+// Lifts `part` from each point of the row at window row y and adds it where
+// aim() found it lands (a share of 0 on a landing exactly on a point adds
 // nothing).
-template <bool kOblique>
-void fly(int n, int y, const double* part, const Landings& l, double* window) {
-  double* source = window + static_cast<std::size_t>(y) * n;
+void fly(int n, int stride, int y, const double* part, const Landings& l, double* window) {
+  double* source = window + static_cast<std::size_t>(y) * stride;
   for (int x = 0; x < n; ++x) {
     source[x] -= part[x];
-    window[l.left[x]] += l.top_left[x];
-    window[l.right[x]] += l.top_right[x];
-    if (kOblique) {
-      window[l.left[x] + n] += l.bottom_left[x];
-      window[l.right[x] + n] += l.bottom_right[x];
-    }
+    window[l.left[x]] += l.to_left[x];
+    window[l.right[x]] += l.to_right[x];
   }
 }
 
-// For a wind along x, shade_row's line is the row and the shadow map's row
-// (and the recovery's, if not null) is read straight through: a loop that
-// vectorises.
-DRIFT_SIMD_KERNEL void shade_along_x_kernel(const std::uint16_t* __restrict shadow,
-                                            const float* __restrict recovery, int n,
-                                            double* __restrict columns, double* __restrict lift) {
-  // Times 1 or 0 (lifts are >= 0): exact, and unlike a select GCC
-  // vectorises it.
+// Where a row's sand flies when the lee of crests is out of the wind
+// (Werner 1995): sand there is not lifted (times 1 or 0: lifts are >= 0,
+// so exact, and unlike a select GCC vectorises it), and grains flying into
+// it are caught at its edge. With a recovery (reattach > 0) the lift is
+// scaled by it too.
+DRIFT_SIMD_KERNEL void shade_kernel(const std::uint16_t* __restrict shadow,
+                                    const float* __restrict recovery, int n,
+                                    double* __restrict columns, double* __restrict lift) {
   if (recovery) {
     for (int x = 0; x < n; ++x) {
       const int s = shadow[x];
@@ -390,183 +317,131 @@ DRIFT_SIMD_KERNEL void shade_along_x_kernel(const std::uint16_t* __restrict shad
     columns[x] = std::min(columns[x], static_cast<double>(s >> 1));
   }
 }
-DRIFT_SIMD_TWINS(shade_along_x, shade_along_x_kernel,
+DRIFT_SIMD_TWINS(shade, shade_kernel,
                  (const std::uint16_t* shadow, const float* recovery, int n, double* columns,
                   double* lift),
                  (shadow, recovery, n, columns, lift))
 
-// Where a row's sand flies when the lee of crests is out of the wind
-// (Werner 1995): sand there is not lifted, and grains flying into it are
-// caught at its edge. A cell's sand follows the two wind lines around it in
-// proportion (one line, its row, for a wind along x): on entry `lift` and
-// `columns` hold the cell's lift and flight; on return the part that flies
-// along the first line and how far it gets, and in `lift_b`, `columns_b`
-// the same for the second (kOblique only).
-//
-// With `reattach` > 0 the lift recovers past a shadow's end
-// (shadow_recovery()): along x worked out here for the row, into
-// `row_recovery` (a row that stays in cache, not a map through memory);
-// obliquely read from `recovery`, which wind_shadow() filled.
-template <bool kOblique>
-void shade_row(const ShadowMap& shadow, double reattach, const std::vector<float>* recovery,
-               const Crossing* crossings, int n, int row, int rows, double* __restrict columns,
-               double* __restrict lift, double* __restrict columns_b, double* __restrict lift_b,
-               float* row_recovery) {
-  if (!kOblique) {
-    const std::uint16_t* line = &shadow[static_cast<std::size_t>(row) * n];
-    if (reattach > 0.0) line_recovery(line, n, reattach, row_recovery);
-    shade_along_x(line, reattach > 0.0 ? row_recovery : nullptr, n, columns, lift);
-    return;
-  }
-  for (int x = 0; x < n; ++x) {
-    const CellLines lines = cell_lines(crossings[x], row, rows);
-    const double flight = columns[x], sand = lift[x];
-    const std::size_t at_a = static_cast<std::size_t>(lines.line_a) * n + x;
-    const std::size_t at_b = static_cast<std::size_t>(lines.line_b) * n + x;
-    const int s_a = shadow[at_a], s_b = shadow[at_b];
-    const double r_a = recovery ? (*recovery)[at_a] : 1.0;
-    const double r_b = recovery ? (*recovery)[at_b] : 1.0;
-    // Times 1 or 0, as in shade_along_x: no branches on the relief.
-    lift[x] = sand * lines.weight_a * static_cast<double>(~s_a & 1) * r_a;
-    columns[x] = std::min(flight, static_cast<double>(s_a >> 1));
-    lift_b[x] = sand * (1.0 - lines.weight_a) * static_cast<double>(~s_b & 1) * r_b;
-    columns_b[x] = std::min(flight, static_cast<double>(s_b >> 1));
-  }
-}
-
 // What saltation needs to know once per step.
 struct SaltationPlan {
-  WindFrame wind;
-  Blocks blocks;
-  // Oblique winds with a shadow: per column, rows modulo the field's.
-  std::vector<Crossing> crossings;
+  WindFrame wind;        // wind_frame(azimuth, n): the lattice's shear
+  int wrap_columns = 0;  // sheared lattice: columns past the last a flight may reach
   const ShadowMap* shadow = nullptr;
-  double reattach = 0.0;                         // with a shadow: see shadow_recovery()
-  const std::vector<float>* recovery = nullptr;  // oblique winds: worked out by wind_shadow()
-  std::size_t kept_rows = 0;                     // per block: its shared rows, then its spill rows
+  double reattach = 0.0;  // with a shadow: see shadow_recovery()
+  // Sheared lattice with a recovery: worked out by wind_shadow() (its lines
+  // do not close on themselves); along x each row works its own out as it
+  // is shaded (a row that stays in cache, not a map through memory).
+  const std::vector<float>* recovery = nullptr;
+  int stride(int n) const { return n + wrap_columns; }
 };
 
 // One source row's landings into the window (`y`: the row's place in it).
-// Compiled twice: kOblique false drops the sideways arithmetic of a wind
-// along x (a third of the work of a ripple step), nothing else. The flights
-// are worked out first, in loops that vectorise, then flown (a shadowed part
-// is 0 and adds nothing).
-template <bool kOblique>
+// The flights are worked out first, in loops that vectorise, then flown (a
+// shadowed part is 0 and adds nothing).
 void saltate_row(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p,
                  int row, int y, double* window, RowScratch& scratch) {
   const int n = h.width();
-  const double t = p.wind.rows_per_column();
   double* columns = scratch.columns.data();
   double* lift = scratch.lift.data();
   launch_row(h, o, p.wind, row, columns, lift);
-  const bool two_lines = kOblique && p.shadow;
   if (p.shadow) {
-    shade_row<kOblique>(*p.shadow, p.reattach, p.recovery, p.crossings.data(), n, row, h.height(),
-                        columns, lift, scratch.columns_b.data(), scratch.lift_b.data(),
-                        scratch.recovery.data());
+    const std::size_t at = static_cast<std::size_t>(row) * n;
+    const float* recovery = nullptr;
+    if (p.recovery) {
+      recovery = p.recovery->data() + at;
+    } else if (p.reattach > 0.0) {
+      line_recovery(p.shadow->data() + at, n, p.reattach, scratch.recovery.data());
+      recovery = scratch.recovery.data();
+    }
+    shade(p.shadow->data() + at, recovery, n, columns, lift);
   }
-  auto flights = [&](const double* reach, const double* part) {
-    aim<kOblique>(n, y, t, reach, part, scratch.landings);
-    fly<kOblique>(n, y, part, scratch.landings, window);
-  };
-  flights(columns, lift);
-  if (two_lines) flights(scratch.columns_b.data(), scratch.lift_b.data());
+  Landings& l = scratch.landings;
+  (p.wrap_columns > 0 ? aim_past_edge : aim_wrapping)(n, p.stride(n), y, columns, lift,
+                                                      l.left.data(), l.right.data(),
+                                                      l.to_left.data(), l.to_right.data());
+  fly(n, p.stride(n), y, lift, l, window);
 }
 
-// Block i: its sources' landings summed in its window; rows nobody else
-// reaches go to `out` (rounded once), shared and spill rows to `kept`.
-void land_block(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p, int i,
-                double* kept, std::vector<float>& out) {
-  const int n = h.width();
-  const Blocks& b = p.blocks;
+// Rows [begin, end): their sources' landings summed in a window; what
+// nobody else reaches goes to `out` (rounded once); on a sheared lattice
+// each row's first and past-the-edge `wrap_columns` go to `kept`, per row
+// first the one then the other.
+void land_rows(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p,
+               int begin, int end, std::vector<double>& kept, std::vector<float>& out) {
+  const int n = h.width(), stride = p.stride(n), wrap = p.wrap_columns;
   thread_local std::vector<double> window;
   thread_local RowScratch scratch;
-  const int wb = b.window_begin(i), wrows = b.window_rows(i);
-  window.resize(static_cast<std::size_t>(wrows) * n);
+  window.resize(static_cast<std::size_t>(end - begin) * stride);
   scratch.resize(n);
-  // Own rows start from the heights, spill rows from 0.
-  for (int r = b.begin(i); r < b.end(i); ++r)
-    std::copy(&h(0, r), &h(0, r) + n, window.begin() + static_cast<std::size_t>(r - wb) * n);
-  const int spill_row = b.direction > 0 ? b.end(i) - wb : 0;
-  std::fill_n(window.begin() + static_cast<std::size_t>(spill_row) * n,
-              static_cast<std::size_t>(b.spill) * n, 0.0);
-  const bool oblique = p.wind.rows_per_column() != 0.0;
-  for (int r = b.begin(i); r < b.end(i); ++r) {
-    (oblique ? saltate_row<true> : saltate_row<false>)(h, o, p, r, r - wb, window.data(), scratch);
+  for (int r = begin; r < end; ++r) {
+    double* row = window.data() + static_cast<std::size_t>(r - begin) * stride;
+    std::copy(&h(0, r), &h(0, r) + n, row);
+    std::fill(row + n, row + stride, 0.0);
   }
-  for (int r = wb; r < wb + wrows; ++r) {
-    const double* from = window.data() + static_cast<std::size_t>(r - wb) * n;
-    const int shared = r - b.shared_begin(i), spilled = r - b.spill_begin(i);
-    if (shared >= 0 && shared < b.spill) {
-      std::copy(from, from + n, kept + static_cast<std::size_t>(shared) * n);
-    } else if (spilled >= 0 && spilled < b.spill) {
-      std::copy(from, from + n, kept + static_cast<std::size_t>(b.spill + spilled) * n);
-    } else {
-      float* to = &out[static_cast<std::size_t>(r) * n];
-      for (int x = 0; x < n; ++x) to[x] = static_cast<float>(from[x]);
+  for (int r = begin; r < end; ++r) saltate_row(h, o, p, r, r - begin, window.data(), scratch);
+  for (int r = begin; r < end; ++r) {
+    const double* from = window.data() + static_cast<std::size_t>(r - begin) * stride;
+    float* to = &out[static_cast<std::size_t>(r) * n];
+    for (int x = wrap; x < n; ++x) to[x] = static_cast<float>(from[x]);
+    if (wrap > 0) {
+      double* keep = kept.data() + static_cast<std::size_t>(r) * 2 * wrap;
+      std::copy(from, from + wrap, keep);
+      std::copy(from + n, from + n + wrap, keep + wrap);
     }
   }
 }
 
-// Block i's shared rows plus the spill its feeder landed on them, rounded once.
-void merge_shared_rows(int n, const SaltationPlan& p, int i, const std::vector<double>& kept,
-                       std::vector<float>& out) {
-  const Blocks& b = p.blocks;
-  const double* own = kept.data() + p.kept_rows * n * i;
-  const double* fed =
-      kept.data() + p.kept_rows * n * b.feeder(i) + static_cast<std::size_t>(b.spill) * n;
-  for (int s = 0; s < b.spill; ++s) {
-    const int row = (b.shared_begin(i) + s + b.rows) % b.rows;
-    float* to = &out[static_cast<std::size_t>(row) * n];
-    const std::size_t at = static_cast<std::size_t>(s) * n;
-    for (int x = 0; x < n; ++x) to[x] = static_cast<float>(own[at + x] + fed[at + x]);
-  }
+// Row r's first `wrap_columns` plus what flew past the edge of row
+// r - shear onto them, rounded once.
+void merge_wrapped(int n, const SaltationPlan& p, int r, const std::vector<double>& kept,
+                   std::vector<float>& out) {
+  const int wrap = p.wrap_columns;
+  const int from_row = wrap_index(r - p.wind.shear, n);
+  const double* own = kept.data() + static_cast<std::size_t>(r) * 2 * wrap;
+  const double* fed = kept.data() + static_cast<std::size_t>(from_row) * 2 * wrap + wrap;
+  float* to = &out[static_cast<std::size_t>(r) * n];
+  for (int x = 0; x < wrap; ++x) to[x] = static_cast<float>(own[x] + fed[x]);
 }
 
 }  // namespace
 
 void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
-  const int n = h.width();
+  const int n = h.width(), rows = h.height();
   SaltationPlan p;
-  p.wind = wind_frame(o.wind_from_deg);
-  const double t = p.wind.rows_per_column();
+  p.wind = wind_frame(o.wind_from_deg, n);
+  const int shear = p.wind.shear;
   const bool shadows = o.shadow_deg > 0.0;
-  // The longest flight bounds how far landings reach sideways and how far
-  // ahead the shadow must be known (neither matters for a plain wind along x).
-  const double longest = t != 0.0 || shadows ? max_flight(h, o) : 0.0;
+  // The longest flight bounds how far flights reach past the last column
+  // and how far ahead the shadow must be known (neither matters for a plain
+  // wind along x).
+  const double longest = shear != 0 || shadows ? max_flight(h, o) : 0.0;
   if (shadows) {
-    // The recovery along oblique lines comes with the shadow (a line's
+    // The recovery along sheared lines comes with the shadow (a line's
     // start needs the line arriving across the periodic edge); rows work
     // theirs out as they are shaded.
-    const bool map_recovery = o.reattach > 0.0 && t != 0.0;
-    wind_shadow(h, t, shadow_drop(o), longest * p.wind.cos_a, w.shadow, o.reattach,
+    const bool map_recovery = o.reattach > 0.0 && shear != 0;
+    wind_shadow(h, shear, shadow_drop(o), longest * p.wind.cos_a, w.shadow, o.reattach,
                 map_recovery ? &w.recovery : nullptr);
     p.shadow = &w.shadow;
     p.reattach = o.reattach;
     if (map_recovery) p.recovery = &w.recovery;
-    // Only oblique lines need to know where they cross each column (rows
-    // are their own lines).
-    if (t != 0.0) {
-      p.crossings.resize(n);
-      for (int x = 0; x < n; ++x) {
-        p.crossings[x] = crossing(t, x);
-        p.crossings[x].row = (p.crossings[x].row % h.height() + h.height()) % h.height();
-      }
-    }
   }
-  p.blocks = landing_blocks(h, longest, p.wind);
-  p.kept_rows = 2 * static_cast<std::size_t>(p.blocks.spill);
-  w.kept.resize(p.kept_rows * n * p.blocks.count);
+  if (shear != 0) {
+    // Landings reach at most the flight's columns past the last, plus the
+    // right-hand point of their pair.
+    p.wrap_columns = std::min(n, static_cast<int>(longest * p.wind.cos_a) + 2);
+    w.kept.resize(static_cast<std::size_t>(rows) * 2 * p.wrap_columns);
+  }
   w.next.resize(h.size());
+  const int blocks = std::max(1, rows / kRowBlock);
   tbb::parallel_for(
-      0, p.blocks.count,
-      [&](int i) { land_block(h, o, p, i, w.kept.data() + p.kept_rows * n * i, w.next); },
+      0, blocks,
+      [&](int i) {
+        const int end = i + 1 == blocks ? rows : (i + 1) * kRowBlock;
+        land_rows(h, o, p, i * kRowBlock, end, w.kept, w.next);
+      },
       tbb::simple_partitioner());
-  if (p.blocks.spill > 0) {
-    tbb::parallel_for(
-        0, p.blocks.count, [&](int i) { merge_shared_rows(n, p, i, w.kept, w.next); },
-        tbb::simple_partitioner());
-  }
+  if (p.wrap_columns > 0) for_rows(rows, [&](int r) { merge_wrapped(n, p, r, w.kept, w.next); });
   std::swap(w.next, h.values());
 }
 
@@ -575,15 +450,73 @@ void saltate(terrain::HeightField& h, const SandOptions& o) {
   saltate(h, o, w);
 }
 
-void creep(terrain::HeightField& h, double coefficient) {
+void creep(terrain::HeightField& h, double coefficient, int shear) {
   Workspace w;
-  creep(h, coefficient, w);
+  creep(h, coefficient, w, shear);
 }
 
-void creep(terrain::HeightField& h, double coefficient, Workspace& ws) {
+namespace {
+
+// Creep on a sheared wind lattice (shear != 0): the paper's diffusion
+// D/4 * (sum of neighbours - 4 H) must stay isotropic on the model grid,
+// where lattice point (x, r) sits at (x, r + t x). Edges e with weights w_e
+// whose sum of w_e e e^T is the identity give, on any smooth field, the
+// grid's Laplacian (Taylor: f(p + e) + f(p - e) - 2 f(p) = e^T H e): for
+// 0 < t <= 1, e = (1, t) along the line with 1 - t, (0, 1) across with
+// 1 - t (1 - t), and (1, t - 1) (the lattice's north-east diagonal) with t;
+// mirrored for t < 0. For t = 1 those are the grid's 4 neighbours.
+struct CreepWeights {
+  float along, across, diagonal;
+};
+
+CreepWeights creep_weights(double t) {
+  const double a = std::fabs(t);
+  return {static_cast<float>(1.0 - a), static_cast<float>(1.0 - a * (1.0 - a)),
+          static_cast<float>(a)};
+}
+
+// One point: its 3 x 3 neighbourhood given as the row above (n), its row (c)
+// and the row below (s) around column x; `rising`: t > 0, whose diagonal
+// runs from the south-west to the north-east.
+DRIFT_SIMD_KERNEL float creep_point(const float* n, const float* c, const float* s, int x, float d,
+                                    const CreepWeights& w, bool rising) {
+  const float h = c[x];
+  const float d1 = rising ? n[x + 1] : s[x + 1], d2 = rising ? s[x - 1] : n[x - 1];
+  return h + d * (w.along * ((c[x - 1] - h) + (c[x + 1] - h)) +
+                  w.across * ((n[x] - h) + (s[x] - h)) + w.diagonal * ((d1 - h) + (d2 - h)));
+}
+
+DRIFT_SIMD_KERNEL void creep_sheared_kernel(const float* __restrict n, const float* __restrict c,
+                                            const float* __restrict s, int w, float d,
+                                            const CreepWeights& weights, bool rising,
+                                            float* __restrict out) {
+  for (int x = 1; x + 1 < w; ++x) out[x] = creep_point(n, c, s, x, d, weights, rising);
+}
+DRIFT_SIMD_TWINS(creep_sheared, creep_sheared_kernel,
+                 (const float* n, const float* c, const float* s, int w, float d,
+                  const CreepWeights& weights, bool rising, float* out),
+                 (n, c, s, w, d, weights, rising, out))
+
+}  // namespace
+
+void creep(terrain::HeightField& h, double coefficient, Workspace& ws, int shear) {
   const int w = h.width(), rows = h.height();
   ws.next.resize(h.size());
   const float d = static_cast<float>(coefficient / 4.0);
+  if (shear != 0) {
+    const CreepWeights weights = creep_weights(static_cast<double>(shear) / w);
+    for_rows(rows, [&](int row) {
+      float* out = &ws.next[static_cast<std::size_t>(row) * w];
+      creep_sheared(&h(0, row == 0 ? rows - 1 : row - 1), &h(0, row),
+                    &h(0, row + 1 == rows ? 0 : row + 1), w, d, weights, shear > 0, out);
+      for (const int x : {0, w - 1}) {
+        const Neighbourhood nb = neighbourhood(h, x, row, shear);
+        out[x] = creep_point(nb[0].data(), nb[1].data(), nb[2].data(), 1, d, weights, shear > 0);
+      }
+    });
+    std::swap(ws.next, h.values());
+    return;
+  }
   for_rows(rows, [&](int row) {
     const float* __restrict c = &h(0, row);
     const float* __restrict n = &h(0, row == 0 ? rows - 1 : row - 1);
@@ -602,13 +535,14 @@ void creep(terrain::HeightField& h, double coefficient, Workspace& ws) {
 }
 
 void step(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
+  const int shear = wind_frame(o.wind_from_deg, h.width()).shear;
   saltate(h, o, w);
-  creep(h, o.creep, w);
+  creep(h, o.creep, w, shear);
   // Sweeps with nothing steeper than the limit move nothing (the fluxes are
   // exactly 0), so checking first only saves time: worth it where slopes stay
   // gentle (ripples), not while slip faces are active (dunes).
   const bool check = !w.steep || w.steps % 8 == 0;
-  w.steep = avalanche(h, max_drop(o), kSweepsPerStep, check ? 1e-4 : -1.0, w.next) > 0;
+  w.steep = avalanche(h, max_drop(o), kSweepsPerStep, check ? 1e-4 : -1.0, w.next, shear) > 0;
   ++w.steps;
 }
 
@@ -620,16 +554,26 @@ void step(terrain::HeightField& h, const SandOptions& o) {
 terrain::HeightField run(const SandOptions& o, const ProgressFn& progress, int snapshot_every,
                          const SnapshotFn& snapshot) {
   validate(o);
+  const int shear = wind_frame(o.wind_from_deg, o.size).shear;
   terrain::HeightField h = initial_field(o);
   Workspace w;
   progress(0.0, "sand");
   for (int s = 0; s < o.steps; ++s) {
     step(h, o, w);
-    if (snapshot_every > 0 && snapshot && (s + 1) % snapshot_every == 0) snapshot(s + 1, h);
+    if (snapshot_every > 0 && snapshot && (s + 1) % snapshot_every == 0) {
+      if (shear == 0) {
+        snapshot(s + 1, h);
+      } else {
+        snapshot(s + 1, unshear(h, shear));
+      }
+    }
     if ((s + 1) % 8 == 0 && !progress(static_cast<double>(s + 1) / o.steps, "")) {
       throw Cancelled();
     }
   }
+  // From the wind lattice to the model grid, where the final relaxation
+  // holds every slope to the angle of repose between grid neighbours.
+  if (shear != 0) h = unshear(h, shear);
   if (o.steps > 0) avalanche(h, max_drop(o), kFinalSweeps, 1e-3 * max_drop(o), w.next);
   progress(1.0, "");
   return h;

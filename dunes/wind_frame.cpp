@@ -2,7 +2,10 @@
 
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
+
+#include "dunes/lattice.h"
 
 namespace drift::dunes {
 
@@ -15,9 +18,7 @@ WindFrame wind_frame(double wind_from_deg) {
   WindFrame f;
   f.quarter_turns = static_cast<int>(quarters) % 4;
   // Quarter turns and diagonals given in degrees stay exact: sin 0 is 0,
-  // not 1e-17, and sin / cos of 45 degrees is 1, not 0.9999999999999999
-  // (which put every diagonal wind line a hair off the cell centres it runs
-  // through and split each cell between two lines).
+  // not 1e-17, and sin / cos of 45 degrees is 1, not 0.9999999999999999.
   if (std::fabs(residual_deg) < 1e-9) return f;
   if (std::fabs(std::fabs(residual_deg) - 45.0) < 1e-9) {
     f.cos_a = std::numbers::sqrt2 / 2.0;
@@ -29,6 +30,53 @@ WindFrame wind_frame(double wind_from_deg) {
   f.cos_a = std::cos(a);
   f.sin_a = std::sin(a);
   return f;
+}
+
+WindFrame wind_frame(double wind_from_deg, int n) {
+  assert(n > 0);
+  WindFrame f = wind_frame(wind_from_deg);
+  // Rows per lap, nearest to n tan a (exact for the axes and diagonals,
+  // whose tan wind_frame() keeps exact).
+  f.shear = static_cast<int>(std::lround(n * f.rows_per_column()));
+  if (f.shear == 0) {
+    f.cos_a = 1.0;
+    f.sin_a = 0.0;
+  } else if (std::abs(f.shear) != n) {
+    const double length = std::hypot(static_cast<double>(n), static_cast<double>(f.shear));
+    f.cos_a = n / length;
+    f.sin_a = f.shear / length;
+  }
+  return f;
+}
+
+double lattice_wind_from(double wind_from_deg, int n) {
+  const WindFrame exact = wind_frame(wind_from_deg), rounded = wind_frame(wind_from_deg, n);
+  // Clockwise residuals, so the wind comes from further clockwise by their
+  // difference.
+  const double shift =
+      std::atan2(rounded.sin_a, rounded.cos_a) - std::atan2(exact.sin_a, exact.cos_a);
+  return wind_from_deg + shift * 180.0 / std::numbers::pi;
+}
+
+terrain::HeightField unshear(const terrain::HeightField& s, int shear) {
+  if (shear == 0) return s;
+  const int n = s.width(), rows = s.height();
+  terrain::HeightField m(n, rows, 0.0f, s.geo());
+  for (int x = 0; x < n; ++x) {
+    for (int r = 0; r < rows; ++r) {
+      // Cell (x, r) sits at lattice row r - shear x / n, between rows j0
+      // and j0 + 1, `above` n-ths of the way.
+      const std::int64_t num =
+          static_cast<std::int64_t>(r) * n - static_cast<std::int64_t>(shear) * x;
+      const std::int64_t j0 = num >= 0 ? num / n : -((-num + n - 1) / n);
+      const auto above = static_cast<int>(num - j0 * n);
+      const int row0 = wrap_index(static_cast<int>(j0 % rows), rows);
+      const int row1 = row0 + 1 == rows ? 0 : row0 + 1;
+      const double w1 = static_cast<double>(above) / n, w0 = static_cast<double>(n - above) / n;
+      m(x, r) = static_cast<float>(w0 * s(x, row0) + w1 * s(x, row1));
+    }
+  }
+  return m;
 }
 
 terrain::HeightField turn_to_ground(const terrain::HeightField& m, const WindFrame& frame) {

@@ -7,6 +7,7 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <numeric>
 #include <type_traits>
 #include <utility>
 
@@ -15,6 +16,7 @@
 #endif
 
 #include "dunes/height_range.h"
+#include "dunes/lattice.h"
 
 namespace drift::dunes {
 
@@ -26,15 +28,10 @@ namespace {
 // same bits for any thread count.
 constexpr int kLineBlock = 4;
 
-int wrap(int i, int n) {
-  i %= n;
-  return i < 0 ? i + n : i;
-}
-
-// The columns a line is followed: `warm_up` before column 0 (a lap at most:
-// no sample further upwind can still cast a shadow, as the shadow line falls
-// by more than the field's height range over them), then the field's width
-// and `ahead` more for the distances. For the lift's recovery on oblique
+// The columns a line is followed: `warm_up` before column 0 (no sample
+// further upwind can still cast a shadow, as the shadow line falls by more
+// than the field's height range over them), then the field's width
+// and `ahead` more for the distances. For the lift's recovery on sheared
 // lines, which do not close on themselves after a lap, also `history`
 // columns before 0 whose shadows are followed (after their own warm-up).
 struct Span {
@@ -49,21 +46,22 @@ struct LineStart {
 };
 
 // Where the lines stand at each column followed, unwrapped column
-// -span.before() + i: the column in the field and where the lines cross it (rows
-// modulo the field's), worked out once per field rather than per line
-// block (integer division is slow).
+// -span.before() + i: the column in the field and the rows the line has
+// moved on by the laps since column 0 (modulo the field's), worked out once
+// per field rather than per line block (integer division is slow).
 struct Stop {
   int column, row;
-  double frac;
 };
 
-std::vector<Stop> stops(int n, int rows, double t, Span span) {
+std::vector<Stop> stops(int n, int rows, int shear, Span span) {
   std::vector<Stop> out;
   const int count = span.before() + n + span.ahead;
   out.reserve(static_cast<std::size_t>(count));
   for (int x = -span.before(); x < n + span.ahead; ++x) {
-    const Crossing c = crossing(t, x);
-    out.push_back({wrap(x, n), wrap(c.row, rows), c.frac});
+    const int laps = x >= 0 ? x / n : -((-x + n - 1) / n);
+    out.push_back(
+        {x - laps * n,
+         wrap_index(static_cast<int>(static_cast<long long>(laps) * shear % rows), rows)});
   }
   return out;
 }
@@ -91,12 +89,7 @@ void mark_shadowed(const terrain::HeightField& h, double drop_per_column, Span s
 #pragma GCC unroll 8
     for (int k = 0; k < kLines; ++k) {
       const int row = first + k < rows ? first + k : first + k - rows;
-      const float* at = data + static_cast<std::size_t>(row) * n + c.column;
-      double v = *at;
-      if (c.frac != 0.0) {
-        const float* below = row + 1 == rows ? data + c.column : at + n;
-        v = (1.0 - c.frac) * v + c.frac * *below;
-      }
+      const double v = data[static_cast<std::size_t>(row) * n + c.column];
       double& line = carried[k];
       line -= drop_per_column;
       const bool shadow = v < line;
@@ -163,10 +156,13 @@ void measure_reach(int n, int limit, Span span, int j0, int j1,
 }
 
 // Columns before column 0 that a line must be followed for.
-int warm_up_columns(const terrain::HeightField& h, double drop_per_column) {
+// Past that, a line has come round to its own start: after a lap for a row,
+// after rows / gcd(shear, rows) laps for a sheared line.
+int warm_up_columns(const terrain::HeightField& h, int shear, double drop_per_column) {
   const HeightRange range = height_range(h);
   const double columns = (static_cast<double>(range.hi) - range.lo) / drop_per_column + 2;
-  return static_cast<int>(std::min<double>(h.width(), columns));
+  const int laps = shear == 0 ? 1 : h.height() / std::gcd(std::abs(shear), h.height());
+  return static_cast<int>(std::min<double>(static_cast<double>(h.width()) * laps, columns));
 }
 
 // A line's shadow flags as bits (bit x % 64 of word x / 64), so that runs
@@ -259,29 +255,28 @@ void recover_line(const std::uint16_t* s, int n, double ratio, const LineStart* 
 
 }  // namespace
 
-void wind_shadow(const terrain::HeightField& h, double rows_per_column, double drop_per_cell,
-                 double max_columns, ShadowMap& shadow, double recovery_ratio,
-                 std::vector<float>* recovery) {
-  assert(std::fabs(rows_per_column) <= 1.0 && h.width() <= 32767 && drop_per_cell > 0);
+void wind_shadow(const terrain::HeightField& h, int shear, double drop_per_cell, double max_columns,
+                 ShadowMap& shadow, double recovery_ratio, std::vector<float>* recovery) {
   const int n = h.width(), rows = h.height();
+  assert(std::abs(shear) <= n && n <= 32767 && drop_per_cell > 0);
+  const double rows_per_column = static_cast<double>(shear) / n;
   shadow.resize(h.size());
   if (recovery) recovery->resize(h.size());
   // A column step is sqrt(1 + t^2) cells along the wind.
   const double drop_per_column = drop_per_cell * std::sqrt(1.0 + rows_per_column * rows_per_column);
   const int limit = static_cast<int>(std::min<double>(n, std::ceil(max_columns) + 1));
-  Span span{warm_up_columns(h, drop_per_column), limit};
+  Span span{warm_up_columns(h, shear, drop_per_column), limit};
   // Rows close on themselves after a lap, so the recovery at column 0 can
-  // start from a row's own end. Oblique lines do not: follow each back over
+  // start from a row's own end. Sheared lines do not: follow each back over
   // the history its recovery needs, the ramp after the longest shadow
   // (no longer than the warm-up) and that shadow itself.
-  const bool oblique = rows_per_column != 0.0;
-  if (recovery && oblique) {
+  const bool sheared = shear != 0;
+  if (recovery && sheared) {
     span.history = static_cast<int>(std::ceil((recovery_ratio + 1.0) * span.warm_up)) + 1;
   }
-  // Rows are read straight through (mark_shadowed_rows); only oblique lines
+  // Rows are read straight through (mark_shadowed_rows); only sheared lines
   // need the path.
-  const std::vector<Stop> path =
-      oblique ? stops(n, rows, rows_per_column, span) : std::vector<Stop>{};
+  const std::vector<Stop> path = sheared ? stops(n, rows, shear, span) : std::vector<Stop>{};
   // Blocks of kLineBlock lines side by side, the last one a line at a time
   // if rows are not a multiple of kLineBlock.
   const int blocks = (rows + kLineBlock - 1) / kLineBlock;
@@ -292,11 +287,11 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
         thread_local std::vector<std::uint8_t> flags;
         flags.resize(static_cast<std::size_t>(n + span.ahead) * kLineBlock);
         std::array<LineStart, kLineBlock> starts;
-        LineStart* starts_at = recovery && oblique ? starts.data() : nullptr;
+        LineStart* starts_at = recovery && sheared ? starts.data() : nullptr;
         auto mark = [&](auto lines, int first) {
           constexpr int kLines = decltype(lines)::value;
           std::uint8_t* at = flags.data() + (first - j0);
-          if (!oblique) {
+          if (!sheared) {
             mark_shadowed_rows<kLines>(h, drop_per_column, span, first, at);
           } else {
             mark_shadowed<kLines>(h, drop_per_column, span, path, first, at,
@@ -337,12 +332,6 @@ void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
         recover_line(&shadow[at], n, ratio, nullptr, &recovery[at]);
       },
       tbb::simple_partitioner());
-}
-
-Crossing crossing(double rows_per_column, int x) {
-  const double y = rows_per_column * x;
-  const double row = std::floor(y);
-  return {static_cast<int>(row), y - row};
 }
 
 }  // namespace drift::dunes

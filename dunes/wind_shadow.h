@@ -13,31 +13,32 @@
 
 namespace drift::dunes {
 
-// Wind lines: line j runs through (x, j + t x) for every column x, t the rows
-// crossed per column (sin a / cos a, in [-1, 1]); the field is sampled on it
-// by linear interpolation between the two rows around it. Per line j and
-// column x, at [j * width + x]: bit 0 set if that sample is shadowed; the rest
-// (value >> 1) the columns to the first shadowed sample downwind on the line,
-// at most min(width, ceil(max_columns) + 1) (none that near). For t = 0 lines
-// are rows.
+// Wind lines are the rows of the wind lattice (dunes/wind_frame.h): line j
+// runs along row j and, past the last column, on along row j + shear. Per
+// lattice point (row j, column x), at [j * width + x]: bit 0 set if it is
+// shadowed; the rest (value >> 1) the columns to the first shadowed point
+// downwind on its line, at most min(width, ceil(max_columns) + 1) (none that
+// near).
 //
-// Exact lines rather than digital (staircase) ones: a crest oblique to the
-// grid then casts the same shadow on every line, and dunes keep crests across
-// the wind instead of snapping to the grid's axes.
+// Every point lies on one line, exactly: the shadow of a crest oblique to
+// the grid is the same on every line, and nothing is interpolated between
+// rows (which, at a fraction of a row changing from column to column, locked
+// dunes to the grid's columns; docs/dunes.md).
 using ShadowMap = std::vector<std::uint16_t>;
 
 // `drop_per_cell` (> 0): the shadow line's fall per cell of distance along
-// the wind, in height units. `max_columns`: the longest flight in columns;
-// distances beyond it are not needed. Lines are followed from as far upwind
-// as a shadow can reach (across the periodic edge) to that far downwind;
-// they are independent, so the result is the same for any thread count.
+// the wind, in height units (a column step is sqrt(1 + t^2) cells, t =
+// shear / width). `max_columns`: the longest flight in columns; distances
+// beyond it are not needed. Lines are followed from as far upwind as a
+// shadow can reach (across the periodic edge) to that far downwind; they
+// are independent, so the result is the same for any thread count.
 // `recovery` (if not null): also the lift's recovery past shadows (see
-// shadow_recovery()) with ratio `recovery_ratio`, worked out on the way. An
-// oblique line does not close on itself after a lap, so its recovery at
+// shadow_recovery()) with ratio `recovery_ratio`, worked out on the way. A
+// sheared line does not close on itself after a lap, so its recovery at
 // column 0 comes from the shadows of the line arriving there, followed back
 // across the periodic edge.
-void wind_shadow(const terrain::HeightField& h, double rows_per_column, double drop_per_cell,
-                 double max_columns, ShadowMap& shadow, double recovery_ratio = 0.0,
+void wind_shadow(const terrain::HeightField& h, int shear, double drop_per_cell, double max_columns,
+                 ShadowMap& shadow, double recovery_ratio = 0.0,
                  std::vector<float>* recovery = nullptr);
 
 // Beyond a shadow the wind does not take up sand at once: the flow
@@ -52,7 +53,7 @@ void wind_shadow(const terrain::HeightField& h, double rows_per_column, double d
 // angle of repose facing the wind; the ramp keeps windward faces gentle.
 // `shadow` as wind_shadow() filled it for the same field and lines; each line
 // is taken to close on itself after a lap (true of rows, a wind along the
-// grid; wind_shadow() handles oblique lines).
+// grid; wind_shadow() handles sheared lines).
 void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
                      std::vector<float>& recovery);
 
@@ -62,30 +63,5 @@ void line_recovery(const std::uint16_t* line, int width, double ratio, float* ou
 
 inline bool shadowed(std::uint16_t s) { return (s & 1u) != 0; }
 inline int columns_to_shadow(std::uint16_t s) { return s >> 1; }
-
-// Where the wind lines cross column x (unwrapped): line j lies between rows
-// j + row and j + row + 1, `frac` of the way.
-struct Crossing {
-  int row;
-  double frac;
-};
-Crossing crossing(double rows_per_column, int x);
-
-// The two wind lines around cell (x, row) given column x's crossing (its row
-// taken modulo the field's rows, in [0, rows)), and the
-// weight of the first, so that a cell and the line samples near it share
-// weights the same way (linear interpolation and its adjoint). The second
-// line's weight is 1 - weight_a; it is 0 for t = 0, where a cell's line is
-// its row.
-struct CellLines {
-  int line_a, line_b;
-  double weight_a;
-};
-inline CellLines cell_lines(const Crossing& c, int row, int rows) {
-  // Line row - c.row passes c.frac below the cell, the one before it
-  // 1 - c.frac above.
-  const int a = row >= c.row ? row - c.row : row - c.row + rows;
-  return {a, a == 0 ? rows - 1 : a - 1, 1.0 - c.frac};
-}
 
 }  // namespace drift::dunes

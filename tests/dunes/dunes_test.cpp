@@ -128,6 +128,24 @@ std::pair<double, double> edge_and_inner_steps(const HeightField& g) {
   return {edge / (2.0 * n), inner / (2.0 * n * (n - 1))};
 }
 
+// Steps `a` under `oa` and `b` under `ob`, `steps` times each.
+void step_both(HeightField& a, const SandOptions& oa, HeightField& b, const SandOptions& ob,
+               int steps) {
+  Workspace wa, wb;
+  for (int s = 0; s < steps; ++s) {
+    step(a, oa, wa);
+    step(b, ob, wb);
+  }
+}
+
+// The largest |a - b| over the cells of two fields of one size.
+double largest_difference(const HeightField& a, const HeightField& b) {
+  double worst = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    worst = std::max(worst, static_cast<double>(std::fabs(a.values()[i] - b.values()[i])));
+  return worst;
+}
+
 SandOptions small(Model model, int size, int steps) {
   SandOptions o = default_options(model);
   o.size = size;
@@ -323,6 +341,117 @@ TEST(Sand, WindsAQuarterTurnApartGiveTurnedFieldsAtAnyAzimuth) {
     EXPECT_EQ(std::fabs(wind_frame(diagonal).rows_per_column()), 1.0) << diagonal;
 }
 
+TEST(Sand, TheWindLatticeRoundsTheWindToWholeRowsPerLap) {
+  // Within half a row per lap of n columns: at most 0.5 / n radians off.
+  for (const int n : {8, 64, 250, 1024}) {
+    for (const double wind : {270.0, 271.0, 285.0, 300.0, 315.0, 240.0, 30.0, 100.0}) {
+      const WindFrame f = wind_frame(wind, n);
+      EXPECT_EQ(f.quarter_turns, wind_frame(wind).quarter_turns);
+      EXPECT_LE(std::abs(f.shear), n);
+      EXPECT_NEAR(f.sin_a / f.cos_a, static_cast<double>(f.shear) / n, 1e-15);
+      EXPECT_NEAR(lattice_wind_from(wind, n), wind, 0.5 / n * 180 / std::numbers::pi + 1e-9)
+          << "wind " << wind << ", n " << n;
+    }
+  }
+  EXPECT_EQ(wind_frame(300.0, 64).shear, 37);  // 64 tan 30 = 36.95
+  EXPECT_EQ(wind_frame(270.0, 64).shear, 0);
+  for (const double diagonal : {45.0, 135.0, 225.0, 315.0})
+    EXPECT_EQ(std::abs(wind_frame(diagonal, 64).shear), 64) << diagonal;
+  EXPECT_EQ(lattice_wind_from(270.0, 64), 270.0);
+}
+
+TEST(Sand, UnshearingTheWindLatticeKeepsMassAndLinearFields) {
+  const int n = 48;
+  for (const int shear : {0, 7, -20, 24, n, -n}) {
+    const double t = static_cast<double>(shear) / n;
+    // Random heights: mass kept (column sums are).
+    SandOptions o = small(Model::Dunes, n, 0);
+    const HeightField noise = initial_field(o);
+    const HeightField m = unshear(noise, shear);
+    EXPECT_NEAR(total(m), total(noise), 1e-4 * total(noise)) << "shear " << shear;
+    // A field linear along the grid's columns, periodic over the lap of
+    // rows (a ramp over rows 0..n-1 would break at the wrap): heights of
+    // lattice point (x, j) = cos of its model-grid row j + t x, 2 pi / n a
+    // row. Interpolation between rows gives the cosine at the grid cell
+    // within its curvature (1 - cos of half a row's phase).
+    HeightField lattice(n, n);
+    for (int j = 0; j < n; ++j)
+      for (int x = 0; x < n; ++x)
+        lattice(x, j) = static_cast<float>(std::cos(2 * std::numbers::pi * (j + t * x) / n));
+    const HeightField grid = unshear(lattice, shear);
+    for (int r = 0; r < n; ++r) {
+      for (int x = 0; x < n; ++x) {
+        ASSERT_NEAR(grid(x, r), std::cos(2 * std::numbers::pi * r / n), 3e-3)
+            << "shear " << shear << " at " << x << "," << r;
+      }
+    }
+    if (shear == 0) {
+      EXPECT_EQ(m.values(), noise.values());  // the grid itself
+    }
+  }
+  // Shear n: grid cell (x, r) is lattice point (x, r - x) exactly.
+  SandOptions o = small(Model::Dunes, n, 0);
+  const HeightField noise = initial_field(o);
+  const HeightField diagonal = unshear(noise, n);
+  for (int r = 0; r < n; ++r)
+    for (int x = 0; x < n; ++x) ASSERT_EQ(diagonal(x, r), noise(x, ((r - x) % n + n) % n));
+}
+
+TEST(Sand, CreepOnTheWindLatticeSpreadsABumpAlikeInEveryDirection) {
+  // A bump spread by creep alone on a sheared lattice, seen on the model
+  // grid, must be round: equal variances along x and y, no covariance (the
+  // lattice's plain 4 neighbours would give a covariance of t times the
+  // variance). Diffusion D/4 a step: variance 2 D/4 per step and axis.
+  const int n = 96, steps = 200;
+  const double D = 0.5;
+  for (const int shear : {0, 29, -29, 60, n}) {
+    HeightField h(n, n, 0.0f);
+    const int x0 = 40, j0 = 50;
+    h(x0, j0) = 1000.0f;
+    for (int s = 0; s < steps; ++s) creep(h, D, shear);
+    const HeightField g = unshear(h, shear);
+    const double y0 = j0 + static_cast<double>(shear) / n * x0;
+    double mass = 0, xx = 0, yy = 0, xy = 0;
+    auto centred = [n](double d) { return d - n * std::round(d / n); };
+    for (int r = 0; r < n; ++r)
+      for (int x = 0; x < n; ++x) {
+        const double dx = centred(x - x0), dy = centred(r - y0), v = g(x, r);
+        mass += v, xx += v * dx * dx, yy += v * dy * dy, xy += v * dx * dy;
+      }
+    xx /= mass, yy /= mass, xy /= mass;
+    const double expected = 2 * D / 4 * steps;
+    EXPECT_NEAR(xx, expected, 0.03 * expected) << "shear " << shear;
+    // Unshearing interpolates along y: up to a quarter row squared more.
+    EXPECT_NEAR(yy, expected, 0.03 * expected + 0.25) << "shear " << shear;
+    EXPECT_LT(std::fabs(xy), 0.02 * expected) << "shear " << shear;
+  }
+}
+
+TEST(Sand, NothingDependsOnTheColumnOnAnObliqueWind) {
+  // Dunes with the wind shadow at a wind from 300: a start shifted by one
+  // column along the wind lattice (past the last column, the row a lap on)
+  // gives the field shifted by one column, to float rounding. Sampling the
+  // wind lines between grid rows failed this: what a cell did depended on
+  // where the lines crossed its column, and slip faces locked onto columns.
+  SandOptions o = small(Model::Dunes, 64, 0);
+  o.wind_from_deg = 300.0;
+  const int n = 64, shear = wind_frame(o.wind_from_deg, n).shear;
+  HeightField a = initial_field(o);
+  for (float& v : a.values()) v *= 8.0f;  // relief enough for shadows at once
+  auto shifted = [&](const HeightField& h) {
+    HeightField out(n, n);
+    for (int j = 0; j < n; ++j)
+      for (int x = 0; x < n; ++x)
+        out(x, j) = x > 0 ? h(x - 1, j) : h(n - 1, ((j - shear) % n + n) % n);
+    return out;
+  };
+  HeightField b = shifted(a);
+  step_both(a, o, b, o, 40);
+  const double spread = largest_difference(a, HeightField(n, n, a(0, 0)));
+  EXPECT_GT(spread, 1.0);
+  EXPECT_LT(largest_difference(b, shifted(a)), 1e-4 * spread);
+}
+
 TEST(Sand, WindsMirroredAboutTheGridGiveMirroredFields) {
   // A wind 30 degrees to one side of +x (from 300) on a field, and 30
   // degrees to the other (from 240) on the field mirrored across the rows,
@@ -345,18 +474,10 @@ TEST(Sand, WindsMirroredAboutTheGridGiveMirroredFields) {
       return m;
     };
     HeightField b = mirrored(a);
-    Workspace wa, wb;
-    for (int s = 0; s < 30; ++s) {
-      step(a, right, wa);
-      step(b, left, wb);
-    }
-    const HeightField back = mirrored(b);
-    double worst = 0, top = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      worst = std::max(worst, static_cast<double>(std::fabs(a.values()[i] - back.values()[i])));
-      top = std::max(top, static_cast<double>(std::fabs(a.values()[i])));
-    }
-    EXPECT_LT(worst, 1e-5 * std::max(top, 1.0)) << "model " << static_cast<int>(model);
+    step_both(a, right, b, left, 30);
+    const double top = largest_difference(a, HeightField(n, n, 0.0f));
+    EXPECT_LT(largest_difference(a, mirrored(b)), 1e-5 * std::max(top, 1.0))
+        << "model " << static_cast<int>(model);
   }
 }
 
@@ -440,33 +561,36 @@ TEST(Sand, RippleCrestsStandAcrossAnObliqueWind) {
 }
 
 TEST(Sand, TheWindShadowLiesDownwindAlongTheWind) {
-  // One tall cell on flat sand, wind 30 degrees off +x (t = tan 30): only
-  // line samples downwind of it, within a cell of its wind line, are
-  // shadowed, as far as the shadow line (falling `drop` per cell) stays above
-  // 0. The two lines passing the cell carry its height in proportion, so
-  // their shadows add up to one cell's: 10 / 0.5 = 20 cells along the wind.
-  const int n = 64;
+  // One tall point on flat sand on the wind lattice of a wind half a row per
+  // column off +x (shear 32 on 64 columns): only points downwind on its own
+  // line are shadowed, as far as the shadow line stays above 0, falling
+  // 0.5 * sqrt(1 + 1/4) per column: 17 columns, past the last column on the
+  // row a lap on (row + 32).
+  const int n = 64, shear = 32;
   HeightField h(n, n, 0.0f);
-  const int px = 21, py = 30;
+  const int px = 50, py = 30;
   h(px, py) = 10.0f;
-  const double t = std::tan(30.0 * std::numbers::pi / 180.0), drop = 0.5;
   ShadowMap s;
-  wind_shadow(h, t, drop, n, s);
-  int count = 0;
-  for (int j = 0; j < n; ++j)
+  wind_shadow(h, shear, 0.5, n, s);
+  const double per_column = 0.5 * std::sqrt(1.25);
+  for (int row = 0; row < n; ++row) {
     for (int x = 0; x < n; ++x) {
-      if (!shadowed(s[static_cast<std::size_t>(j) * n + x])) continue;
-      ++count;
-      const double y = j + t * x;  // where line j crosses column x
-      EXPECT_GT(x, px) << "line " << j << ", column " << x;
-      EXPECT_LT(std::abs(y - (py + t * (x - px))), 1.0) << "line " << j << ", column " << x;
+      // Columns downwind of the tall point along its line, or -1.
+      int along = -1;
+      if (row == py && x > px) along = x - px;
+      if (row == py + shear && x < px) along = x + n - px;
+      const bool expected = along > 0 && 10.0 - along * per_column > 0.0;
+      ASSERT_EQ(shadowed(s[static_cast<std::size_t>(row) * n + x]), expected)
+          << "row " << row << ", column " << x;
     }
-  EXPECT_NEAR(count, 20 * std::cos(30.0 * std::numbers::pi / 180.0), 2.0);
-  // The lines through the cell see the shadow start in the next column.
-  const CellLines lines = cell_lines(crossing(t, px), py, n);
-  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(lines.line_a) * n + px]), 1);
-  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(lines.line_b) * n + px]), 1);
-  EXPECT_NEAR(lines.weight_a, 1.0 - (t * px - std::floor(t * px)), 1e-12);
+  }
+  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(py) * n + px]), 1);
+  // Flights stop at the shadow's start: 51 columns on from column 0 of the
+  // tall point's row, and 55 from column 60 of the row arriving there after
+  // the periodic edge (row 30 - 32 = 62).
+  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(py) * n]), px + 1);
+  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(py - shear + n) * n + 60]),
+            n - 60 + px + 1);
 }
 
 TEST(Sand, BadOptionsAreErrors) {
