@@ -157,11 +157,16 @@ void measure_reach(int n, int limit, Span span, int j0, int j1,
 
 // Columns before column 0 that a line must be followed for.
 // Past that, a line has come round to its own start: after a lap for a row,
-// after rows / gcd(shear, rows) laps for a sheared line.
+// after rows / gcd(shear, rows) laps for a sheared line. Shadows longer than
+// 4 laps of the field (a shadow angle of a small fraction of a degree) are
+// cut there, which keeps the path followed (and the recovery's history, a
+// multiple of it) within a few laps rather than up to a lap per row.
 int warm_up_columns(const terrain::HeightField& h, int shear, double drop_per_column) {
   const HeightRange range = height_range(h);
   const double columns = (static_cast<double>(range.hi) - range.lo) / drop_per_column + 2;
-  const int laps = shear == 0 ? 1 : h.height() / std::gcd(std::abs(shear), h.height());
+  constexpr int kMaxLaps = 4;
+  const int laps =
+      shear == 0 ? 1 : std::min(kMaxLaps, h.height() / std::gcd(std::abs(shear), h.height()));
   return static_cast<int>(std::min<double>(static_cast<double>(h.width()) * laps, columns));
 }
 
