@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
-#include <numbers>
 #include <vector>
 
 #include "dunes/lattice.h"
@@ -99,11 +98,7 @@ DRIFT_SIMD_KERNEL void relax_span(const float* __restrict c, const float* __rest
   }
 }
 
-// A whole row: the inner columns in place; each wrapped column from a 3 x 3
-// copy of its lattice neighbourhood (dunes/lattice.h), its fluxes across
-// the north edges worked out from the heights (the very expression its
-// neighbours evaluate, so the same bits), so that every cell runs the same
-// code. `row` and `h` locate the wrapped neighbours.
+// A row's inner columns, in place.
 DRIFT_SIMD_KERNEL void relax_inner_kernel(const float* c, const float* s, int w,
                                           const EdgeLimits& lim, const float* a_s,
                                           const float* a_se, const float* a_sw, float* south,
@@ -116,6 +111,11 @@ DRIFT_SIMD_TWINS(relax_inner, relax_inner_kernel,
                   float* south_west, float* out),
                  (c, s, w, lim, a_s, a_se, a_sw, south, south_east, south_west, out))
 
+// A whole row: the inner columns in place; each wrapped column from a 3 x 3
+// copy of its lattice neighbourhood (dunes/lattice.h), its fluxes across
+// the north edges worked out from the heights (the very expression its
+// neighbours evaluate, so the same bits), so that every cell runs the same
+// code. `row` and `h` locate the wrapped neighbours.
 void relax_row(const terrain::HeightField& h, int row, int shear, const EdgeLimits& lim,
                const float* a_s, const float* a_se, const float* a_sw, float* south,
                float* south_east, float* south_west, float* out) {

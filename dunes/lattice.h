@@ -13,6 +13,11 @@ inline int wrap_index(int i, int n) {
   return i < 0 ? i + n : i;
 }
 
+// a / n rounded down (n > 0), for negative a too.
+inline long long floor_div(long long a, long long n) {
+  return a >= 0 ? a / n : -((-a + n - 1) / n);
+}
+
 // The height of lattice point (x, row) for any x in [-n, 2n) and any row:
 // a column past either edge is the wrapped column on the row a lap on or back.
 inline float lattice_at(const terrain::HeightField& h, int x, int row, int shear) {

@@ -2,8 +2,8 @@
 
 #include <cassert>
 #include <cmath>
-#include <cstdint>
 #include <numbers>
+#include <vector>
 
 #include "dunes/lattice.h"
 
@@ -61,19 +61,24 @@ double lattice_wind_from(double wind_from_deg, int n) {
 terrain::HeightField unshear(const terrain::HeightField& s, int shear) {
   if (shear == 0) return s;
   const int n = s.width(), rows = s.height();
-  terrain::HeightField m(n, rows, 0.0f, s.geo());
+  // Cell (x, r) sits at lattice row r - shear x / n: `offset` rows (rounded
+  // down) and `above` n-ths of a row from r, the same for a whole column.
+  std::vector<int> offset(n);
+  std::vector<double> w0(n), w1(n);
   for (int x = 0; x < n; ++x) {
-    for (int r = 0; r < rows; ++r) {
-      // Cell (x, r) sits at lattice row r - shear x / n, between rows j0
-      // and j0 + 1, `above` n-ths of the way.
-      const std::int64_t num =
-          static_cast<std::int64_t>(r) * n - static_cast<std::int64_t>(shear) * x;
-      const std::int64_t j0 = num >= 0 ? num / n : -((-num + n - 1) / n);
-      const auto above = static_cast<int>(num - j0 * n);
-      const int row0 = wrap_index(static_cast<int>(j0 % rows), rows);
+    const long long shift = -static_cast<long long>(shear) * x;
+    const long long down = floor_div(shift, n);
+    const auto above = static_cast<int>(shift - down * n);
+    offset[x] = wrap_index(static_cast<int>(down % rows), rows);
+    w0[x] = static_cast<double>(n - above) / n;
+    w1[x] = static_cast<double>(above) / n;
+  }
+  terrain::HeightField m(n, rows, 0.0f, s.geo());
+  for (int r = 0; r < rows; ++r) {
+    for (int x = 0; x < n; ++x) {
+      const int row0 = r + offset[x] < rows ? r + offset[x] : r + offset[x] - rows;
       const int row1 = row0 + 1 == rows ? 0 : row0 + 1;
-      const double w1 = static_cast<double>(above) / n, w0 = static_cast<double>(n - above) / n;
-      m(x, r) = static_cast<float>(w0 * s(x, row0) + w1 * s(x, row1));
+      m(x, r) = static_cast<float>(w0[x] * s(x, row0) + w1[x] * s(x, row1));
     }
   }
   return m;

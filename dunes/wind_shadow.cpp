@@ -58,7 +58,7 @@ std::vector<Stop> stops(int n, int rows, int shear, Span span) {
   const int count = span.before() + n + span.ahead;
   out.reserve(static_cast<std::size_t>(count));
   for (int x = -span.before(); x < n + span.ahead; ++x) {
-    const int laps = x >= 0 ? x / n : -((-x + n - 1) / n);
+    const auto laps = static_cast<int>(floor_div(x, n));
     out.push_back(
         {x - laps * n,
          wrap_index(static_cast<int>(static_cast<long long>(laps) * shear % rows), rows)});
