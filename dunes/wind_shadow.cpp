@@ -7,7 +7,9 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 #include <numeric>
+#include <span>
 #include <type_traits>
 #include <utility>
 
@@ -17,6 +19,7 @@
 
 #include "dunes/height_range.h"
 #include "dunes/lattice.h"
+#include "terrain/simd.h"
 
 namespace drift::dunes {
 
@@ -45,113 +48,109 @@ struct LineStart {
   int since = 1 << 29, run = 0;  // no shadow seen
 };
 
-// Where the lines stand at each column followed, unwrapped column
-// -span.before() + i: the column in the field and the rows the line has
-// moved on by the laps since column 0 (modulo the field's), worked out once
-// per field rather than per line block (integer division is slow).
-struct Stop {
-  int column, row;
+// The columns a line is followed, unwrapped x in [-span.before(),
+// n + span.ahead), a lap of the field at a time: in lap `l` (x in
+// [l n, (l + 1) n)) the line reads column x - l n of the row l shear on
+// (modulo the field's rows). Along x every lap reads the row itself.
+struct Lap {
+  int begin, end;     // unwrapped columns
+  int column_offset;  // -l n
+  int row_shift;      // l shear, wrapped
 };
 
-std::vector<Stop> stops(int n, int rows, int shear, Span span) {
-  std::vector<Stop> out;
-  const int count = span.before() + n + span.ahead;
-  out.reserve(static_cast<std::size_t>(count));
-  for (int x = -span.before(); x < n + span.ahead; ++x) {
-    const auto laps = static_cast<int>(floor_div(x, n));
-    out.push_back(
-        {x - laps * n,
-         wrap_index(static_cast<int>(static_cast<long long>(laps) * shear % rows), rows)});
+std::vector<Lap> laps(int n, int rows, int shear, Span span) {
+  std::vector<Lap> out;
+  const int end = n + span.ahead;
+  for (int x = -span.before(); x < end;) {
+    const long long lap = floor_div(x, n);
+    const int lap_end = static_cast<int>(std::min<long long>((lap + 1) * n, end));
+    out.push_back({x, lap_end, static_cast<int>(-lap * n),
+                   wrap_index(static_cast<int>(lap * shear % rows), rows)});
+    x = lap_end;
   }
   return out;
 }
 
-// Shadow flags of lines [j0, j0 + kLines) at columns [0, n + ahead): each
-// sample below the shadow line cast by the samples upwind of it, at
-// flags[x * kLineBlock + (j - j0)]. With `starts`, also where the recovery
-// stands at column 0 on each line, from the shadows of the `history` columns
-// before it.
-template <int kLines>
-void mark_shadowed(const terrain::HeightField& h, double drop_per_column, Span span,
-                   const std::vector<Stop>& path, int j0, std::uint8_t* flags, LineStart* starts) {
-  const int n = h.width(), rows = h.height();
-  // The lines' shadow heights, in registers: kLines is a constant, so the
-  // loop over lines unrolls.
-  std::array<double, kLines> carried;
-  carried.fill(-1e300);
-  std::array<LineStart, kLines> start;
-  const float* data = h.data();
-  for (int x = -span.before(); x < n + span.ahead; ++x) {
-    const int stop = x + span.before();
-    const Stop& c = path[static_cast<std::size_t>(stop)];
-    const int first = j0 + c.row < rows ? j0 + c.row : j0 + c.row - rows;
-    std::uint8_t* flag = flags + static_cast<std::size_t>(x < 0 ? 0 : x) * kLineBlock;
-#pragma GCC unroll 8
-    for (int k = 0; k < kLines; ++k) {
-      const int row = first + k < rows ? first + k : first + k - rows;
-      const double v = data[static_cast<std::size_t>(row) * n + c.column];
-      double& line = carried[k];
-      line -= drop_per_column;
-      const bool shadow = v < line;
+// A block's lines side by side in the lanes of one vector (GCC's vector
+// extensions: two SSE2 registers in the baseline build, one AVX2 register
+// in its twin; the same IEEE operation in every lane either way).
+using LineDoubles = double __attribute__((vector_size(kLineBlock * sizeof(double))));
+using LineInts = std::int32_t __attribute__((vector_size(kLineBlock * sizeof(std::int32_t))));
+
+// Shadow flags of a block of kLineBlock lines at columns [0, n + ahead):
+// each sample below the shadow line cast by the samples upwind of it, at
+// flags[x * kLineBlock + lane]. Lane k follows line first_row[k] (a short
+// last block repeats its last line), lap by lap (`laps`, `count` of them).
+// With `starts`, also where the recovery stands at column 0 on each line,
+// from the shadows of the `history` columns before it.
+DRIFT_SIMD_KERNEL void mark_shadowed_kernel(const float* data, int n, int rows,
+                                            double drop_per_column, int history, const Lap* laps,
+                                            int count, const std::int32_t* first_row,
+                                            std::int32_t* flags, LineStart* starts) {
+  static_assert(kLineBlock == 4, "the lanes below are written out for 4 lines");
+  LineDoubles carried = {-1e300, -1e300, -1e300, -1e300};
+  LineInts since = LineInts{} + (1 << 29), run = LineInts{};  // no shadow seen
+  for (const Lap& lap : std::span(laps, static_cast<std::size_t>(count))) {
+    std::array<const float*, kLineBlock> line_row;
+    for (int k = 0; k < kLineBlock; ++k) {
+      const int row = first_row[k] + lap.row_shift;
+      line_row[k] = data + static_cast<std::size_t>(row < rows ? row : row - rows) * n;
+    }
+    for (int x = lap.begin; x < lap.end; ++x) {
+      const int c = x + lap.column_offset;
+      const LineDoubles v = {line_row[0][c], line_row[1][c], line_row[2][c], line_row[3][c]};
+      const LineDoubles line = carried - drop_per_column;
+      const LineInts shadow = __builtin_convertvector(v < line, LineInts);  // -1 or 0
       if (x >= 0) {
-        flag[k] = shadow;
-      } else if (x >= -span.history) {
-        LineStart& s = start[k];
-        s.run = shadow ? (s.since == 0 ? s.run + 1 : 1) : s.run;
-        s.since = shadow ? 0 : s.since + 1;
+        const LineInts flag = shadow & 1;
+        std::memcpy(flags + static_cast<std::size_t>(x) * kLineBlock, &flag, sizeof flag);
+      } else if (x >= -history) {
+        run = shadow != 0 ? (since == 0 ? run + 1 : LineInts{} + 1) : run;
+        since = shadow != 0 ? LineInts{} : since + 1;
       }
-      line = std::max(line, v);
+      carried = line < v ? v : line;  // std::max(line, v)
     }
   }
-  if (starts) std::copy(start.begin(), start.end(), starts);
+  for (int k = 0; starts && k < kLineBlock; ++k) starts[k] = {since[k], run[k]};
 }
+DRIFT_SIMD_TWINS(mark_shadowed, mark_shadowed_kernel,
+                 (const float* data, int n, int rows, double drop_per_column, int history,
+                  const Lap* laps, int count, const std::int32_t* first_row, std::int32_t* flags,
+                  LineStart* starts),
+                 (data, n, rows, drop_per_column, history, laps, count, first_row, flags, starts))
 
-// The same for a wind along x, where lines are rows: each row is read
-// straight through, in three runs that need no wrapping (the warm-up at the
-// end of the row, the row, then its start again for the distances ahead).
-template <int kLines>
-void mark_shadowed_rows(const terrain::HeightField& h, double drop_per_column, Span span, int j0,
-                        std::uint8_t* flags) {
-  const int n = h.width();
-  std::array<const float*, kLines> rows;
-  for (int k = 0; k < kLines; ++k) rows[k] = &h(0, j0 + k);
-  std::array<double, kLines> carried;
-  carried.fill(-1e300);
-  auto walk = [&](int begin, int end, int column_offset, bool record) {
-    for (int x = begin; x < end; ++x) {
-      std::uint8_t* flag = flags + static_cast<std::size_t>(x < 0 ? 0 : x) * kLineBlock;
-#pragma GCC unroll 8
-      for (int k = 0; k < kLines; ++k) {
-        const double v = rows[k][x + column_offset];
-        const double line = carried[k] - drop_per_column;
-        if (record) flag[k] = v < line;
-        carried[k] = std::max(line, v);
-      }
-    }
-  };
-  walk(-span.warm_up, 0, n, false);
-  walk(0, n, 0, true);
-  walk(n, n + span.ahead, -n, true);
-}
-
-// Per sample of lines [j0, j1) at columns [0, n): its flag and the columns to
-// the next shadowed sample downwind, at most `limit`. Branch free (the flags
-// follow the relief, which no predictor guesses).
+// Per sample of lines [j0, j1) (at most a block) at columns [0, n): its
+// flag and the columns to the next shadowed sample downwind, at most
+// `limit`. The block's lines in the lanes of a vector, branch free (the
+// flags follow the relief, which no predictor guesses).
 void measure_reach(int n, int limit, Span span, int j0, int j1,
-                   const std::vector<std::uint8_t>& flags, ShadowMap& shadow) {
-  for (int j = j0; j < j1; ++j) {
-    int next = 1 << 30;  // no shadow seen yet
-    std::uint16_t* out = &shadow[static_cast<std::size_t>(j) * n];
-    const std::uint8_t* flag = &flags[static_cast<std::size_t>(j - j0)];
-    for (int x = n + span.ahead - 1; x >= n; --x) {
-      next = flag[static_cast<std::size_t>(x) * kLineBlock] != 0 ? x : next;
-    }
+                   const std::vector<std::int32_t>& flags, ShadowMap& shadow) {
+  auto flag_at = [&](int x) {
+    LineInts f;
+    std::memcpy(&f, &flags[static_cast<std::size_t>(x) * kLineBlock], sizeof f);
+    return f;
+  };
+  LineInts next = LineInts{} + (1 << 30);  // no shadow seen yet
+  for (int x = n + span.ahead - 1; x >= n; --x) next = flag_at(x) != 0 ? x : next;
+  std::uint16_t* out = &shadow[static_cast<std::size_t>(j0) * n];
+  // A whole block stores every lane with no test (the constant unrolls).
+  auto walk = [&](auto whole) {
+    const int lines = decltype(whole)::value ? kLineBlock : j1 - j0;
     for (int x = n - 1; x >= 0; --x) {
-      const int flagged = flag[static_cast<std::size_t>(x) * kLineBlock] != 0 ? 1 : 0;
-      const int reach = std::min(next - x, limit);
-      out[x] = static_cast<std::uint16_t>((reach << 1) | flagged);
+      const LineInts flagged = flag_at(x);
+      const LineInts reach = next - x;
+      const LineInts packed = ((reach < limit ? reach : limit) << 1) | flagged;
+#pragma GCC unroll 4
+      for (int k = 0; k < lines; ++k) {
+        out[static_cast<std::size_t>(k) * n + x] = static_cast<std::uint16_t>(packed[k]);
+      }
       next = flagged != 0 ? x : next;
     }
+  };
+  if (j1 - j0 == kLineBlock) {
+    walk(std::true_type{});
+  } else {
+    walk(std::false_type{});
   }
 }
 
@@ -279,35 +278,22 @@ void wind_shadow(const terrain::HeightField& h, int shear, double drop_per_cell,
   if (recovery && sheared) {
     span.history = static_cast<int>(std::ceil((recovery_ratio + 1.0) * span.warm_up)) + 1;
   }
-  // Rows are read straight through (mark_shadowed_rows); only sheared lines
-  // need the path.
-  const std::vector<Stop> path = sheared ? stops(n, rows, shear, span) : std::vector<Stop>{};
-  // Blocks of kLineBlock lines side by side, the last one a line at a time
-  // if rows are not a multiple of kLineBlock.
+  const std::vector<Lap> path = laps(n, rows, shear, span);
+  // Blocks of kLineBlock lines side by side; a short last block repeats its
+  // last line.
   const int blocks = (rows + kLineBlock - 1) / kLineBlock;
   tbb::parallel_for(
       0, blocks,
       [&](int block) {
         const int j0 = block * kLineBlock, j1 = std::min(rows, j0 + kLineBlock);
-        thread_local std::vector<std::uint8_t> flags;
+        thread_local std::vector<std::int32_t> flags;
         flags.resize(static_cast<std::size_t>(n + span.ahead) * kLineBlock);
+        std::array<std::int32_t, kLineBlock> first_row;
+        for (int k = 0; k < kLineBlock; ++k) first_row[k] = std::min(j0 + k, j1 - 1);
         std::array<LineStart, kLineBlock> starts;
         LineStart* starts_at = recovery && sheared ? starts.data() : nullptr;
-        auto mark = [&](auto lines, int first) {
-          constexpr int kLines = decltype(lines)::value;
-          std::uint8_t* at = flags.data() + (first - j0);
-          if (!sheared) {
-            mark_shadowed_rows<kLines>(h, drop_per_column, span, first, at);
-          } else {
-            mark_shadowed<kLines>(h, drop_per_column, span, path, first, at,
-                                  starts_at ? starts_at + (first - j0) : nullptr);
-          }
-        };
-        if (j1 - j0 == kLineBlock) {
-          mark(std::integral_constant<int, kLineBlock>{}, j0);
-        } else {
-          for (int j = j0; j < j1; ++j) mark(std::integral_constant<int, 1>{}, j);
-        }
+        mark_shadowed(h.data(), n, rows, drop_per_column, span.history, path.data(),
+                      static_cast<int>(path.size()), first_row.data(), flags.data(), starts_at);
         measure_reach(n, limit, span, j0, j1, flags, shadow);
         // The recovery while the block's lines of the map are at hand in
         // cache, rather than in a pass of its own.
