@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <numbers>
 #include <vector>
 
 #include "dunes/lattice.h"
@@ -22,21 +23,19 @@ namespace {
 // operation) does not depend on the number of threads.
 constexpr int kRowBlock = 16;
 
-// The largest drops across the 4 kinds of edge of the wind lattice, each
-// max_drop times the edge's length on the model grid: lattice point (x, r)
-// sits at (x, r + t x), so a step of dx columns and dr rows is
-// sqrt(dx^2 + (dr + t dx)^2) cells long. For t = 0, 1, 1 and sqrt(2).
+// The largest drops across the edges of the square lattice: max_drop along
+// its axes, sqrt(2) max_drop along its diagonals.
 struct EdgeLimits {
   float along;       // (x, r) - (x + 1, r): along the wind line
-  float across;      // (x, r) - (x, r + 1): along the grid's column
+  float across;      // (x, r) - (x, r + 1)
   float south_east;  // (x, r) - (x + 1, r + 1)
   float south_west;  // (x, r) - (x - 1, r + 1)
 };
 
-EdgeLimits edge_limits(double max_drop, double t) {
-  return {static_cast<float>(max_drop * std::sqrt(1.0 + t * t)), static_cast<float>(max_drop),
-          static_cast<float>(max_drop * std::sqrt(1.0 + (1.0 + t) * (1.0 + t))),
-          static_cast<float>(max_drop * std::sqrt(1.0 + (1.0 - t) * (1.0 - t)))};
+EdgeLimits edge_limits(double max_drop) {
+  const auto axis = static_cast<float>(max_drop);
+  const auto diagonal = static_cast<float>(max_drop * std::numbers::sqrt2);
+  return {axis, axis, diagonal, diagonal};
 }
 
 // Flux from a down to b across an edge whose drop may be at most `lim`: a
@@ -111,20 +110,20 @@ DRIFT_SIMD_TWINS(relax_inner, relax_inner_kernel,
                   float* south_west, float* out),
                  (c, s, w, lim, a_s, a_se, a_sw, south, south_east, south_west, out))
 
-// A whole row: the inner columns in place; each wrapped column from a 3 x 3
-// copy of its lattice neighbourhood (dunes/lattice.h), its fluxes across
-// the north edges worked out from the heights (the very expression its
-// neighbours evaluate, so the same bits), so that every cell runs the same
-// code. `row` and `h` locate the wrapped neighbours.
-void relax_row(const terrain::HeightField& h, int row, int shear, const EdgeLimits& lim,
-               const float* a_s, const float* a_se, const float* a_sw, float* south,
-               float* south_east, float* south_west, float* out) {
-  const int w = h.width(), rows = h.height();
+// A whole row, given the row south of it (`s`, the lattice's next row): the
+// inner columns in place; each wrapped column from a 3 x 3 copy of its
+// lattice neighbourhood (dunes/lattice.h), its fluxes across the north edges
+// worked out from the heights (the very expression its neighbours evaluate,
+// so the same bits), so that every cell runs the same code. `row` and `h`
+// locate the wrapped neighbours.
+void relax_row(const terrain::HeightField& h, int row, const float* s, int shift,
+               const EdgeLimits& lim, const float* a_s, const float* a_se, const float* a_sw,
+               float* south, float* south_east, float* south_west, float* out) {
+  const int w = h.width();
   const float* c = &h(0, row);
-  const float* s = &h(0, row + 1 == rows ? 0 : row + 1);
   relax_inner(c, s, w, lim, a_s, a_se, a_sw, south, south_east, south_west, out);
   for (const int x : {0, w - 1}) {
-    const Neighbourhood nb = neighbourhood(h, x, row, shear);
+    const Neighbourhood nb = neighbourhood(h, x, row, shift);
     const float a_s3[3] = {0.0f, flux(nb[0][1], nb[1][1], lim.across), 0.0f};
     const float a_se3[3] = {flux(nb[0][0], nb[1][1], lim.south_east), 0.0f, 0.0f};
     const float a_sw3[3] = {0.0f, 0.0f, flux(nb[0][2], nb[1][1], lim.south_west)};
@@ -140,9 +139,9 @@ void relax_row(const terrain::HeightField& h, int row, int shear, const EdgeLimi
 
 }  // namespace
 
-double max_excess(const terrain::HeightField& h, double max_drop, int shear) {
+double max_excess(const terrain::HeightField& h, double max_drop, int shift) {
   const int w = h.width(), rows = h.height();
-  const EdgeLimits lim = edge_limits(max_drop, static_cast<double>(shear) / w);
+  const EdgeLimits lim = edge_limits(max_drop);
   // Excesses clamped at 0 are non-negative floats, whose bits order like
   // integers: an integer max reduction, which vectorises (a float one does
   // not without -ffast-math).
@@ -159,12 +158,13 @@ double max_excess(const terrain::HeightField& h, double max_drop, int shear) {
   const std::int32_t bits = tbb::parallel_reduce(
       tbb::blocked_range<int>(0, rows, kRowBlock), std::int32_t{0},
       [&](const tbb::blocked_range<int>& r, std::int32_t m) {
+        thread_local std::vector<float> wrapped;
         for (int row = r.begin(); row < r.end(); ++row) {
           const float* __restrict c = &h(0, row);
-          const float* __restrict s = &h(0, row + 1 == rows ? 0 : row + 1);
+          const float* __restrict s = lattice_row(h, row + 1, shift, wrapped);
           std::int32_t row_max = 0;
           for (const int x : {0, w - 1}) {
-            const Neighbourhood nb = neighbourhood(h, x, row, shear);
+            const Neighbourhood nb = neighbourhood(h, x, row, shift);
             row_max = larger(row_max, edges(nb[1][1], nb[1][2], nb[2][1], nb[2][2], nb[2][0]));
           }
           for (int x = 1; x + 1 < w; ++x)
@@ -178,20 +178,20 @@ double max_excess(const terrain::HeightField& h, double max_drop, int shear) {
 }
 
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
-              int shear) {
+              int shift) {
   std::vector<float> scratch;
-  return avalanche(h, max_drop, max_sweeps, tolerance, scratch, shear);
+  return avalanche(h, max_drop, max_sweeps, tolerance, scratch, shift);
 }
 
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
-              std::vector<float>& next, int shear) {
+              std::vector<float>& next, int shift) {
   const int w = h.width(), rows = h.height();
   next.resize(h.size());
-  const EdgeLimits lim = edge_limits(max_drop, static_cast<double>(shear) / w);
+  const EdgeLimits lim = edge_limits(max_drop);
   // Convergence is checked every few sweeps, by a separate vectorised pass.
   constexpr int kCheckEvery = 8;
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
-    if (tolerance >= 0 && sweep % kCheckEvery == 0 && max_excess(h, max_drop, shear) <= tolerance) {
+    if (tolerance >= 0 && sweep % kCheckEvery == 0 && max_excess(h, max_drop, shift) <= tolerance) {
       return sweep;
     }
     tbb::parallel_for(
@@ -209,12 +209,14 @@ int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double t
           float* above[3] = {buffers.data(), buffers.data() + stride, buffers.data() + 2 * stride};
           float* below[3] = {buffers.data() + 3 * stride, buffers.data() + 4 * stride,
                              buffers.data() + 5 * stride};
+          thread_local std::vector<float> wrapped;  // a row past the edge, shifted
           const int first = r.begin();
-          south_fluxes(&h(0, first == 0 ? rows - 1 : first - 1), &h(0, first), w, lim, above[0],
+          south_fluxes(lattice_row(h, first - 1, shift, wrapped), &h(0, first), w, lim, above[0],
                        above[1], above[2]);
           for (int row = first; row < r.end(); ++row) {
-            relax_row(h, row, shear, lim, above[0], above[1], above[2], below[0], below[1],
-                      below[2], &next[static_cast<std::size_t>(row) * w]);
+            relax_row(h, row, lattice_row(h, row + 1, shift, wrapped), shift, lim, above[0],
+                      above[1], above[2], below[0], below[1], below[2],
+                      &next[static_cast<std::size_t>(row) * w]);
             std::swap(above, below);
           }
         },

@@ -21,17 +21,18 @@ namespace drift::dunes {
 // after `max_sweeps`; returns the sweeps done. A negative tolerance skips the
 // checks (all `max_sweeps` run).
 //
-// `shear` != 0: h is the wind lattice of that shear (dunes/wind_frame.h),
-// its 8 neighbours wrapping across the column edge a lap of rows on, each
-// edge's limit max_drop times its length on the model grid.
+// `shift`: h is a wind lattice (dunes/wind_frame.h) whose row 0 goes on past
+// its last row `shift` columns back; 0 for a plain periodic grid. Edges are
+// those of a square lattice of the field's own spacing (the caller scales
+// max_drop to it).
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance = 1e-4,
-              int shear = 0);
+              int shift = 0);
 // The same with caller-owned scratch for the new field (kept between calls,
 // so a run does not allocate and clear it every step).
 int avalanche(terrain::HeightField& h, double max_drop, int max_sweeps, double tolerance,
-              std::vector<float>& scratch, int shear = 0);
+              std::vector<float>& scratch, int shift = 0);
 
 // How far the steepest edge (of 8 neighbours) exceeds its limit (<= 0: none).
-double max_excess(const terrain::HeightField& h, double max_drop, int shear = 0);
+double max_excess(const terrain::HeightField& h, double max_drop, int shift = 0);
 
 }  // namespace drift::dunes

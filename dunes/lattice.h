@@ -1,8 +1,10 @@
-// Neighbours on the wind lattice (dunes/wind_frame.h): rows are periodic,
-// and past the last column row j goes on as row j + shear from column 0.
+// Neighbours on the wind lattice (dunes/wind_frame.h): rows close on
+// themselves, and past the last row, row 0 goes on `shift` columns back
+// (point (x, row + K) is point (x - shift, row)).
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "terrain/grid.h"
 
@@ -18,21 +20,34 @@ inline long long floor_div(long long a, long long n) {
   return a >= 0 ? a / n : -((-a + n - 1) / n);
 }
 
-// The height of lattice point (x, row) for any x in [-n, 2n) and any row:
-// a column past either edge is the wrapped column on the row a lap on or back.
-inline float lattice_at(const terrain::HeightField& h, int x, int row, int shear) {
-  const int n = h.width();
-  const int laps = x < 0 ? -1 : (x >= n ? 1 : 0);
-  return h(x - laps * n, wrap_index(row + laps * shear, h.height()));
+// The height of lattice point (x, row) for any x and row: a row past either
+// edge is the wrapped row `shift` columns back per lap of rows.
+inline float lattice_at(const terrain::HeightField& h, long long x, long long row, int shift) {
+  const long long laps = floor_div(row, h.height());
+  const long long column = x - laps * shift;
+  const long long wrapped = column % h.width();
+  return h(static_cast<int>(wrapped < 0 ? wrapped + h.width() : wrapped),
+           static_cast<int>(row - laps * h.height()));
+}
+
+// The heights of lattice row `row` (any integer): the row itself if it lies
+// in the field, else the wrapped row turned by the shift into `buffer`.
+inline const float* lattice_row(const terrain::HeightField& h, int row, int shift,
+                                std::vector<float>& buffer) {
+  if (row >= 0 && row < h.height()) return &h(0, row);
+  const int w = h.width();
+  buffer.resize(static_cast<std::size_t>(w));
+  for (int x = 0; x < w; ++x) buffer[x] = lattice_at(h, x, row, shift);
+  return buffer.data();
 }
 
 // The 3 x 3 heights around lattice point (x, row): [0] the row above
 // (columns x - 1, x, x + 1), [1] the row, [2] the row below.
 using Neighbourhood = std::array<std::array<float, 3>, 3>;
-inline Neighbourhood neighbourhood(const terrain::HeightField& h, int x, int row, int shear) {
+inline Neighbourhood neighbourhood(const terrain::HeightField& h, int x, int row, int shift) {
   Neighbourhood out;
   for (int dr = -1; dr <= 1; ++dr)
-    for (int dx = -1; dx <= 1; ++dx) out[dr + 1][dx + 1] = lattice_at(h, x + dx, row + dr, shear);
+    for (int dx = -1; dx <= 1; ++dx) out[dr + 1][dx + 1] = lattice_at(h, x + dx, row + dr, shift);
   return out;
 }
 

@@ -9,18 +9,24 @@
 // turned fields; the residual keeps the wind's component along +x at least
 // cos 45 degrees, so every flight moves downwind column by column.
 //
-// The wind lattice. On an n x n grid the residual is rounded to a whole number
-// of rows per lap of columns, `shear` = k (t = k / n rows per column, within
-// half a row per lap of the asked direction). The model's sand then lives on
-// the sheared lattice whose rows are the wind lines: lattice point (i, j) sits
-// at (i, j + t i) on the model grid, so every line runs exactly through its
-// points, each point lies on one line, and flights, the wind shadow and the
-// launch slope are one-dimensional along rows, as for a wind along x. The
-// lattice is periodic with the grid: past column n - 1, row j goes on as row
-// j + k from column 0 (a helix). Nothing depends on the column but through
-// that wrap, so no pattern locks to the grid's columns, as it did when the
-// lines were sampled between grid rows every step (docs/dunes.md). For k = 0
-// the lattice is the grid; for k = +-n its rows are the grid's diagonals.
+// The wind lattice. On an n x n grid the residual is rounded to a direction
+// (p, q) of whole columns and rows (p, q coprime, |q| <= p), and the sand
+// lives on a square lattice turned to it, whose rows are the wind lines:
+// lattice point (i, j) sits at i h (cos a, sin a) + j h (-sin a, cos a) on
+// the model grid, h = n / (c K) grid cells apart, c = sqrt(p^2 + q^2). The
+// model grid is a torus (n x n, periodic), and so is the turned lattice when
+// it has K rows of M = c^2 K points: a row closes on itself after M points
+// (n (p, q) is a period of the grid), and past row K - 1, row 0 goes on
+// `shift` columns back: point (i, j + K) is point (i - S, j), S = (a p + b q)
+// K for b p - a q = 1. The lattice has as many points as the grid, within a
+// row's worth.
+//
+// Every flight, the wind shadow and the launch slope run along a row, as
+// for a wind along x, and a crest across the wind is a lattice column: no
+// staircase, so slip faces across an oblique wind form as they do along the
+// grid (a lattice sheared along the grid's columns wore them down,
+// docs/dunes.md). The field is interpolated onto the grid at the end;
+// for the axes the lattice is the grid itself (h = 1, S = 0, M = K = n).
 #pragma once
 
 #include "terrain/grid.h"
@@ -31,29 +37,41 @@ struct WindFrame {
   int quarter_turns = 0;  // clockwise quarter turns (map view) from model to ground
   double cos_a = 1.0;     // wind direction in the model grid: columns ...
   double sin_a = 0.0;     // ... and rows (rows run south before the turn), |a| <= 45 deg
-  int shear = 0;          // wind_frame(az, n): rows per lap of n columns, |shear| <= n
-  // Rows crossed per column along the wind: sin a / cos a, in [-1, 1].
-  double rows_per_column() const { return sin_a / cos_a; }
 };
 
 // `wind_from_deg`: where the wind comes from, clockwise from north; the
-// residual angle exact, shear 0.
+// residual angle exact.
 WindFrame wind_frame(double wind_from_deg);
 
-// The same on an n x n grid, the residual rounded to the wind lattice's
-// t = shear / n (cos a and sin a those of the rounded direction).
-WindFrame wind_frame(double wind_from_deg, int n);
+// The wind lattice of an n x n model grid (see above).
+struct WindLattice {
+  WindFrame frame;    // cos a, sin a those of (p, q)
+  int p = 1, q = 0;   // the wind's direction in whole columns and rows
+  int columns = 0;    // M = (p^2 + q^2) K points a row
+  int rows = 0;       // K
+  int shift = 0;      // S, in [0, M): past the last row, row 0 S columns back
+  double cell = 1.0;  // h: the lattice's spacing in grid cells, in [1, 1 + 1 / K)
+  bool turned() const { return q != 0; }
+};
 
-// The azimuth the wind lattice of wind_frame(wind_from_deg, n) simulates:
+// The lattice for `wind_from_deg` on an n x n grid: of the axis and the
+// directions (p, q) with c <= max(sqrt 2, sqrt n) (rows of at most
+// max(2, sqrt n) grid widths: long thin lattices cost cache and parallel
+// rows) and at least 4 rows, the one that minimises the angle from the wind
+// (radians) plus h - 1 (a coarser lattice costs resolution: 1 % of it
+// weighs as much as 0.57 degrees). The axes and diagonals are exact.
+WindLattice wind_lattice(double wind_from_deg, int n);
+
+// The azimuth the lattice of wind_lattice(wind_from_deg, n) simulates:
 // wind_from_deg moved by the rounding of its residual angle.
 double lattice_wind_from(double wind_from_deg, int n);
 
-// Wind lattice -> model grid (see above): each grid cell (x, r) by linear
-// interpolation between the lattice points of column x around it, rows
-// r - t x rounded down and up (weights exact multiples of 1/n). Column sums,
-// so mass, are kept to float rounding; the identity for shear 0, a
-// permutation of cells for shear +-n.
-terrain::HeightField unshear(const terrain::HeightField& lattice, int shear);
+// Wind lattice -> n x n model grid: each grid cell bilinearly from the 4
+// lattice points around it, then the mean (so the mass: the lattice's points
+// stand for h^2 cells each, and M K h^2 = n^2) restored exactly in double.
+// The lattice itself for a wind along the axes.
+terrain::HeightField lattice_to_grid(const terrain::HeightField& lattice, const WindLattice& l,
+                                     int n);
 
 // Model field -> ground field by the frame's quarter turns (exact; square
 // grids). Values are copied unchanged.

@@ -56,17 +56,9 @@ void run_dunes(const DunesCommand& c, const CLI::App& sub) {
   const double simulated_from = dunes::lattice_wind_from(o.wind_from_deg, o.size);
   if (std::fabs(simulated_from - o.wind_from_deg) > 1e-9) {
     std::fprintf(stderr,
-                 "drift dunes: note: --wind %g runs as %.3f, the nearest direction crossing a "
-                 "whole number of rows per lap of the %d-cell grid (so the field tiles)\n",
+                 "drift dunes: note: --wind %g runs as %.2f, the nearest direction of whole "
+                 "columns and rows whose turned lattice tiles the %d-cell grid\n",
                  o.wind_from_deg, simulated_from, o.size);
-  }
-  if (o.shadow_deg > 0.0 && dunes::wind_frame(o.wind_from_deg, o.size).shear != 0) {
-    std::fprintf(stderr,
-                 "drift dunes: note: --wind %g is oblique to the grid; with a wind shadow "
-                 "(--shadow %g) dunes grow more slowly than along the grid and small slip faces "
-                 "lock onto the grid's columns (a known defect, docs/dunes.md). Winds from 0, "
-                 "90, 180 or 270 give the best dunes; turn the scene instead.\n",
-                 o.wind_from_deg, o.shadow_deg);
   }
   const std::filesystem::path out = c.output;
   const std::string description = c.model + " height (m)";
@@ -109,9 +101,9 @@ void add_dunes_command(CLI::App& root) {
   sub->add_option(
       "--wind", o.wind_from_deg,
       "where the wind comes FROM, degrees clockwise from north, as in weather "
-      "reports (270: a west wind) [-360, 360]. Any azimuth, rounded to a whole number of "
-      "rows per lap of the grid (within half a row) so that the field always tiles "
-      "(dunes with a shadow: best along the axes, see docs/dunes.md)");
+      "reports (270: a west wind) [-360, 360]. Any azimuth; off the axes it is rounded to "
+      "a direction of whole columns and rows so that the field always tiles (within 2 "
+      "degrees on a 256-cell grid, 1 on 1024; the run prints it)");
   sub->add_option("--L0", o.L0, "base flight length in cells [0.5, 64]");
   sub->add_option("--b", o.b, "flight-length coefficient [0, 32]");
   sub->add_option("--q", o.q, "height lifted per cell and step (dunes: q0) [1e-4, 2]");

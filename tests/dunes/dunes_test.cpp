@@ -11,8 +11,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <numbers>
+#include <numeric>
+#include <string>
 
 #include "dunes/avalanche.h"
+#include "dunes/lattice.h"
 #include "dunes/sand_model.h"
 #include "dunes/wind_frame.h"
 #include "dunes/wind_shadow.h"
@@ -338,145 +341,171 @@ TEST(Sand, WindsAQuarterTurnApartGiveTurnedFieldsAtAnyAzimuth) {
   EXPECT_EQ(wind_frame(0.0).quarter_turns, 1);
   // Diagonal winds cross exactly one row per column.
   for (const double diagonal : {45.0, 135.0, 225.0, 315.0})
-    EXPECT_EQ(std::fabs(wind_frame(diagonal).rows_per_column()), 1.0) << diagonal;
+    EXPECT_EQ(std::fabs(wind_frame(diagonal).sin_a), wind_frame(diagonal).cos_a) << diagonal;
 }
 
-TEST(Sand, TheWindLatticeRoundsTheWindToWholeRowsPerLap) {
-  // Within half a row per lap of n columns: at most 0.5 / n radians off.
+TEST(Sand, TheWindLatticeIsATurnedSquareLatticeThatTilesTheGrid) {
   for (const int n : {8, 64, 250, 1024}) {
     for (const double wind : {270.0, 271.0, 285.0, 300.0, 315.0, 240.0, 30.0, 100.0}) {
-      const WindFrame f = wind_frame(wind, n);
-      EXPECT_EQ(f.quarter_turns, wind_frame(wind).quarter_turns);
-      EXPECT_LE(std::abs(f.shear), n);
-      EXPECT_NEAR(f.sin_a / f.cos_a, static_cast<double>(f.shear) / n, 1e-15);
-      EXPECT_NEAR(lattice_wind_from(wind, n), wind, 0.5 / n * 180 / std::numbers::pi + 1e-9)
-          << "wind " << wind << ", n " << n;
-    }
-  }
-  EXPECT_EQ(wind_frame(300.0, 64).shear, 37);  // 64 tan 30 = 36.95
-  EXPECT_EQ(wind_frame(270.0, 64).shear, 0);
-  for (const double diagonal : {45.0, 135.0, 225.0, 315.0})
-    EXPECT_EQ(std::abs(wind_frame(diagonal, 64).shear), 64) << diagonal;
-  EXPECT_EQ(lattice_wind_from(270.0, 64), 270.0);
-}
-
-TEST(Sand, UnshearingTheWindLatticeKeepsMassAndLinearFields) {
-  const int n = 48;
-  for (const int shear : {0, 7, -20, 24, n, -n}) {
-    const double t = static_cast<double>(shear) / n;
-    // Random heights: mass kept (column sums are).
-    SandOptions o = small(Model::Dunes, n, 0);
-    const HeightField noise = initial_field(o);
-    const HeightField m = unshear(noise, shear);
-    EXPECT_NEAR(total(m), total(noise), 1e-4 * total(noise)) << "shear " << shear;
-    // A field linear along the grid's columns, periodic over the lap of
-    // rows (a ramp over rows 0..n-1 would break at the wrap): heights of
-    // lattice point (x, j) = cos of its model-grid row j + t x, 2 pi / n a
-    // row. Interpolation between rows gives the cosine at the grid cell
-    // within its curvature (1 - cos of half a row's phase).
-    HeightField lattice(n, n);
-    for (int j = 0; j < n; ++j)
-      for (int x = 0; x < n; ++x)
-        lattice(x, j) = static_cast<float>(std::cos(2 * std::numbers::pi * (j + t * x) / n));
-    const HeightField grid = unshear(lattice, shear);
-    for (int r = 0; r < n; ++r) {
-      for (int x = 0; x < n; ++x) {
-        ASSERT_NEAR(grid(x, r), std::cos(2 * std::numbers::pi * r / n), 3e-3)
-            << "shear " << shear << " at " << x << "," << r;
+      const WindLattice l = wind_lattice(wind, n);
+      const std::string at = "wind " + std::to_string(wind) + ", n " + std::to_string(n);
+      EXPECT_EQ(l.frame.quarter_turns, wind_frame(wind).quarter_turns) << at;
+      ASSERT_GE(l.p, 1) << at;
+      EXPECT_LE(std::abs(l.q), l.p) << at;
+      EXPECT_EQ(std::gcd(l.p, std::abs(l.q)), 1) << at;
+      EXPECT_NEAR(l.frame.sin_a / l.frame.cos_a, static_cast<double>(l.q) / l.p, 1e-15) << at;
+      // As many points as the grid, within a row's worth; spacing >= 1 cell.
+      EXPECT_EQ(l.columns, (l.p * l.p + l.q * l.q) * l.rows) << at;
+      EXPECT_GE(l.cell, 1.0) << at;
+      EXPECT_LT(l.cell, 1.0 + 1.0 / l.rows) << at;
+      // Its periods land on the grid's: a row closes after `columns`
+      // points, and row `rows` is row 0 `shift` columns back. Point (i, j)
+      // sits at i h (cos a, sin a) + j h (-sin a, cos a).
+      auto on_the_grid_lattice = [&](double i, double j) {
+        const double x = l.cell * (i * l.frame.cos_a - j * l.frame.sin_a);
+        const double y = l.cell * (i * l.frame.sin_a + j * l.frame.cos_a);
+        return std::fabs(x / n - std::round(x / n)) < 1e-9 * l.columns &&
+               std::fabs(y / n - std::round(y / n)) < 1e-9 * l.columns;
+      };
+      EXPECT_TRUE(on_the_grid_lattice(l.columns, 0)) << at;
+      EXPECT_TRUE(on_the_grid_lattice(l.shift, l.rows)) << at;
+      // The direction: from the 250-cell grid on, within 2 degrees
+      // (closest to the axes, where steep directions need long rows).
+      if (n >= 250) {
+        EXPECT_NEAR(lattice_wind_from(wind, n), wind, 2.0) << at;
       }
     }
-    if (shear == 0) {
-      EXPECT_EQ(m.values(), noise.values());  // the grid itself
-    }
   }
-  // Shear n: grid cell (x, r) is lattice point (x, r - x) exactly.
+  const WindLattice along = wind_lattice(270.0, 64);
+  EXPECT_EQ(along.columns, 64);
+  EXPECT_EQ(along.rows, 64);
+  EXPECT_EQ(along.shift, 0);
+  EXPECT_EQ(along.cell, 1.0);
+  EXPECT_EQ(lattice_wind_from(270.0, 64), 270.0);
+  for (const double diagonal : {45.0, 135.0, 225.0, 315.0}) {
+    const WindLattice l = wind_lattice(diagonal, 64);
+    EXPECT_EQ(l.p, 1);
+    EXPECT_EQ(std::abs(l.q), 1);
+    EXPECT_EQ(l.rows, 45);  // 64 / sqrt 2 = 45.25
+    EXPECT_NEAR(lattice_wind_from(diagonal, 64), diagonal, 1e-12);
+  }
+  // 1024 cells: 30 degrees off the axes within a tenth of a degree.
+  EXPECT_NEAR(lattice_wind_from(300.0, 1024), 300.0, 0.1);
+}
+
+TEST(Sand, TheLatticeComesOntoTheGridWithItsMassAndShape) {
+  const int n = 64;
+  for (const double wind : {300.0, 240.0, 315.0, 285.0}) {
+    const WindLattice l = wind_lattice(wind, n);
+    // Random heights: the mean, so the mass, kept.
+    SandOptions o = small(Model::Dunes, n, 0);
+    o.wind_from_deg = wind;
+    const HeightField noise = initial_field(o);
+    ASSERT_EQ(noise.width(), l.columns);
+    ASSERT_EQ(noise.height(), l.rows);
+    const HeightField m = lattice_to_grid(noise, l, n);
+    ASSERT_EQ(m.width(), n);
+    EXPECT_NEAR(total(m) / m.size(), total(noise) / noise.size(), 1e-6) << "wind " << wind;
+    // A smooth field periodic on the grid, sampled at the lattice's points,
+    // comes back within the bilinear interpolation's error.
+    auto smooth = [n](double x, double y) {
+      return std::cos(2 * std::numbers::pi * x / n) + std::sin(4 * std::numbers::pi * y / n);
+    };
+    HeightField lattice(l.columns, l.rows);
+    for (int j = 0; j < l.rows; ++j)
+      for (int i = 0; i < l.columns; ++i)
+        lattice(i, j) =
+            static_cast<float>(smooth(l.cell * (i * l.frame.cos_a - j * l.frame.sin_a),
+                                      l.cell * (i * l.frame.sin_a + j * l.frame.cos_a)));
+    const HeightField grid = lattice_to_grid(lattice, l, n);
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        ASSERT_NEAR(grid(x, y), smooth(x, y), 2e-2) << "wind " << wind << " at " << x << "," << y;
+  }
+  // Along the axes the lattice is the grid.
   SandOptions o = small(Model::Dunes, n, 0);
   const HeightField noise = initial_field(o);
-  const HeightField diagonal = unshear(noise, n);
-  for (int r = 0; r < n; ++r)
-    for (int x = 0; x < n; ++x) ASSERT_EQ(diagonal(x, r), noise(x, ((r - x) % n + n) % n));
+  EXPECT_EQ(lattice_to_grid(noise, wind_lattice(270.0, n), n).values(), noise.values());
 }
 
-TEST(Sand, CreepOnTheWindLatticeSpreadsABumpAlikeInEveryDirection) {
-  // A bump spread by creep alone on a sheared lattice, seen on the model
-  // grid, must be round: equal variances along x and y, no covariance (the
-  // lattice's plain 4 neighbours would give a covariance of t times the
-  // variance). Diffusion D/4 a step: variance 2 D/4 per step and axis.
-  const int n = 96, steps = 200;
-  const double D = 0.5;
-  for (const int shear : {0, 29, -29, 60, n}) {
-    HeightField h(n, n, 0.0f);
-    const int x0 = 40, j0 = 50;
-    h(x0, j0) = 1000.0f;
-    for (int s = 0; s < steps; ++s) creep(h, D, shear);
-    const HeightField g = unshear(h, shear);
-    const double y0 = j0 + static_cast<double>(shear) / n * x0;
-    double mass = 0, xx = 0, yy = 0, xy = 0;
-    auto centred = [n](double d) { return d - n * std::round(d / n); };
-    for (int r = 0; r < n; ++r)
-      for (int x = 0; x < n; ++x) {
-        const double dx = centred(x - x0), dy = centred(r - y0), v = g(x, r);
-        mass += v, xx += v * dx * dx, yy += v * dy * dy, xy += v * dx * dy;
-      }
-    xx /= mass, yy /= mass, xy /= mass;
-    const double expected = 2 * D / 4 * steps;
-    EXPECT_NEAR(xx, expected, 0.03 * expected) << "shear " << shear;
-    // Unshearing interpolates along y: up to a quarter row squared more.
-    EXPECT_NEAR(yy, expected, 0.03 * expected + 0.25) << "shear " << shear;
-    EXPECT_LT(std::fabs(xy), 0.02 * expected) << "shear " << shear;
+TEST(Sand, CreepCrossesTheLatticesShiftedWrapLikeAnyOtherRow) {
+  // A bump on row 0 of the wind lattice for 300 degrees, half of it spread
+  // across the wrap (onto the last rows, shifted), and the same bump on a
+  // middle row must spread alike, and keep their mass.
+  const WindLattice l = wind_lattice(300.0, 64);
+  ASSERT_TRUE(l.turned());
+  ASSERT_NE(l.shift, 0);
+  const int x0 = 10, middle = l.rows / 2;
+  HeightField edge(l.columns, l.rows, 0.0f), inner = edge;
+  edge(x0, 0) = 1000.0f;
+  inner(x0, middle) = 1000.0f;
+  for (int s = 0; s < 60; ++s) {
+    creep(edge, 0.5, l.shift);
+    creep(inner, 0.5, l.shift);
   }
+  EXPECT_NEAR(total(edge), 1000.0, 1e-2);
+  for (int dj = -6; dj <= 6; ++dj) {
+    for (int dx = -6; dx <= 6; ++dx) {
+      const float a = lattice_at(edge, x0 + dx, dj, l.shift);
+      const float b = lattice_at(inner, x0 + dx, middle + dj, l.shift);
+      ASSERT_NEAR(a, b, 1e-4f * 1000.0f) << dx << "," << dj;
+    }
+  }
+  EXPECT_GT(lattice_at(edge, x0, -3, l.shift), 1.0f) << "the bump crossed the wrap";
 }
 
 TEST(Sand, NothingDependsOnTheColumnOnAnObliqueWind) {
   // Dunes with the wind shadow at a wind from 300: a start shifted by one
-  // column along the wind lattice (past the last column, the row a lap on)
-  // gives the field shifted by one column, to float rounding. Sampling the
-  // wind lines between grid rows failed this: what a cell did depended on
-  // where the lines crossed its column, and slip faces locked onto columns.
+  // column along the wind lattice gives the field shifted by one column, to
+  // float rounding. Sampling the wind lines between grid rows failed this:
+  // what a cell did depended on where the lines crossed its column, and
+  // slip faces locked onto columns.
   SandOptions o = small(Model::Dunes, 64, 0);
   o.wind_from_deg = 300.0;
-  const int n = 64, shear = wind_frame(o.wind_from_deg, n).shear;
   HeightField a = initial_field(o);
+  const int columns = a.width(), rows = a.height();
   for (float& v : a.values()) v *= 8.0f;  // relief enough for shadows at once
   auto shifted = [&](const HeightField& h) {
-    HeightField out(n, n);
-    for (int j = 0; j < n; ++j)
-      for (int x = 0; x < n; ++x)
-        out(x, j) = x > 0 ? h(x - 1, j) : h(n - 1, ((j - shear) % n + n) % n);
+    HeightField out(columns, rows);
+    for (int j = 0; j < rows; ++j)
+      for (int x = 0; x < columns; ++x) out(x, j) = h(x > 0 ? x - 1 : columns - 1, j);
     return out;
   };
   HeightField b = shifted(a);
   step_both(a, o, b, o, 40);
-  const double spread = largest_difference(a, HeightField(n, n, a(0, 0)));
+  const double spread = largest_difference(a, HeightField(columns, rows, a(0, 0)));
   EXPECT_GT(spread, 1.0);
   EXPECT_LT(largest_difference(b, shifted(a)), 1e-4 * spread);
 }
 
 TEST(Sand, WindsMirroredAboutTheGridGiveMirroredFields) {
   // A wind 30 degrees to one side of +x (from 300) on a field, and 30
-  // degrees to the other (from 240) on the field mirrored across the rows,
-  // must give mirrored fields: nothing in saltation, the wind shadow, the
-  // lift's recovery, creep or avalanching may prefer a side. The two runs
-  // sum in other orders, so they agree to float rounding, not bit for bit.
+  // degrees to the other (from 240) on the field mirrored across the wind
+  // (the lattices are mirror images: lattice point (i, j) of one is (i, -j)
+  // of the other), must give mirrored fields: nothing in saltation, the wind
+  // shadow, the lift's recovery, creep or avalanching may prefer a side. The
+  // two runs sum in other orders, so they agree to float rounding, not bit
+  // for bit.
   for (Model model : {Model::Dunes, Model::Ripples}) {
     SandOptions right = small(model, 64, 0);
     SandOptions left = right;
     right.wind_from_deg = 300.0;
     left.wind_from_deg = 240.0;
-    ASSERT_EQ(wind_frame(240.0).quarter_turns, 0);
-    ASSERT_NEAR(wind_frame(240.0).sin_a, -wind_frame(300.0).sin_a, 1e-15);
+    const WindLattice lr = wind_lattice(300.0, 64), ll = wind_lattice(240.0, 64);
+    ASSERT_EQ(ll.q, -lr.q);
+    ASSERT_EQ(ll.rows, lr.rows);
+    ASSERT_EQ(ll.shift, (lr.columns - lr.shift) % lr.columns);
     HeightField a = initial_field(right);
-    const int n = a.width();
-    auto mirrored = [n](const HeightField& h) {
+    auto mirrored = [&](const HeightField& h) {
       HeightField m = h;
-      for (int row = 0; row < n; ++row)
-        for (int x = 0; x < n; ++x) m(x, row) = h(x, n - 1 - row);
+      for (int j = 0; j < h.height(); ++j)
+        for (int i = 0; i < h.width(); ++i) m(i, j) = lattice_at(h, i, -j, lr.shift);
       return m;
     };
     HeightField b = mirrored(a);
     step_both(a, right, b, left, 30);
-    const double top = largest_difference(a, HeightField(n, n, 0.0f));
-    EXPECT_LT(largest_difference(a, mirrored(b)), 1e-5 * std::max(top, 1.0))
+    const double top = largest_difference(a, HeightField(a.width(), a.height(), 0.0f));
+    EXPECT_LT(largest_difference(b, mirrored(a)), 1e-5 * std::max(top, 1.0))
         << "model " << static_cast<int>(model);
   }
 }
@@ -558,39 +587,6 @@ TEST(Sand, RippleCrestsStandAcrossAnObliqueWind) {
     EXPECT_LT(off, 3.0) << "wind " << wind << ": wave direction " << got << ", wind axis "
                         << expected;
   }
-}
-
-TEST(Sand, TheWindShadowLiesDownwindAlongTheWind) {
-  // One tall point on flat sand on the wind lattice of a wind half a row per
-  // column off +x (shear 32 on 64 columns): only points downwind on its own
-  // line are shadowed, as far as the shadow line stays above 0, falling
-  // 0.5 * sqrt(1 + 1/4) per column: 17 columns, past the last column on the
-  // row a lap on (row + 32).
-  const int n = 64, shear = 32;
-  HeightField h(n, n, 0.0f);
-  const int px = 50, py = 30;
-  h(px, py) = 10.0f;
-  ShadowMap s;
-  wind_shadow(h, shear, 0.5, n, s);
-  const double per_column = 0.5 * std::sqrt(1.25);
-  for (int row = 0; row < n; ++row) {
-    for (int x = 0; x < n; ++x) {
-      // Columns downwind of the tall point along its line, or -1.
-      int along = -1;
-      if (row == py && x > px) along = x - px;
-      if (row == py + shear && x < px) along = x + n - px;
-      const bool expected = along > 0 && 10.0 - along * per_column > 0.0;
-      ASSERT_EQ(shadowed(s[static_cast<std::size_t>(row) * n + x]), expected)
-          << "row " << row << ", column " << x;
-    }
-  }
-  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(py) * n + px]), 1);
-  // Flights stop at the shadow's start: 51 columns on from column 0 of the
-  // tall point's row, and 55 from column 60 of the row arriving there after
-  // the periodic edge (row 30 - 32 = 62).
-  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(py) * n]), px + 1);
-  EXPECT_EQ(columns_to_shadow(s[static_cast<std::size_t>(py - shear + n) * n + 60]),
-            n - 60 + px + 1);
 }
 
 TEST(Sand, BadOptionsAreErrors) {
