@@ -26,16 +26,12 @@ constexpr int kRowBlock = 16;
 // The largest drops across the edges of the square lattice: max_drop along
 // its axes, sqrt(2) max_drop along its diagonals.
 struct EdgeLimits {
-  float along;       // (x, r) - (x + 1, r): along the wind line
-  float across;      // (x, r) - (x, r + 1)
-  float south_east;  // (x, r) - (x + 1, r + 1)
-  float south_west;  // (x, r) - (x - 1, r + 1)
+  float axis;      // (x, r) - (x + 1, r) and (x, r) - (x, r + 1)
+  float diagonal;  // (x, r) - (x + 1, r + 1) and (x, r) - (x - 1, r + 1)
 };
 
 EdgeLimits edge_limits(double max_drop) {
-  const auto axis = static_cast<float>(max_drop);
-  const auto diagonal = static_cast<float>(max_drop * std::numbers::sqrt2);
-  return {axis, axis, diagonal, diagonal};
+  return {static_cast<float>(max_drop), static_cast<float>(max_drop * std::numbers::sqrt2)};
 }
 
 // Flux from a down to b across an edge whose drop may be at most `lim`: a
@@ -60,10 +56,10 @@ DRIFT_SIMD_KERNEL void south_fluxes_kernel(const float* __restrict c, const floa
                                            int w, const EdgeLimits& lim, float* __restrict south,
                                            float* __restrict south_east,
                                            float* __restrict south_west) {
-  const float across = lim.across, se = lim.south_east, sw = lim.south_west;
-  for (int x = 0; x < w; ++x) south[x] = flux(c[x], s[x], across);
-  for (int x = 0; x + 1 < w; ++x) south_east[x] = flux(c[x], s[x + 1], se);
-  for (int x = 1; x < w; ++x) south_west[x] = flux(c[x], s[x - 1], sw);
+  const float axis = lim.axis, diagonal = lim.diagonal;
+  for (int x = 0; x < w; ++x) south[x] = flux(c[x], s[x], axis);
+  for (int x = 0; x + 1 < w; ++x) south_east[x] = flux(c[x], s[x + 1], diagonal);
+  for (int x = 1; x < w; ++x) south_west[x] = flux(c[x], s[x - 1], diagonal);
 }
 DRIFT_SIMD_TWINS(south_fluxes, south_fluxes_kernel,
                  (const float* c, const float* s, int w, const EdgeLimits& lim, float* south,
@@ -83,15 +79,15 @@ DRIFT_SIMD_KERNEL void relax_span(const float* __restrict c, const float* __rest
                                   float* __restrict south_west, float* __restrict out) {
   // One level of inlining, no lambda: either loses `restrict` for GCC, which
   // then does not vectorise the loop.
-  const float along = lim.along, across = lim.across, se = lim.south_east, sw = lim.south_west;
+  const float edge = lim.axis, diagonal = lim.diagonal;
   for (int x = begin; x < end; ++x) {
-    const float to_s = flux(c[x], s[x], across);
-    const float to_se = flux(c[x], s[x + 1], se);
-    const float to_sw = flux(c[x], s[x - 1], sw);
+    const float to_s = flux(c[x], s[x], edge);
+    const float to_se = flux(c[x], s[x + 1], diagonal);
+    const float to_sw = flux(c[x], s[x - 1], diagonal);
     south[x] = to_s;
     south_east[x] = to_se;
     south_west[x] = to_sw;
-    const float axis = -flux(c[x - 1], c[x], along) + flux(c[x], c[x + 1], along) + -a_s[x] + to_s;
+    const float axis = -flux(c[x - 1], c[x], edge) + flux(c[x], c[x + 1], edge) + -a_s[x] + to_s;
     const float diag = -a_se[x - 1] + -a_sw[x + 1] + to_sw + to_se;
     out[x] = c[x] - (axis + diag);
   }
@@ -124,9 +120,9 @@ void relax_row(const terrain::HeightField& h, int row, const float* s, int shift
   relax_inner(c, s, w, lim, a_s, a_se, a_sw, south, south_east, south_west, out);
   for (const int x : {0, w - 1}) {
     const Neighbourhood nb = neighbourhood(h, x, row, shift);
-    const float a_s3[3] = {0.0f, flux(nb[0][1], nb[1][1], lim.across), 0.0f};
-    const float a_se3[3] = {flux(nb[0][0], nb[1][1], lim.south_east), 0.0f, 0.0f};
-    const float a_sw3[3] = {0.0f, 0.0f, flux(nb[0][2], nb[1][1], lim.south_west)};
+    const float a_s3[3] = {0.0f, flux(nb[0][1], nb[1][1], lim.axis), 0.0f};
+    const float a_se3[3] = {flux(nb[0][0], nb[1][1], lim.diagonal), 0.0f, 0.0f};
+    const float a_sw3[3] = {0.0f, 0.0f, flux(nb[0][2], nb[1][1], lim.diagonal)};
     float south3[3], south_east3[3], south_west3[3], out3[3];
     relax_span(nb[1].data(), nb[2].data(), 1, 2, lim, a_s3, a_se3, a_sw3, south3, south_east3,
                south_west3, out3);
@@ -152,8 +148,8 @@ double max_excess(const terrain::HeightField& h, double max_drop, int shift) {
   auto larger = [](std::int32_t a, std::int32_t b) { return a > b ? a : b; };
   // Each edge once: east, south, south-east, south-west.
   auto edges = [&](float c, float e, float s, float se, float sw) {
-    return larger(larger(excess(c, e, lim.along), excess(c, s, lim.across)),
-                  larger(excess(c, se, lim.south_east), excess(c, sw, lim.south_west)));
+    return larger(larger(excess(c, e, lim.axis), excess(c, s, lim.axis)),
+                  larger(excess(c, se, lim.diagonal), excess(c, sw, lim.diagonal)));
   };
   const std::int32_t bits = tbb::parallel_reduce(
       tbb::blocked_range<int>(0, rows, kRowBlock), std::int32_t{0},
