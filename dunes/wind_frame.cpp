@@ -51,9 +51,8 @@ std::pair<long long, long long> unit_pair(long long p, long long q) {
   return {-t0, s0};
 }
 
-// Rows a turned lattice has at least (each point of a row is followed by a
-// task of its own only in blocks of rows; and the diagonal of an 8-cell
-// grid has 5).
+// Rows a turned lattice has at least: rows are the steps' units of parallel
+// work (the diagonal of the smallest grid, 8 cells, has 5).
 constexpr int kMinRows = 4;
 
 }  // namespace
