@@ -145,10 +145,10 @@ namespace {
 // (dunes/wind_frame.h), whose rows are the wind lines and close on
 // themselves, so a flight lands on its own row, past the last column
 // wrapped, shared linearly between the two points around the landing (as
-// the paper has it along x). Rows are cut into fixed blocks; a block sums
-// its rows' landings in double precision in a private window, and each point
-// is rounded to float once, so mass is kept to float rounding and the bits
-// do not depend on the thread count.
+// the paper has it along x). Each row's landings are summed in double
+// precision in a private window in a fixed order, and each point is rounded
+// to float once, so mass is kept to float rounding and the bits do not
+// depend on the thread count.
 //
 // Flight lengths and slopes are in grid cells, as in the paper; the
 // lattice's columns are h cells apart: `per_cell` = 1 / h columns a cell.
