@@ -13,7 +13,8 @@
 // (p, q) of whole columns and rows (p, q coprime, |q| <= p), and the sand
 // lives on a square lattice turned to it, whose rows are the wind lines:
 // lattice point (i, j) sits at i h (cos a, sin a) + j h (-sin a, cos a) on
-// the model grid, h = n / (c K) grid cells apart, c = sqrt(p^2 + q^2). The
+// the model grid, h = n / (c K) grid cells apart, c = sqrt(p^2 + q^2),
+// K = floor(n / c). The
 // model grid is a torus (n x n, periodic), and so is the turned lattice when
 // it has K rows of M = c^2 K points: a row closes on itself after M points
 // (n (p, q) is a period of the grid), and past row K - 1, row 0 goes on
@@ -68,7 +69,7 @@ double lattice_wind_from(double wind_from_deg, int n);
 
 // Wind lattice -> n x n model grid: each grid cell bilinearly from the 4
 // lattice points around it, then the mean (so the mass: the lattice's points
-// stand for h^2 cells each, and M K h^2 = n^2) restored exactly in double.
+// stand for h^2 cells each, and M K h^2 = n^2) restored to float rounding.
 // The lattice itself for a wind along the axes.
 terrain::HeightField lattice_to_grid(const terrain::HeightField& lattice, const WindLattice& l,
                                      int n);
