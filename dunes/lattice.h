@@ -3,7 +3,6 @@
 // (point (x, row + K) is point (x - shift, row)).
 #pragma once
 
-#include <array>
 #include <vector>
 
 #include "terrain/grid.h"
@@ -39,16 +38,6 @@ inline const float* lattice_row(const terrain::HeightField& h, int row, int shif
   buffer.resize(static_cast<std::size_t>(w));
   for (int x = 0; x < w; ++x) buffer[x] = lattice_at(h, x, row, shift);
   return buffer.data();
-}
-
-// The 3 x 3 heights around lattice point (x, row): [0] the row above
-// (columns x - 1, x, x + 1), [1] the row, [2] the row below.
-using Neighbourhood = std::array<std::array<float, 3>, 3>;
-inline Neighbourhood neighbourhood(const terrain::HeightField& h, int x, int row, int shift) {
-  Neighbourhood out;
-  for (int dr = -1; dr <= 1; ++dr)
-    for (int dx = -1; dx <= 1; ++dx) out[dr + 1][dx + 1] = lattice_at(h, x + dx, row + dr, shift);
-  return out;
 }
 
 }  // namespace drift::dunes

@@ -237,7 +237,7 @@ struct Landings {
 };
 
 // Per-row scratch of saltation: each point's flight (columns) and lift, the
-// lift's recovery past shadows along x, and where the flights land.
+// lift's recovery past shadows along the row, and where the flights land.
 struct RowScratch {
   std::vector<double> columns, lift;
   std::vector<float> recovery;
@@ -358,12 +358,11 @@ void land_rows(const terrain::HeightField& h, const SandOptions& o, const Saltat
   }
 }
 
-}  // namespace
-
-void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
+// Saltation on a lattice `per_cell` columns a grid cell along the wind.
+void saltate_on(terrain::HeightField& h, const SandOptions& o, double per_cell, Workspace& w) {
   const int rows = h.height();
   SaltationPlan p;
-  p.per_cell = 1.0 / wind_lattice(o.wind_from_deg, o.size).cell;
+  p.per_cell = per_cell;
   if (o.shadow_deg > 0.0) {
     // The shadow is needed as far ahead as the longest flight reaches; its
     // line falls shadow_drop per cell, so per column 1 / per_cell times that.
@@ -382,6 +381,12 @@ void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
       },
       tbb::simple_partitioner());
   std::swap(w.next, h.values());
+}
+
+}  // namespace
+
+void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
+  saltate_on(h, o, 1.0 / wind_lattice(o.wind_from_deg, o.size).cell, w);
 }
 
 void saltate(terrain::HeightField& h, const SandOptions& o) {
@@ -420,7 +425,7 @@ void creep(terrain::HeightField& h, double coefficient, Workspace& ws, int shift
 void step(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
   const WindLattice l = wind_lattice(o.wind_from_deg, o.size);
   assert(h.width() == l.columns && h.height() == l.rows);
-  saltate(h, o, w);
+  saltate_on(h, o, 1.0 / l.cell, w);
   // The paper's D and the repose slope are per grid cell; the lattice's
   // spacing is h cells: D / h^2 and h times the drop per edge.
   creep(h, o.creep / (l.cell * l.cell), w, l.shift);

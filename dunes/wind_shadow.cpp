@@ -8,16 +8,13 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
-#include <span>
 #include <type_traits>
-#include <utility>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
 #include "dunes/height_range.h"
-#include "dunes/lattice.h"
 #include "terrain/simd.h"
 
 namespace drift::dunes {
@@ -38,23 +35,16 @@ struct Span {
   int warm_up, ahead;
 };
 
-// The columns followed, unwrapped x in [-warm_up, n + ahead), a lap of the
-// row at a time: in lap `l` (x in [l n, (l + 1) n)) column x - l n.
-struct Lap {
+// The columns followed, unwrapped x in [-warm_up, n + ahead), in three
+// runs that need no wrapping: the warm-up at the end of the row, the row,
+// then its start again for the distances ahead (warm_up and ahead <= n).
+struct Run {
   int begin, end;     // unwrapped columns
-  int column_offset;  // -l n
+  int column_offset;  // added to x to give the row's column
 };
 
-std::vector<Lap> laps(int n, Span span) {
-  std::vector<Lap> out;
-  const int end = n + span.ahead;
-  for (int x = -span.warm_up; x < end;) {
-    const long long lap = floor_div(x, n);
-    const int lap_end = static_cast<int>(std::min<long long>((lap + 1) * n, end));
-    out.push_back({x, lap_end, static_cast<int>(-lap * n)});
-    x = lap_end;
-  }
-  return out;
+std::array<Run, 3> runs(int n, Span span) {
+  return {{{-span.warm_up, 0, n}, {0, n, 0}, {n, n + span.ahead, -n}}};
 }
 
 // A block's lines side by side in the lanes of one vector (GCC's vector
@@ -65,19 +55,19 @@ using LineInts = std::int32_t __attribute__((vector_size(kLineBlock * sizeof(std
 
 // Shadow flags of a block of kLineBlock rows at columns [0, n + ahead):
 // each sample below the shadow line cast by the samples upwind of it, at
-// flags[x * kLineBlock + lane], lap by lap (`laps`, `count` of them). Lane k
+// flags[x * kLineBlock + lane], run by run (`runs`). Lane k
 // follows row first_row + k (a short last block repeats its last row).
 DRIFT_SIMD_KERNEL void mark_shadowed_kernel(const float* data, int n, double drop_per_column,
-                                            const Lap* laps, int count,
+                                            const std::array<Run, 3>& runs,
                                             const std::int32_t* first_row, std::int32_t* flags) {
   static_assert(kLineBlock == 4, "the lanes below are written out for 4 lines");
   std::array<const float*, kLineBlock> line_row;
   for (int k = 0; k < kLineBlock; ++k)
     line_row[k] = data + static_cast<std::size_t>(first_row[k]) * n;
   LineDoubles carried = {-1e300, -1e300, -1e300, -1e300};
-  for (const Lap& lap : std::span(laps, static_cast<std::size_t>(count))) {
-    for (int x = lap.begin; x < lap.end; ++x) {
-      const int c = x + lap.column_offset;
+  for (const Run& run : runs) {
+    for (int x = run.begin; x < run.end; ++x) {
+      const int c = x + run.column_offset;
       const LineDoubles v = {line_row[0][c], line_row[1][c], line_row[2][c], line_row[3][c]};
       const LineDoubles line = carried - drop_per_column;
       if (x >= 0) {
@@ -89,9 +79,9 @@ DRIFT_SIMD_KERNEL void mark_shadowed_kernel(const float* data, int n, double dro
   }
 }
 DRIFT_SIMD_TWINS(mark_shadowed, mark_shadowed_kernel,
-                 (const float* data, int n, double drop_per_column, const Lap* laps, int count,
+                 (const float* data, int n, double drop_per_column, const std::array<Run, 3>& runs,
                   const std::int32_t* first_row, std::int32_t* flags),
-                 (data, n, drop_per_column, laps, count, first_row, flags))
+                 (data, n, drop_per_column, runs, first_row, flags))
 
 // Per sample of lines [j0, j1) (at most a block) at columns [0, n): its
 // flag and the columns to the next shadowed sample downwind, at most
@@ -232,7 +222,7 @@ void wind_shadow(const terrain::HeightField& h, double drop_per_column, double m
   const int limit = static_cast<int>(
       std::min<double>({static_cast<double>(n), std::ceil(max_columns) + 1, 32767.0}));
   const Span span{warm_up_columns(h, drop_per_column), limit};
-  const std::vector<Lap> path = laps(n, span);
+  const std::array<Run, 3> path = runs(n, span);
   // Blocks of kLineBlock rows side by side; a short last block repeats its
   // last row.
   const int blocks = (rows + kLineBlock - 1) / kLineBlock;
@@ -244,8 +234,7 @@ void wind_shadow(const terrain::HeightField& h, double drop_per_column, double m
         flags.resize(static_cast<std::size_t>(n + span.ahead) * kLineBlock);
         std::array<std::int32_t, kLineBlock> first_row;
         for (int k = 0; k < kLineBlock; ++k) first_row[k] = std::min(j0 + k, j1 - 1);
-        mark_shadowed(h.data(), n, drop_per_column, path.data(), static_cast<int>(path.size()),
-                      first_row.data(), flags.data());
+        mark_shadowed(h.data(), n, drop_per_column, path, first_row.data(), flags.data());
         measure_reach(n, limit, span, j0, j1, flags, shadow);
       },
       tbb::simple_partitioner());
