@@ -3,6 +3,7 @@
 // (point (x, row + K) is point (x - shift, row)).
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "terrain/grid.h"
@@ -29,15 +30,35 @@ inline float lattice_at(const terrain::HeightField& h, long long x, long long ro
            static_cast<int>(row - laps * h.height()));
 }
 
-// The heights of lattice row `row` (any integer): the row itself if it lies
-// in the field, else the wrapped row turned by the shift into `buffer`.
-inline const float* lattice_row(const terrain::HeightField& h, int row, int shift,
-                                std::vector<float>& buffer) {
-  if (row >= 0 && row < h.height()) return &h(0, row);
-  const int w = h.width();
-  buffer.resize(static_cast<std::size_t>(w));
-  for (int x = 0; x < w; ++x) buffer[x] = lattice_at(h, x, row, shift);
-  return buffer.data();
-}
+// The rows -1 to K of a lattice of K rows, as sweeps read them: its own,
+// and past either edge the wrapped row turned by the shift (a rotation),
+// worked out once.
+class LatticeRows {
+ public:
+  LatticeRows(const terrain::HeightField& h, int shift) : h_(h) {
+    before_ = turned(h.height() - 1, -1, shift);
+    after_ = turned(0, 1, shift);
+  }
+  const float* operator[](int row) const {
+    if (row < 0) return before_.data();
+    if (row >= h_.height()) return after_.data();
+    return &h_(0, row);
+  }
+
+ private:
+  // Row `source` a lap of rows away (laps = +-1): point x is source point
+  // x - laps * shift, wrapped.
+  std::vector<float> turned(int source, int laps, int shift) const {
+    const int w = h_.width();
+    const int offset = wrap_index(laps * (shift % w), w);
+    const float* row = &h_(0, source);
+    std::vector<float> out(static_cast<std::size_t>(w));
+    std::copy(row + (w - offset), row + w, out.begin());
+    std::copy(row, row + (w - offset), out.begin() + offset);
+    return out;
+  }
+  const terrain::HeightField& h_;
+  std::vector<float> before_, after_;
+};
 
 }  // namespace drift::dunes

@@ -1,6 +1,5 @@
 #include "dunes/sand_model.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -13,6 +12,7 @@
 #include "dunes/avalanche.h"
 #include "dunes/height_range.h"
 #include "dunes/lattice.h"
+#include "dunes/tiles.h"
 #include "dunes/wind_frame.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
@@ -22,9 +22,6 @@ namespace drift::dunes {
 
 namespace {
 
-// Fixed row blocks: the work partition, and so every bit, is independent of
-// the thread count.
-constexpr int kRowBlock = 16;
 // Relaxation sweeps per time step: saltation steepens slopes a little each
 // step, and a few sweeps keep them at the angle of repose as the sand moves.
 constexpr int kSweepsPerStep = 4;
@@ -68,16 +65,6 @@ double max_drop(const SandOptions& o) {
 // The shadow line's fall per cell along the wind, in model height units.
 double shadow_drop(const SandOptions& o) {
   return std::tan(o.shadow_deg * std::numbers::pi / 180.0) * o.cell_m / o.height_unit;
-}
-
-template <class Fn>
-void for_rows(int rows, Fn fn) {
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, rows, kRowBlock),
-      [&](const tbb::blocked_range<int>& r) {
-        for (int row = r.begin(); row < r.end(); ++row) fn(row);
-      },
-      tbb::simple_partitioner());
 }
 
 }  // namespace
@@ -143,12 +130,11 @@ namespace {
 
 // How saltation's landings are summed. The sand lives on the wind lattice
 // (dunes/wind_frame.h), whose rows are the wind lines and close on
-// themselves, so a flight lands on its own row, past the last column
-// wrapped, shared linearly between the two points around the landing (as
-// the paper has it along x). Each row's landings are summed in double
-// precision in a private window in a fixed order, and each point is rounded
-// to float once, so mass is kept to float rounding and the bits do not
-// depend on the thread count.
+// themselves, so a flight lands on its own row, shared linearly between the
+// two points around the landing (as the paper has it along x). Each row's
+// landings are summed in double precision in a private window in a fixed
+// order, and each point is rounded to float once, so mass is kept to float
+// rounding and the bits do not depend on the thread count.
 //
 // Flight lengths and slopes are in grid cells, as in the paper; the
 // lattice's columns are h cells apart: `per_cell` = 1 / h columns a cell.
@@ -163,221 +149,208 @@ double max_flight(const terrain::HeightField& h, const SandOptions& o, double pe
   return std::clamp(longest, 0.0, (h.width() - 1.0) / per_cell);
 }
 
-// A flight of `flight` cells along the wind in columns (times per_cell),
-// kept within a lap (`longest` cells) by selects so that loops over it
-// vectorise.
-DRIFT_SIMD_KERNEL double columns_along(double flight, double longest, double per_cell) {
-  const double positive = flight > 0.0 ? flight : 0.0;
-  return (positive < longest ? positive : longest) * per_cell;
-}
-
-// Eqs. 2-3 along a row c of the lattice, a wind line: dH/dx is the central
-// difference between its neighbours on the line, a column (1 / per_cell
-// cells) either side; `before` is the point before the first column and
-// `after` the one after the last (the row's last and first). The line's own
-// points: the gradient of 4 grid neighbours dotted with the wind would take
-// an oblique slope from the neighbouring lines only, blind to the point's own
-// (docs/dunes.md).
-struct DuneLaunch {
-  float per_cell_f;  // columns per cell along the wind
-  double L0, b, q, b_prime, longest, per_cell;
+// What the flight kernel needs, in float: flights of a few tens of columns
+// keep 1e-6 of a column, and the sand each carries is summed in double.
+struct FlightParams {
+  float L0, b, q, b_prime;
+  float per_cell;     // columns per cell along the wind
+  float max_columns;  // the longest flight, in columns (< the row's width)
 };
 
-DRIFT_SIMD_KERNEL void launch_dunes_kernel(const float* __restrict c, int n, float before,
-                                           float after, const DuneLaunch& p,
-                                           double* __restrict columns, double* __restrict lift) {
+// The flights of one row of n points (`c` its heights; `before` the point
+// before the first column and `after` the one after the last: the row's last
+// and first): point x lifts part[x], which lands land[x] + f columns on,
+// unwrapped (land[x] = x + the whole columns, < 2n - 1); to_next[x] is the
+// share f * part[x] of the point one further on. Paper eq. 1 (ripples:
+// L = L0 + b H, q) or eqs. 2-3 (dunes: L = L0 - b tanh(dH/dx), q + b'
+// tanh(dH/dx)), dH/dx the central difference between the point's neighbours
+// on its wind line, a column (1 / per_cell cells) either side: the gradient
+// of 4 grid neighbours dotted with the wind would take an oblique slope from
+// the neighbouring lines only, blind to the point's own (docs/dunes.md).
+//
+// In the wind shadow (Werner 1995; `shadow` as wind_shadow() fills it)
+// nothing is lifted, and flights into it are caught at its edge; past it the
+// lift is scaled by its `recovery` (shadow_recovery()). Rows without a
+// shadow pass a map with no shadow in reach and a recovery of 1. One pass,
+// branch free (selects), so that the loop vectorises; the scattering adds
+// are left to fly().
+template <Model kModel>
+DRIFT_SIMD_KERNEL void flights_kernel(const float* __restrict c, int n, float before, float after,
+                                      const FlightParams& p, const std::uint16_t* __restrict shadow,
+                                      const float* __restrict recovery,
+                                      std::int32_t* __restrict land, float* __restrict part,
+                                      float* __restrict to_next) {
   // Parameters as locals: the outputs could alias them otherwise.
-  const float per_cell_f = p.per_cell_f;
-  const double L0 = p.L0, b = p.b, q = p.q, b_prime = p.b_prime, longest = p.longest;
-  const double per_cell = p.per_cell;
-  auto fill = [&](int x, float upwind, float downwind) {
-    const double g = fast_tanh(per_cell_f * (0.5f * (downwind - upwind)));
-    columns[x] = columns_along(L0 - b * g, longest, per_cell);
-    lift[x] = q + b_prime * g;
-  };
-  fill(0, before, c[1]);
-  for (int x = 1; x + 1 < n; ++x) fill(x, c[x - 1], c[x + 1]);
-  fill(n - 1, c[n - 2], after);
-}
-DRIFT_SIMD_TWINS(launch_dunes, launch_dunes_kernel,
-                 (const float* c, int n, float before, float after, const DuneLaunch& p,
-                  double* columns, double* lift),
-                 (c, n, before, after, p, columns, lift))
-
-// Paper eq. 1 (ripples) or eqs. 2-3 (dunes) along one row: the flight of each
-// point in columns (its length along the wind times per_cell) and its lift.
-void launch_row(const terrain::HeightField& h, const SandOptions& o, double per_cell, int row,
-                double* __restrict columns, double* __restrict lift) {
-  const int n = h.width();
-  const float* __restrict c = &h(0, row);
-  const double longest = (n - 1.0) / per_cell, L0 = o.L0, b = o.b, q = o.q;
-  if (o.model == Model::Ripples) {
-    for (int x = 0; x < n; ++x) {
-      columns[x] = columns_along(L0 + b * c[x], longest, per_cell);  // L = L0 + b H
-      lift[x] = q;
+  const float L0 = p.L0, b = p.b, q = p.q, b_prime = p.b_prime, per_cell = p.per_cell;
+  const float max_columns = p.max_columns;
+  auto flight = [&](int x, float upwind, float downwind) {
+    float length, lift;
+    if constexpr (kModel == Model::Dunes) {
+      const float g = fast_tanh(per_cell * (0.5f * (downwind - upwind)));
+      length = L0 - b * g;
+      lift = q + b_prime * g;
+    } else {
+      length = L0 + b * c[x];
+      lift = q;
     }
-    return;
-  }
-  const DuneLaunch p{.per_cell_f = static_cast<float>(per_cell),
-                     .L0 = L0,
-                     .b = b,
-                     .q = q,
-                     .b_prime = o.b_prime,
-                     .longest = longest,
-                     .per_cell = per_cell};
-  launch_dunes(c, n, c[n - 1], c[0], p, columns, lift);
-}
-
-// Where each flight of a row lands in the window: the window index of the
-// point left of the landing and of the one right of it, and the sand each
-// gets, shared linearly.
-struct Landings {
-  std::vector<std::int32_t> left, right;
-  std::vector<double> to_left, to_right;
-};
-
-// Per-row scratch of saltation: each point's flight (columns) and lift, the
-// lift's recovery past shadows along the row, and where the flights land.
-struct RowScratch {
-  std::vector<double> columns, lift;
-  std::vector<float> recovery;
-  Landings landings;
-  void resize(int n) {
-    recovery.resize(n);
-    for (auto* v : {&columns, &lift, &landings.to_left, &landings.to_right}) v->resize(n);
-    landings.left.resize(n);
-    landings.right.resize(n);
-  }
-};
-
-// Where the flights (`reach` columns downwind, carrying `part`) of a row
-// land: column x + reach, wrapped onto the row. Branch free, so it
-// vectorises; the scattering adds are left to fly().
-DRIFT_SIMD_KERNEL void aim_kernel(int n, const double* __restrict reach,
-                                  const double* __restrict part, std::int32_t* __restrict left,
-                                  std::int32_t* __restrict right, double* __restrict to_left,
-                                  double* __restrict to_right) {
-  for (int x = 0; x < n; ++x) {
-    const double land_x = x + reach[x];
-    const int i0 = static_cast<int>(land_x);
-    const double fx = land_x - i0;
-    const int a = i0 >= n ? i0 - n : i0;
-    const int b = a + 1 == n ? 0 : a + 1;
-    left[x] = a;
-    right[x] = b;
-    to_left[x] = part[x] * (1.0 - fx);
-    to_right[x] = part[x] * fx;
-  }
-}
-DRIFT_SIMD_TWINS(aim, aim_kernel,
-                 (int n, const double* reach, const double* part, std::int32_t* left,
-                  std::int32_t* right, double* to_left, double* to_right),
-                 (n, reach, part, left, right, to_left, to_right))
-
-// Lifts `part` from each point of the row in `window` and adds it where
-// aim() found it lands (a share of 0 on a landing exactly on a point adds
-// nothing).
-void fly(int n, const double* part, const Landings& l, double* window) {
-  for (int x = 0; x < n; ++x) {
-    window[x] -= part[x];
-    window[l.left[x]] += l.to_left[x];
-    window[l.right[x]] += l.to_right[x];
-  }
-}
-
-// Where a row's sand flies when the lee of crests is out of the wind
-// (Werner 1995): sand there is not lifted (times 1 or 0: lifts are >= 0,
-// so exact, and unlike a select GCC vectorises it), and grains flying into
-// it are caught at its edge. With a recovery (reattach > 0) the lift is
-// scaled by it too.
-DRIFT_SIMD_KERNEL void shade_kernel(const std::uint16_t* __restrict shadow,
-                                    const float* __restrict recovery, int n,
-                                    double* __restrict columns, double* __restrict lift) {
-  if (recovery) {
-    for (int x = 0; x < n; ++x) {
-      const int s = shadow[x];
-      lift[x] = lift[x] * static_cast<double>(~s & 1) * recovery[x];
-      columns[x] = std::min(columns[x], static_cast<double>(s >> 1));
-    }
-    return;
-  }
-  for (int x = 0; x < n; ++x) {
     const int s = shadow[x];
-    lift[x] *= static_cast<double>(~s & 1);
-    columns[x] = std::min(columns[x], static_cast<double>(s >> 1));
-  }
+    const float along = length * per_cell;
+    const float positive = along > 0.0f ? along : 0.0f;
+    const float bounded = positive < max_columns ? positive : max_columns;
+    const float to_shadow = static_cast<float>(s >> 1);
+    const float columns = bounded < to_shadow ? bounded : to_shadow;
+    // Times 1 or 0 (lifts are >= 0, so exact; GCC vectorises it, unlike a
+    // select).
+    const float lifted = lift * static_cast<float>(~s & 1) * recovery[x];
+    const int whole = static_cast<int>(columns);
+    land[x] = x + whole;
+    part[x] = lifted;
+    to_next[x] = lifted * (columns - static_cast<float>(whole));
+  };
+  flight(0, before, c[1]);
+  for (int x = 1; x + 1 < n; ++x) flight(x, c[x - 1], c[x + 1]);
+  flight(n - 1, c[n - 2], after);
 }
-DRIFT_SIMD_TWINS(shade, shade_kernel,
-                 (const std::uint16_t* shadow, const float* recovery, int n, double* columns,
-                  double* lift),
-                 (shadow, recovery, n, columns, lift))
+DRIFT_SIMD_TWINS(ripple_flights, flights_kernel<Model::Ripples>,
+                 (const float* c, int n, float before, float after, const FlightParams& p,
+                  const std::uint16_t* shadow, const float* recovery, std::int32_t* land,
+                  float* part, float* to_next),
+                 (c, n, before, after, p, shadow, recovery, land, part, to_next))
+DRIFT_SIMD_TWINS(dune_flights, flights_kernel<Model::Dunes>,
+                 (const float* c, int n, float before, float after, const FlightParams& p,
+                  const std::uint16_t* shadow, const float* recovery, std::int32_t* land,
+                  float* part, float* to_next),
+                 (c, n, before, after, p, shadow, recovery, land, part, to_next))
+
+// Per-row scratch of saltation: the lift's recovery past shadows, the
+// flights, and the two windows the row's sand is summed in (fly()); for
+// rows without a shadow, a map with none in reach and a recovery of 1.
+struct RowScratch {
+  std::vector<float> recovery;
+  std::vector<std::int32_t> land;
+  std::vector<float> part, to_next;
+  std::vector<double> window, odd_window;
+  std::vector<std::uint16_t> no_shadow;
+  std::vector<float> full_lift;
+  void resize(int n) {
+    const auto size = static_cast<std::size_t>(n);
+    for (auto* v : {&recovery, &part, &to_next}) v->resize(size);
+    land.resize(size);
+    window.resize(2 * size);
+    odd_window.resize(2 * size);
+    if (no_shadow.size() != size) no_shadow.assign(size, std::uint16_t{0xfffe});
+    if (full_lift.size() != size) full_lift.assign(size, 1.0f);
+  }
+};
+
+// A row's sand after its flights, in `window` (n + tail points): each
+// point less what it lifts, plus what lands on it, summed in double.
+// Landings past the row's end (at most `tail` columns) are summed beyond it
+// and then folded onto its start, so the adds need no wrapping test. Their
+// time is the chain of adds to the same few points (neighbouring flights
+// land side by side, and those caught at a shadow's edge on one point), so
+// even and odd sources land in two windows, two chains side by side, summed
+// at the end. A share is exact in double: part - to_next of two floats, and
+// both added, so what lands is what was lifted.
+void fly(const float* c, int n, int tail, RowScratch& f) {
+  const std::int32_t* __restrict land = f.land.data();
+  const float* __restrict part = f.part.data();
+  const float* __restrict to_next = f.to_next.data();
+  double* __restrict even = f.window.data();
+  double* __restrict odd = f.odd_window.data();
+  const int size = n + tail;
+  for (int x = 0; x < n; ++x) even[x] = static_cast<double>(c[x]) - part[x];
+  std::fill(even + n, even + size, 0.0);
+  std::fill(odd, odd + size, 0.0);
+  auto land_in = [&](double* window, int x) {
+    const double next = to_next[x];
+    window[land[x]] += static_cast<double>(part[x]) - next;
+    window[land[x] + 1] += next;
+  };
+  int x = 0;
+  for (; x + 1 < n; x += 2) {
+    land_in(even, x);
+    land_in(odd, x + 1);
+  }
+  if (x < n) land_in(even, x);
+  for (int i = 0; i < size; ++i) even[i] += odd[i];
+  for (int i = 0; i < tail; ++i) even[i] += even[n + i];
+}
 
 // What saltation needs to know once per step.
 struct SaltationPlan {
-  double per_cell = 1.0;  // lattice columns a grid cell along the wind (1 / h)
+  FlightParams flights{};
+  int tail = 0;  // points past a row's end that landings reach (see fly())
   const ShadowMap* shadow = nullptr;
   double reattach = 0.0;  // with a shadow: see shadow_recovery()
 };
 
-// One row's landings into the window of the row.
-// The flights are worked out first, in loops that vectorise, then flown (a
-// shadowed part is 0 and adds nothing).
+// One row's sand after saltation, in the scratch's window (see fly()).
 void saltate_row(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p,
-                 int row, double* window, RowScratch& scratch) {
+                 int row, RowScratch& scratch) {
   const int n = h.width();
-  double* columns = scratch.columns.data();
-  double* lift = scratch.lift.data();
-  launch_row(h, o, p.per_cell, row, columns, lift);
+  const float* c = &h(0, row);
+  const std::uint16_t* shadow = scratch.no_shadow.data();
+  const float* recovery = scratch.full_lift.data();
   if (p.shadow) {
-    const std::uint16_t* shadow = p.shadow->data() + static_cast<std::size_t>(row) * n;
-    const float* recovery = nullptr;
+    shadow = p.shadow->data() + static_cast<std::size_t>(row) * n;
     if (p.reattach > 0.0) {
       line_recovery(shadow, n, p.reattach, scratch.recovery.data());
       recovery = scratch.recovery.data();
     }
-    shade(shadow, recovery, n, columns, lift);
   }
-  Landings& l = scratch.landings;
-  aim(n, columns, lift, l.left.data(), l.right.data(), l.to_left.data(), l.to_right.data());
-  fly(n, lift, l, window);
+  auto* flights = o.model == Model::Dunes ? dune_flights : ripple_flights;
+  flights(c, n, c[n - 1], c[0], p.flights, shadow, recovery, scratch.land.data(),
+          scratch.part.data(), scratch.to_next.data());
+  fly(c, n, p.tail, scratch);
 }
 
-// Rows [begin, end), each in turn: its sources' landings summed in a window
-// of the row, then each point rounded once into `out`.
+// Rows [begin, end), each in turn: its sand summed in a window, then each
+// point rounded once into `out`.
 void land_rows(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p,
                int begin, int end, std::vector<float>& out) {
   const int n = h.width();
-  thread_local std::vector<double> window;
   thread_local RowScratch scratch;
-  window.resize(static_cast<std::size_t>(n));
   scratch.resize(n);
   for (int r = begin; r < end; ++r) {
-    std::copy(&h(0, r), &h(0, r) + n, window.begin());
-    saltate_row(h, o, p, r, window.data(), scratch);
-    std::copy(window.begin(), window.end(), out.begin() + static_cast<std::ptrdiff_t>(r) * n);
+    saltate_row(h, o, p, r, scratch);
+    std::copy(scratch.window.begin(), scratch.window.begin() + n,
+              out.begin() + static_cast<std::ptrdiff_t>(r) * n);
   }
 }
 
 // Saltation on a lattice `per_cell` columns a grid cell along the wind.
 void saltate_on(terrain::HeightField& h, const SandOptions& o, double per_cell, Workspace& w) {
   const int rows = h.height();
+  // The longest flight in columns, as the kernel bounds it.
+  const double longest = max_flight(h, o, per_cell);
+  const auto max_columns =
+      std::min(static_cast<float>(longest * per_cell), static_cast<float>(h.width() - 1));
   SaltationPlan p;
-  p.per_cell = per_cell;
+  p.flights = FlightParams{.L0 = static_cast<float>(o.L0),
+                           .b = static_cast<float>(o.b),
+                           .q = static_cast<float>(o.q),
+                           .b_prime = static_cast<float>(o.b_prime),
+                           .per_cell = static_cast<float>(per_cell),
+                           .max_columns = max_columns};
+  // land + 1 <= n - 1 + floor(max_columns) + 1.
+  p.tail = static_cast<int>(max_columns) + 1;
   if (o.shadow_deg > 0.0) {
     // The shadow is needed as far ahead as the longest flight reaches; its
     // line falls shadow_drop per cell, so per column 1 / per_cell times that.
-    const double longest = max_flight(h, o, p.per_cell);
-    wind_shadow(h, shadow_drop(o) / p.per_cell, longest * p.per_cell, w.shadow);
+    wind_shadow(h, shadow_drop(o) / per_cell, longest * per_cell, w.shadow);
     p.shadow = &w.shadow;
     p.reattach = o.reattach;
   }
   w.next.resize(h.size());
-  const int blocks = std::max(1, rows / kRowBlock);
+  // Rows are independent, so no partition changes a bit: tasks of some 16k
+  // points, one row each on a wind lattice's long rows.
+  const int rows_per_task = std::clamp(16384 / h.width(), 1, 16);
+  const int tasks = (rows + rows_per_task - 1) / rows_per_task;
   tbb::parallel_for(
-      0, blocks,
+      0, tasks,
       [&](int i) {
-        const int end = i + 1 == blocks ? rows : (i + 1) * kRowBlock;
-        land_rows(h, o, p, i * kRowBlock, end, w.next);
+        land_rows(h, o, p, i * rows_per_task, std::min(rows, (i + 1) * rows_per_task), w.next);
       },
       tbb::simple_partitioner());
   std::swap(w.next, h.values());
@@ -403,21 +376,20 @@ void creep(terrain::HeightField& h, double coefficient, Workspace& ws, int shift
   const int w = h.width(), rows = h.height();
   ws.next.resize(h.size());
   const float d = static_cast<float>(coefficient / 4.0);
-  for_rows(rows, [&](int row) {
-    // Rows past the edges come shifted on the wind lattice (dunes/lattice.h).
-    thread_local std::vector<float> above, below;
-    const float* __restrict c = &h(0, row);
-    const float* __restrict n = lattice_row(h, row - 1, shift, above);
-    const float* __restrict s = lattice_row(h, row + 1, shift, below);
-    float* __restrict out = &ws.next[static_cast<std::size_t>(row) * w];
-    // Sum of edge fluxes d * (neighbour - centre): antisymmetric per edge.
-    // The wrapped columns apart, so the loop between them vectorises.
-    auto cell = [&](int x, int xl, int xr) {
-      out[x] = c[x] + d * ((c[xl] - c[x]) + (c[xr] - c[x]) + (n[x] - c[x]) + (s[x] - c[x]));
-    };
-    cell(0, w - 1, 1);
-    for (int x = 1; x + 1 < w; ++x) cell(x, x - 1, x + 1);
-    cell(w - 1, w - 2, 0);
+  // Rows past the edges come shifted on the wind lattice (dunes/lattice.h).
+  const LatticeRows row(h, shift);
+  for_tiles(w, rows, [&](const Tile& t) {
+    for (int r = t.first_row; r < t.end_row; ++r) {
+      const float* __restrict c = row[r];
+      const float* __restrict n = row[r - 1];
+      const float* __restrict s = row[r + 1];
+      float* __restrict out = &ws.next[static_cast<std::size_t>(r) * w];
+      // Sum of edge fluxes d * (neighbour - centre): antisymmetric per edge.
+      auto cell = [&](int x, int xl, int xr) {
+        out[x] = c[x] + d * ((c[xl] - c[x]) + (c[xr] - c[x]) + (n[x] - c[x]) + (s[x] - c[x]));
+      };
+      for_strip_columns(t, w, cell);
+    }
   });
   std::swap(ws.next, h.values());
 }

@@ -36,41 +36,51 @@ HeightField spiky_field(int w, int h, float lo, float hi, std::uint32_t seed) {
 }
 
 // One Jacobi sweep as the avalanche's doc defines it: every cell sums, over
-// its 8 neighbours in the order W, E, N, S, NW, NE, SW, SE, a ninth of the
-// excess drop across each edge, whose limit is `limit` times the edge's
-// length (sqrt 2 on diagonals). On a wind lattice of shift S, past the last
+// its 8 neighbours in the order W, E, N, S, NW, NE, SW, SE, the excess drop
+// across each edge, whose limit is `limit` times the edge's length (sqrt 2
+// on diagonals), and loses a ninth of the sum. On a wind lattice of shift S, past the last
 // row, row 0 goes on S columns back: point (x, y + rows) is (x - S, y).
+// The height of the neighbour (dx, dy) of (x, y) on a wind lattice of
+// shift S: past the last row, row 0 goes on S columns back, so point
+// (x, y + rows) is (x - S, y).
+float neighbour(const HeightField& h, int x, int y, int dx, int dy, int shift) {
+  const int w = h.width(), rows = h.height();
+  const int laps = y + dy < 0 ? -1 : (y + dy >= rows ? 1 : 0);
+  return h(((x + dx - laps * shift) % w + w) % w, y + dy - laps * rows);
+}
+
 HeightField reference_sweep(const HeightField& h, float limit, int shift) {
   auto edge_limit = [&](int dx, int dy) {
     return static_cast<float>(limit * std::sqrt(static_cast<double>(dx * dx + dy * dy)));
   };
-  auto flux = [](float a, float b, float lim) {
+  auto excess = [](float a, float b, float lim) {
     const float d = a - b;
-    return (std::max(d - lim, 0.0f) + std::min(d + lim, 0.0f)) * (1.0f / 9.0f);
+    return std::max(d - lim, 0.0f) + std::min(d + lim, 0.0f);
   };
   const int w = h.width(), rows = h.height();
   HeightField out(w, rows);
   for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < w; ++x) {
-      auto at = [&](int dx, int dy) {
-        const int laps = y + dy < 0 ? -1 : (y + dy >= rows ? 1 : 0);
-        return h(((x + dx - laps * shift) % w + w) % w, y + dy - laps * rows);
+      auto edge = [&](int dx, int dy) {
+        return excess(h(x, y), neighbour(h, x, y, dx, dy, shift), edge_limit(dx, dy));
       };
-      auto edge = [&](int dx, int dy) { return flux(h(x, y), at(dx, dy), edge_limit(dx, dy)); };
       const float axis = edge(-1, 0) + edge(1, 0) + edge(0, -1) + edge(0, 1);
       const float diag = edge(-1, -1) + edge(1, -1) + edge(-1, 1) + edge(1, 1);
-      out(x, y) = h(x, y) - (axis + diag);
+      out(x, y) = h(x, y) - (axis + diag) * (1.0f / 9.0f);
     }
   }
   return out;
 }
 
+// Sizes whose rows are cut into several strips (dunes/tiles.h) and rows
+// into blocks with a short last one, with wrapped columns: the grid, and
+// wind lattices whose rows wrap shifted.
+const std::pair<int, int> kSweepSizes[] = {{37, 23}, {64, 64}, {9, 40}, {2100, 19}, {1030, 3}};
+
 }  // namespace
 
 TEST(Kernels, AvalancheSweepsAreTheEightNeighbourSum) {
-  // Odd, non-square sizes: the wrapped columns and a short last row block;
-  // the grid, and wind lattices whose rows wrap shifted.
-  for (auto [w, h] : {std::pair{37, 23}, {64, 64}, {9, 40}}) {
+  for (auto [w, h] : kSweepSizes) {
     for (const int shift : {0, 5, w / 2, w - 1}) {
       const float limit = 0.7f;
       HeightField fast = spiky_field(w, h, 0.0f, 3.0f, 7);
@@ -81,6 +91,33 @@ TEST(Kernels, AvalancheSweepsAreTheEightNeighbourSum) {
         ASSERT_EQ(fast.values(), slow.values())
             << w << "x" << h << ", shift " << shift << ", sweep " << sweep;
       }
+    }
+  }
+}
+
+TEST(Kernels, CreepIsTheFourNeighbourSumAndTheSteepestEdgeIsFound) {
+  for (auto [w, h] : kSweepSizes) {
+    for (const int shift : {0, 5, w - 1}) {
+      const HeightField start = spiky_field(w, h, 0.0f, 3.0f, 11);
+      HeightField crept = start;
+      const float d = 0.3f;
+      creep(crept, d, shift);
+      float steepest = 0.0f;
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          const float c = start(x, y);
+          auto at = [&](int dx, int dy) { return neighbour(start, x, y, dx, dy, shift); };
+          const float expected =
+              c + d / 4 * ((at(-1, 0) - c) + (at(1, 0) - c) + (at(0, -1) - c) + (at(0, 1) - c));
+          ASSERT_EQ(crept(x, y), expected) << w << "x" << h << " at " << x << "," << y;
+          for (const auto& [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {-1, 1}}) {
+            const float lim =
+                dx != 0 && dy != 0 ? static_cast<float>(std::numbers::sqrt2 * 0.7) : 0.7f;
+            steepest = std::max(steepest, std::fabs(c - at(dx, dy)) - lim);
+          }
+        }
+      }
+      EXPECT_EQ(max_excess(start, 0.7, shift), steepest) << w << "x" << h << ", shift " << shift;
     }
   }
 }
