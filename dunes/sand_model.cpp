@@ -223,45 +223,45 @@ DRIFT_SIMD_TWINS(dune_flights, flights_kernel<Model::Dunes>,
                  (c, n, before, after, p, shadow, recovery, land, part, to_next))
 
 // Per-row scratch of saltation: the lift's recovery past shadows, the
-// flights, and the two windows the row's sand is summed in (fly()); for
-// rows without a shadow, a map with none in reach and a recovery of 1.
+// flights, and the two windows the row's sand is summed in (fly(); the odd
+// one is left all 0 for the next row); for rows without a shadow, a map
+// with none in reach and a recovery of 1.
 struct RowScratch {
   std::vector<float> recovery;
   std::vector<std::int32_t> land;
   std::vector<float> part, to_next;
-  std::vector<double> window, odd_window;
+  std::vector<double> even, odd;
   std::vector<std::uint16_t> no_shadow;
   std::vector<float> full_lift;
   void resize(int n) {
     const auto size = static_cast<std::size_t>(n);
     for (auto* v : {&recovery, &part, &to_next}) v->resize(size);
     land.resize(size);
-    window.resize(2 * size);
-    odd_window.resize(2 * size);
+    even.resize(2 * size);
+    if (odd.size() != 2 * size) odd.assign(2 * size, 0.0);
     if (no_shadow.size() != size) no_shadow.assign(size, std::uint16_t{0xfffe});
     if (full_lift.size() != size) full_lift.assign(size, 1.0f);
   }
 };
 
-// A row's sand after its flights, in `window` (n + tail points): each
-// point less what it lifts, plus what lands on it, summed in double.
-// Landings past the row's end (at most `tail` columns) are summed beyond it
-// and then folded onto its start, so the adds need no wrapping test. Their
-// time is the chain of adds to the same few points (neighbouring flights
-// land side by side, and those caught at a shadow's edge on one point), so
-// even and odd sources land in two windows, two chains side by side, summed
-// at the end. A share is exact in double: part - to_next of two floats, and
-// both added, so what lands is what was lifted.
-void fly(const float* c, int n, int tail, RowScratch& f) {
+// A row's sand after its flights, into `out` (its n points): each point
+// less what it lifts, plus what lands on it, summed in double and rounded
+// once. Landings past the row's end (at most `tail` points) are summed
+// beyond it and then folded onto its start, so the adds need no wrapping
+// test. Their time is the chain of adds to the same few points
+// (neighbouring flights land side by side, and those caught at a shadow's
+// edge on one point), so even and odd sources land in two windows, two
+// chains side by side, summed at the end. A share is exact in double:
+// part - to_next of two floats, and both added, so what lands is what was
+// lifted.
+void fly(const float* c, int n, int tail, RowScratch& f, float* __restrict out) {
   const std::int32_t* __restrict land = f.land.data();
   const float* __restrict part = f.part.data();
   const float* __restrict to_next = f.to_next.data();
-  double* __restrict even = f.window.data();
-  double* __restrict odd = f.odd_window.data();
-  const int size = n + tail;
+  double* __restrict even = f.even.data();
+  double* __restrict odd = f.odd.data();
   for (int x = 0; x < n; ++x) even[x] = static_cast<double>(c[x]) - part[x];
-  std::fill(even + n, even + size, 0.0);
-  std::fill(odd, odd + size, 0.0);
+  std::fill(even + n, even + n + tail, 0.0);
   auto land_in = [&](double* window, int x) {
     const double next = to_next[x];
     window[land[x]] += static_cast<double>(part[x]) - next;
@@ -273,8 +273,16 @@ void fly(const float* c, int n, int tail, RowScratch& f) {
     land_in(odd, x + 1);
   }
   if (x < n) land_in(even, x);
-  for (int i = 0; i < size; ++i) even[i] += odd[i];
-  for (int i = 0; i < tail; ++i) even[i] += even[n + i];
+  // Summed, folded and rounded in one pass, which leaves `odd` all 0.
+  for (int i = 0; i < tail; ++i) {
+    out[i] = static_cast<float>((even[i] + odd[i]) + (even[n + i] + odd[n + i]));
+    odd[i] = 0.0;
+    odd[n + i] = 0.0;
+  }
+  for (int i = tail; i < n; ++i) {
+    out[i] = static_cast<float>(even[i] + odd[i]);
+    odd[i] = 0.0;
+  }
 }
 
 // What saltation needs to know once per step.
@@ -285,9 +293,9 @@ struct SaltationPlan {
   double reattach = 0.0;  // with a shadow: see shadow_recovery()
 };
 
-// One row's sand after saltation, in the scratch's window (see fly()).
+// One row's sand after saltation, into `out` (see fly()).
 void saltate_row(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p,
-                 int row, RowScratch& scratch) {
+                 int row, RowScratch& scratch, float* out) {
   const int n = h.width();
   const float* c = &h(0, row);
   const std::uint16_t* shadow = scratch.no_shadow.data();
@@ -302,20 +310,17 @@ void saltate_row(const terrain::HeightField& h, const SandOptions& o, const Salt
   auto* flights = o.model == Model::Dunes ? dune_flights : ripple_flights;
   flights(c, n, c[n - 1], c[0], p.flights, shadow, recovery, scratch.land.data(),
           scratch.part.data(), scratch.to_next.data());
-  fly(c, n, p.tail, scratch);
+  fly(c, n, p.tail, scratch, out);
 }
 
-// Rows [begin, end), each in turn: its sand summed in a window, then each
-// point rounded once into `out`.
+// Rows [begin, end), each in turn, into `out`.
 void land_rows(const terrain::HeightField& h, const SandOptions& o, const SaltationPlan& p,
                int begin, int end, std::vector<float>& out) {
   const int n = h.width();
   thread_local RowScratch scratch;
   scratch.resize(n);
   for (int r = begin; r < end; ++r) {
-    saltate_row(h, o, p, r, scratch);
-    std::copy(scratch.window.begin(), scratch.window.begin() + n,
-              out.begin() + static_cast<std::ptrdiff_t>(r) * n);
+    saltate_row(h, o, p, r, scratch, &out[static_cast<std::size_t>(r) * n]);
   }
 }
 
