@@ -102,13 +102,11 @@ DRIFT_SIMD_KERNEL void relax_strip_kernel(const float* c, const float* s, int w,
                                           float limit, float diagonal, const float* a_s,
                                           const float* a_se, const float* a_sw, float* south,
                                           float* south_east, float* south_west, float* out) {
-  const int begin = std::max(x0, 1), end = std::min(x1, w - 1);
-  relax_span(c + x0, s + x0, begin - x0, end - x0, limit, diagonal, a_s, a_se, a_sw, south,
-             south_east, south_west, out + x0);
-  for (const int x : {0, w - 1}) {
-    if (x < x0 || x >= x1) continue;
+  const InnerColumns inner = inner_columns(x0, x1, w);
+  relax_span(c + x0, s + x0, inner.begin - x0, inner.end - x0, limit, diagonal, a_s, a_se, a_sw,
+             south, south_east, south_west, out + x0);
+  for_wrapped_columns(x0, x1, w, [&](int x, int l, int r) {
     const int i = x - x0;
-    const int l = x == 0 ? w - 1 : x - 1, r = x + 1 == w ? 0 : x + 1;
     const float c3[3] = {c[l], c[x], c[r]}, s3[3] = {s[l], s[x], s[r]};
     const float a_s3[3] = {0.0f, a_s[i], 0.0f}, a_se3[3] = {a_se[i - 1], 0.0f, 0.0f};
     const float a_sw3[3] = {0.0f, 0.0f, a_sw[i + 1]};
@@ -119,7 +117,7 @@ DRIFT_SIMD_KERNEL void relax_strip_kernel(const float* c, const float* s, int w,
     south_east[i] = south_east3[1];
     south_west[i] = south_west3[1];
     out[x] = out3[1];
-  }
+  });
   strip_ends(c, s, w, x0, x1, diagonal, south_east, south_west);
 }
 DRIFT_SIMD_TWINS(relax_strip, relax_strip_kernel,

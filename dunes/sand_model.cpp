@@ -361,6 +361,31 @@ void saltate_on(terrain::HeightField& h, const SandOptions& o, double per_cell, 
   std::swap(w.next, h.values());
 }
 
+// Creep at a point: the sum of edge fluxes d * (neighbour - centre),
+// antisymmetric per edge, so mass is conserved.
+DRIFT_SIMD_KERNEL float crept(float centre, float west, float east, float north, float south,
+                              float d) {
+  return centre + d * ((west - centre) + (east - centre) + (north - centre) + (south - centre));
+}
+
+// Creep on the strip [x0, x1) of row c (n and s the rows north and south of
+// it).
+DRIFT_SIMD_KERNEL void creep_strip_kernel(const float* __restrict c, const float* __restrict n,
+                                          const float* __restrict s, int w, int x0, int x1, float d,
+                                          float* __restrict out) {
+  const InnerColumns inner = inner_columns(x0, x1, w);
+  for (int x = inner.begin; x < inner.end; ++x) {
+    out[x] = crept(c[x], c[x - 1], c[x + 1], n[x], s[x], d);
+  }
+  for_wrapped_columns(x0, x1, w, [&](int x, int west, int east) {
+    out[x] = crept(c[x], c[west], c[east], n[x], s[x], d);
+  });
+}
+DRIFT_SIMD_TWINS(creep_strip, creep_strip_kernel,
+                 (const float* c, const float* n, const float* s, int w, int x0, int x1, float d,
+                  float* out),
+                 (c, n, s, w, x0, x1, d, out))
+
 }  // namespace
 
 void saltate(terrain::HeightField& h, const SandOptions& o, Workspace& w) {
@@ -385,15 +410,8 @@ void creep(terrain::HeightField& h, double coefficient, Workspace& ws, int shift
   const LatticeRows row(h, shift);
   for_tiles(w, rows, [&](const Tile& t) {
     for (int r = t.first_row; r < t.end_row; ++r) {
-      const float* __restrict c = row[r];
-      const float* __restrict n = row[r - 1];
-      const float* __restrict s = row[r + 1];
-      float* __restrict out = &ws.next[static_cast<std::size_t>(r) * w];
-      // Sum of edge fluxes d * (neighbour - centre): antisymmetric per edge.
-      auto cell = [&](int x, int xl, int xr) {
-        out[x] = c[x] + d * ((c[xl] - c[x]) + (c[xr] - c[x]) + (n[x] - c[x]) + (s[x] - c[x]));
-      };
-      for_strip_columns(t, w, cell);
+      creep_strip(row[r], row[r - 1], row[r + 1], w, t.x0, t.x1, d,
+                  &ws.next[static_cast<std::size_t>(r) * w]);
     }
   });
   std::swap(ws.next, h.values());

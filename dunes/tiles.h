@@ -37,16 +37,33 @@ void for_tiles(int width, int rows, Fn fn) {
       tbb::simple_partitioner());
 }
 
-// Calls cell(x, x - 1, x + 1) for every column of the tile's strip of a
-// row `width` points long whose columns wrap: the inner columns first, in a
-// loop with no wrapping test (so that it vectorises), then column 0 and
-// width - 1, if the strip has them, with their wrapped neighbours.
+// The columns of a strip [x0, x1) of a row `width` points long, whose
+// columns wrap, with both neighbours inside the row: [begin, end).
+struct InnerColumns {
+  int begin, end;
+};
+inline InnerColumns inner_columns(int x0, int x1, int width) {
+  return {std::max(x0, 1), std::min(x1, width - 1)};
+}
+
+// Calls cell(x, west, east) for the strip's wrapped columns, 0 and width -
+// 1, if it has them, with their wrapped neighbours.
+template <class Cell>
+void for_wrapped_columns(int x0, int x1, int width, Cell cell) {
+  if (x0 == 0) cell(0, width - 1, 1);
+  if (x1 == width) cell(width - 1, width - 2, 0);
+}
+
+// Calls cell(x, x - 1, x + 1) for every column of the tile's strip: the
+// inner columns first, in a loop with no wrapping test, then the wrapped
+// ones. (A kernel that stores through `restrict` pointers writes the inner
+// loop itself: a lambda's capture by reference loses `restrict`, and GCC
+// then does not vectorise.)
 template <class Cell>
 void for_strip_columns(const Tile& t, int width, Cell cell) {
-  const int begin = std::max(t.x0, 1), end = std::min(t.x1, width - 1);
-  for (int x = begin; x < end; ++x) cell(x, x - 1, x + 1);
-  if (t.x0 == 0) cell(0, width - 1, 1);
-  if (t.x1 == width) cell(width - 1, width - 2, 0);
+  const InnerColumns inner = inner_columns(t.x0, t.x1, width);
+  for (int x = inner.begin; x < inner.end; ++x) cell(x, x - 1, x + 1);
+  for_wrapped_columns(t.x0, t.x1, width, cell);
 }
 
 }  // namespace drift::dunes
