@@ -139,14 +139,18 @@ namespace {
 // Flight lengths and slopes are in grid cells, as in the paper; the
 // lattice's columns are h cells apart: `per_cell` = 1 / h columns a cell.
 
-// The longest flight, in cells, short of a lap of the row.
-double max_flight(const terrain::HeightField& h, const SandOptions& o, double per_cell) {
+// Whether a step needs the field's height range: the ripples' longest
+// flight and the wind shadow's reach upwind do.
+bool needs_height_range(const SandOptions& o) {
+  return o.model == Model::Ripples || o.shadow_deg > 0.0;
+}
+
+// The longest flight, in cells, short of a lap of a row `width` points long
+// (`range`: the field's, for ripples).
+double max_flight(const SandOptions& o, double per_cell, int width, HeightRange range) {
   double longest = o.L0 + o.b;  // dunes: L0 - b tanh(.) <= L0 + b
-  if (o.model == Model::Ripples) {
-    const float top = height_range(h).hi;
-    longest = o.L0 + o.b * top;
-  }
-  return std::clamp(longest, 0.0, (h.width() - 1.0) / per_cell);
+  if (o.model == Model::Ripples) longest = o.L0 + o.b * range.hi;
+  return std::clamp(longest, 0.0, (width - 1.0) / per_cell);
 }
 
 // What the flight kernel needs, in float: flights of a few tens of columns
@@ -327,8 +331,10 @@ void land_rows(const terrain::HeightField& h, const SandOptions& o, const Saltat
 // Saltation on a lattice `per_cell` columns a grid cell along the wind.
 void saltate_on(terrain::HeightField& h, const SandOptions& o, double per_cell, Workspace& w) {
   const int rows = h.height();
+  // One pass for both the longest flight and the shadow.
+  const HeightRange range = needs_height_range(o) ? height_range(h) : HeightRange{0.0f, 0.0f};
   // The longest flight in columns, as the kernel bounds it.
-  const double longest = max_flight(h, o, per_cell);
+  const double longest = max_flight(o, per_cell, h.width(), range);
   const auto max_columns =
       std::min(static_cast<float>(longest * per_cell), static_cast<float>(h.width() - 1));
   SaltationPlan p;
@@ -343,7 +349,7 @@ void saltate_on(terrain::HeightField& h, const SandOptions& o, double per_cell, 
   if (o.shadow_deg > 0.0) {
     // The shadow is needed as far ahead as the longest flight reaches; its
     // line falls shadow_drop per cell, so per column 1 / per_cell times that.
-    wind_shadow(h, shadow_drop(o) / per_cell, longest * per_cell, w.shadow);
+    wind_shadow(h, range, shadow_drop(o) / per_cell, longest * per_cell, w.shadow);
     p.shadow = &w.shadow;
     p.reattach = o.reattach;
   }

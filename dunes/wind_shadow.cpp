@@ -14,7 +14,6 @@
 #include <emmintrin.h>
 #endif
 
-#include "dunes/height_range.h"
 #include "terrain/simd.h"
 
 namespace drift::dunes {
@@ -120,10 +119,9 @@ void measure_reach(int n, int limit, Span span, int j0, int j1,
 
 // Columns before column 0 that a row must be followed for: past a lap it
 // has come round to its own start.
-int warm_up_columns(const terrain::HeightField& h, double drop_per_column) {
-  const HeightRange range = height_range(h);
+int warm_up_columns(int width, HeightRange range, double drop_per_column) {
   const double columns = (static_cast<double>(range.hi) - range.lo) / drop_per_column + 2;
-  return static_cast<int>(std::min<double>(h.width(), columns));
+  return static_cast<int>(std::min<double>(width, columns));
 }
 
 // A line's shadow flags as bits (bit x % 64 of word x / 64), so that runs
@@ -213,15 +211,15 @@ void recover_line(const std::uint16_t* s, int n, double ratio, float* out) {
 
 }  // namespace
 
-void wind_shadow(const terrain::HeightField& h, double drop_per_column, double max_columns,
-                 ShadowMap& shadow) {
+void wind_shadow(const terrain::HeightField& h, HeightRange range, double drop_per_column,
+                 double max_columns, ShadowMap& shadow) {
   const int n = h.width(), rows = h.height();
   assert(drop_per_column > 0);
   shadow.resize(h.size());
   // Reaches are kept in 15 bits.
   const int limit = static_cast<int>(
       std::min<double>({static_cast<double>(n), std::ceil(max_columns) + 1, 32767.0}));
-  const Span span{warm_up_columns(h, drop_per_column), limit};
+  const Span span{warm_up_columns(n, range, drop_per_column), limit};
   const std::array<Run, 3> path = runs(n, span);
   // Blocks of kLineBlock rows side by side; a short last block repeats its
   // last row.

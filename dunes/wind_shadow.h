@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "dunes/height_range.h"
 #include "terrain/grid.h"
 
 namespace drift::dunes {
@@ -20,13 +21,15 @@ namespace drift::dunes {
 // ceil(max_columns) + 1) (none that near).
 using ShadowMap = std::vector<std::uint16_t>;
 
-// `drop_per_column` (> 0): the shadow line's fall per column, in height
-// units. `max_columns`: the longest flight in columns; distances beyond it
-// are not needed. Rows are followed from as far upwind as a shadow can reach
-// (across the periodic edge) to that far downwind; they are independent, so
-// the result is the same for any thread count.
-void wind_shadow(const terrain::HeightField& h, double drop_per_column, double max_columns,
-                 ShadowMap& shadow);
+// `range`: the field's height_range() (a caller that needs it too works it
+// out once). `drop_per_column` (> 0): the shadow line's fall per column, in
+// height units. `max_columns`: the longest flight in columns; distances
+// beyond it are not needed. Rows are followed from as far upwind as a
+// shadow can reach (across the periodic edge; the range bounds it) to that
+// far downwind; they are independent, so the result is the same for any
+// thread count.
+void wind_shadow(const terrain::HeightField& h, HeightRange range, double drop_per_column,
+                 double max_columns, ShadowMap& shadow);
 
 // Beyond a shadow the wind does not take up sand at once: the flow
 // reattaches behind the separation bubble and the sand flux then saturates

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "dunes/avalanche.h"
+#include "dunes/height_range.h"
 #include "dunes/lattice.h"
 #include "dunes/sand_model.h"
 #include "dunes/wind_frame.h"
@@ -335,7 +336,7 @@ HeightField reference_saltation(const HeightField& h, const SandOptions& o) {
   std::vector<float> recovery;
   if (o.shadow_deg > 0) {
     const double drop = std::tan(o.shadow_deg * std::numbers::pi / 180) * o.cell_m / o.height_unit;
-    wind_shadow(h, drop * l.cell, n, shadow);
+    wind_shadow(h, height_range(h), drop * l.cell, n, shadow);
     if (o.reattach > 0) {
       shadow_recovery(shadow, n, o.reattach, recovery);
     } else {

@@ -35,11 +35,6 @@ HeightField spiky_field(int w, int h, float lo, float hi, std::uint32_t seed) {
   return f;
 }
 
-// One Jacobi sweep as the avalanche's doc defines it: every cell sums, over
-// its 8 neighbours in the order W, E, N, S, NW, NE, SW, SE, the excess drop
-// across each edge, whose limit is `limit` times the edge's length (sqrt 2
-// on diagonals), and loses a ninth of the sum. On a wind lattice of shift S, past the last
-// row, row 0 goes on S columns back: point (x, y + rows) is (x - S, y).
 // The height of the neighbour (dx, dy) of (x, y) on a wind lattice of
 // shift S: past the last row, row 0 goes on S columns back, so point
 // (x, y + rows) is (x - S, y).
@@ -49,6 +44,10 @@ float neighbour(const HeightField& h, int x, int y, int dx, int dy, int shift) {
   return h(((x + dx - laps * shift) % w + w) % w, y + dy - laps * rows);
 }
 
+// One Jacobi sweep as the avalanche's doc defines it: every cell sums, over
+// its 8 neighbours in the order W, E, N, S, NW, NE, SW, SE, the excess drop
+// across each edge, whose limit is `limit` times the edge's length (sqrt 2
+// on diagonals), and loses a ninth of the sum.
 HeightField reference_sweep(const HeightField& h, float limit, int shift) {
   auto edge_limit = [&](int dx, int dy) {
     return static_cast<float>(limit * std::sqrt(static_cast<double>(dx * dx + dy * dy)));
@@ -133,7 +132,7 @@ TEST(Kernels, TheShadowAlongRowsIsCastByEverySampleUpwind) {
   for (float& v : h.values()) v = 0.5f * static_cast<float>(rng() % 24);
   ShadowMap shadow;
   const int max_columns = 9;
-  wind_shadow(h, drop, max_columns, shadow);
+  wind_shadow(h, height_range(h), drop, max_columns, shadow);
   for (int row = 0; row < rows; ++row) {
     std::vector<bool> expected(w, false);
     for (int x = 0; x < w; ++x) {
