@@ -18,12 +18,22 @@ namespace drift::pipeline {
 namespace {
 
 struct SnowfallCommand {
-  std::string ground, objects, output, cover, mesh_out;
+  std::string ground, objects, output, cover, surface, mesh_out;
   std::vector<double> direction{0.0, 90.0};
   std::string occlusion = "sweep";
   unsigned long long seed = 1;
   snow::SnowfallOptions options;
 };
+
+// SPEC 3a's third output: the height of the snow's top, for stages that press
+// into it (marks). NaN where the ground has no data.
+terrain::HeightField snow_surface(const terrain::HeightField& ground,
+                                  const terrain::HeightField& depth) {
+  terrain::HeightField top = depth;
+  for (std::size_t i = 0; i < top.size(); ++i)
+    top.values()[i] = ground.values()[i] + depth.values()[i];
+  return top;
+}
 
 void run_snowfall(SnowfallCommand& c) {
   if (c.direction.size() != 2) usage_error("--direction takes AZ,EL (degrees)");
@@ -53,6 +63,11 @@ void run_snowfall(SnowfallCommand& c) {
   if (!c.cover.empty()) {
     terrain::write_geotiff(r.coverage, c.cover, {"snow coverage (0..1)", ""});
     std::printf("snow fall: wrote %s\n", c.cover.c_str());
+  }
+  if (!c.surface.empty()) {
+    terrain::write_geotiff(snow_surface(ground, r.depth), c.surface,
+                           {"snow surface height, ground + depth (m)", "m"});
+    std::printf("snow fall: wrote %s\n", c.surface.c_str());
   }
   if (!c.mesh_out.empty()) {
     terrain::write_ply(r.objects, c.mesh_out);
@@ -85,6 +100,8 @@ void add_snowfall_command(CLI::App& root) {
   sub->add_option("--objects", c->objects, "TOML file of [[objects]] (mesh, position, ...)");
   sub->add_option("-o,--output", c->output, "snow depth GeoTIFF (m)")->required();
   sub->add_option("--cover", c->cover, "snow coverage GeoTIFF (0..1)");
+  sub->add_option("--surface", c->surface,
+                  "snow surface GeoTIFF: ground + snow depth (m), e.g. for drift marks");
   sub->add_option("--mesh-out", c->mesh_out,
                   "PLY of the objects raised by their snow, with per-vertex snow_depth, "
                   "snow_probability, snow_coverage, snow_adhesion");
