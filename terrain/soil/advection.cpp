@@ -24,23 +24,22 @@ void copy_back(SoilState& s, std::size_t i) {
   s.fz[i] = s.back.fz[i];
 }
 
-void advect(SoilState& s, double dt) {
+detail::Ranges advect(SoilState& s, double dt) {
   const terrain::Grid3Shape& g = s.shape;
-  const std::size_t n = s.size();
-  tbb::parallel_for(std::size_t{0}, n, std::size_t{1} << 16, [&](std::size_t begin) {
-    const std::size_t end = std::min(n, begin + (std::size_t{1} << 16));
-    for (std::size_t i = begin; i < end; ++i) s.back.accept[i] = s.rho[i] + s.psi[i] < kFull;
-  });
   const float scale = static_cast<float>(dt / g.voxel_size);  // m/s -> voxels per step
   const float *ux = s.ux.data(), *uy = s.uy.data(), *uz = s.uz.data();
+  const float *rho = s.rho.data(), *psi = s.psi.data();
   auto disp = [=](std::size_t i) {
     return detail::D3{std::clamp(ux[i] * scale, -1.0f, 1.0f),
                       std::clamp(uy[i] * scale, -1.0f, 1.0f),
                       std::clamp(uz[i] * scale, -1.0f, 1.0f)};
   };
+  // Eq. 24: a voxel full of soil and body is locked (rho is only read here).
+  auto unlocked = [=](std::size_t i) { return rho[i] + psi[i] < kFull; };
   const detail::Carried carried{{ux, uy, uz}, {s.fx.data(), s.fy.data(), s.fz.data()}};
-  detail::transport(
-      g, s.rho.data(), s.back.accept.data(), disp, carried, false,
+  return detail::transport(
+      g, s.rho.data(), detail::sender_ranges(g, s.rho.data(), unlocked, disp), unlocked, disp,
+      carried, false,
       [&](std::size_t i, const detail::Gathered& r) {
         s.back.rho[i] = r.amount;
         const float inv = r.amount > 0 ? 1.0f / r.amount : 0.0f;
@@ -51,6 +50,7 @@ void advect(SoilState& s, double dt) {
         s.back.fy[i] = r.f[1] * inv;
         s.back.fz[i] = r.f[2] * inv;
       },
+      true,
       [&](std::size_t i, float self) {  // backflow came back with zero velocity (eq. 28)
         s.ux[i] *= self;
         s.uy[i] *= self;
@@ -66,10 +66,11 @@ float room(const SoilState& s, std::size_t i) { return std::max(0.0f, 1.0f - s.p
 // One Jacobi pass of "up one voxel", in place per column: the excess of
 // voxel z is computed from the values before the pass (z is read before it is
 // written, and the carry holds what z - 1 sent up).
-void overflow_up_pass(SoilState& s) {
+void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
   tbb::parallel_for(0, g.ny, [&](int y) {
     for (int x = 0; x < g.nx; ++x) {
+      if (dirty && !(*dirty)[static_cast<std::size_t>(y) * g.nx + x]) continue;
       const std::size_t c = g.column(x, y);
       float carry = 0, cu[3] = {0, 0, 0};
       for (int z = 0; z < g.nz; ++z) {
@@ -161,19 +162,20 @@ void overflow_weighted_pass(SoilState& s, const std::array<float, 27>& w) {
 
 }  // namespace
 
-void resolve_overflow(SoilState& s, OverflowHeuristic h, int passes) {
+void resolve_overflow(SoilState& s, OverflowHeuristic h, int passes, const ColumnMask* dirty) {
   for (int p = 0; p < passes; ++p) {
     if (h == OverflowHeuristic::Up)
-      overflow_up_pass(s);
+      overflow_up_pass(s, dirty);
     else
       overflow_weighted_pass(s, heuristic_weights(h));
   }
 }
 
-void settle_overflow(SoilState& s) {
+void settle_overflow(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
   tbb::parallel_for(0, g.ny, [&](int y) {
     for (int x = 0; x < g.nx; ++x) {
+      if (dirty && !(*dirty)[static_cast<std::size_t>(y) * g.nx + x]) continue;
       const std::size_t c = g.column(x, y);
       float carry = 0;
       for (int z = 0; z < g.nz; ++z) {

@@ -12,7 +12,6 @@ namespace drift::soil {
 namespace {
 constexpr float kCollided = 1e-6f;  // rho + psi - 1 above which a voxel is collided
 constexpr float kSolid = 1.0f - 1e-6f;
-constexpr std::size_t kChunk = std::size_t{1} << 16;
 }  // namespace
 
 void apply_forces(SoilState& s, const std::vector<BodyMotion>& bodies) {
@@ -45,30 +44,36 @@ void apply_forces(SoilState& s, const std::vector<BodyMotion>& bodies) {
   });
 }
 
-void propagate_forces(SoilState& s) {
+detail::Ranges propagate_forces(SoilState& s) {
   const terrain::Grid3Shape& g = s.shape;
-  const std::size_t n = s.size();
   std::vector<float>& moving = s.back.moving;
-  std::vector<std::uint8_t> any((n + kChunk - 1) / kChunk, 0);
-  tbb::parallel_for(std::size_t{0}, n, kChunk, [&](std::size_t begin) {
-    const std::size_t end = std::min(n, begin + kChunk);
-    for (std::size_t i = begin; i < end; ++i) {
-      const float e = s.rho[i] + s.psi[i] - 1.0f;
-      const bool pushed = e > kCollided && (s.fx[i] != 0 || s.fy[i] != 0 || s.fz[i] != 0);
-      moving[i] = pushed ? std::min(e, s.rho[i]) : 0.0f;
-      s.back.accept[i] = s.psi[i] < kSolid;
-      any[begin / kChunk] |= pushed;
+  // The collided soil that moves, and per column the range holding it.
+  detail::Ranges senders(g.columns(), {g.nz, -1});
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) {
+      auto& r = senders[static_cast<std::size_t>(y) * g.nx + x];
+      for (int z = 0; z < g.nz; ++z) {
+        const std::size_t i = g.index(x, y, z);
+        const float e = s.rho[i] + s.psi[i] - 1.0f;
+        const bool pushed = e > kCollided && (s.fx[i] != 0 || s.fy[i] != 0 || s.fz[i] != 0);
+        moving[i] = pushed ? std::min(e, s.rho[i]) : 0.0f;
+        if (!pushed) continue;
+        r.first = std::min(r.first, z);
+        r.second = z;
+      }
     }
   });
-  if (std::none_of(any.begin(), any.end(), [](std::uint8_t a) { return a != 0; })) return;
-  const float *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data();
+  if (std::all_of(senders.begin(), senders.end(), [](const auto& r) { return r.first > r.second; }))
+    return senders;
+  const float *fx = s.fx.data(), *fy = s.fy.data(), *fz = s.fz.data(), *psi = s.psi.data();
   auto disp = [=](std::size_t i) {  // eq. 34: f over its largest component
     const float m = std::max(std::abs(fx[i]), std::max(std::abs(fy[i]), std::abs(fz[i])));
     return m > 0 ? detail::D3{fx[i] / m, fy[i] / m, fz[i] / m} : detail::D3{};
   };
+  auto open = [=](std::size_t i) { return psi[i] < kSolid; };
   const detail::Carried carried{{s.ux.data(), s.uy.data(), s.uz.data()}, {fx, fy, fz}};
-  detail::transport(
-      g, moving.data(), s.back.accept.data(), disp, carried, true,
+  return detail::transport(
+      g, moving.data(), senders, open, disp, carried, true,
       [&](std::size_t i, const detail::Gathered& r) {
         const float kept = s.rho[i] - moving[i], now = kept + r.amount;
         const float inv = now > 0 ? 1.0f / now : 0.0f;
@@ -82,8 +87,7 @@ void propagate_forces(SoilState& s) {
         s.back.fy[i] = r.f[1] * fin;
         s.back.fz[i] = r.f[2] * fin;
       },
-      [](std::size_t, float) {},  // nothing moved near it: unchanged
-      [&](std::size_t i) { copy_back(s, i); });
+      false, [](std::size_t, float) {}, [&](std::size_t i) { copy_back(s, i); });
 }
 
 }  // namespace drift::soil

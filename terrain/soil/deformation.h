@@ -7,6 +7,7 @@
 
 #include "terrain/soil/primitives.h"
 #include "terrain/soil/soil_state.h"
+#include "terrain/soil/transport.h"
 
 namespace drift::soil {
 
@@ -27,7 +28,7 @@ void apply_forces(SoilState& state, const std::vector<BodyMotion>& bodies);
 // (so it leaves its voxel entirely) into neighbours that are in the grid and
 // not solid body (psi < 1), with u; anything refused comes back. f becomes
 // the inflow-weighted mean of the arriving forces where the voxel is still
-// collided, 0 elsewhere.
-void propagate_forces(SoilState& state);
+// collided, 0 elsewhere. Returns per column the z-range that changed.
+detail::Ranges propagate_forces(SoilState& state);
 
 }  // namespace drift::soil

@@ -10,6 +10,17 @@
 
 namespace drift::soil {
 
+namespace {
+
+// Marks the columns of a body's voxel box, widened by one, as dirty.
+void mark_box(const VoxelBox& box, ColumnMask& dirty, const terrain::Grid3Shape& g) {
+  for (int y = std::max(0, box.lo.y() - 1); y < std::min(g.ny, box.hi.y() + 1); ++y)
+    for (int x = std::max(0, box.lo.x() - 1); x < std::min(g.nx, box.hi.x() + 1); ++x)
+      dirty[static_cast<std::size_t>(y) * g.nx + x] = 1;
+}
+
+}  // namespace
+
 void validate(const SoilOptions& o) {
   auto check = [](bool ok, const char* name, double v, const char* range) {
     if (!ok)
@@ -57,12 +68,19 @@ void SoilSimulation::step() {
   time_ += dt;
   rebuild_collision_field();
 
-  apply_forces(state_, motion);
-  for (int i = 0; i < options_.propagation_iterations; ++i) propagate_forces(state_);
+  // Overflow can only arise where soil moved or a body is: mark those columns.
+  ColumnMask dirty(state_.shape.columns(), 0);
+  auto mark = [&](const detail::Ranges& r) {
+    for (std::size_t c = 0; c < r.size(); ++c) dirty[c] |= r[c].first <= r[c].second;
+  };
+  for (const BodyMotion& m : motion) mark_box(m.box, dirty, state_.shape);
 
-  advect(state_, dt);
-  resolve_overflow(state_, options_.overflow, options_.overflow_passes);
-  if (options_.settle) settle_overflow(state_);
+  apply_forces(state_, motion);
+  for (int i = 0; i < options_.propagation_iterations; ++i) mark(propagate_forces(state_));
+
+  mark(advect(state_, dt));
+  resolve_overflow(state_, options_.overflow, options_.overflow_passes, &dirty);
+  if (options_.settle) settle_overflow(state_, &dirty);
 
   apply_gravity(state_, options_.gravity, dt);
   if (options_.slippage) slippage_.step(state_, options_.soil, options_.gravity, dt);

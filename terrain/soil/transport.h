@@ -55,9 +55,14 @@ struct Carried {
 // keeps, a - sent, makes the step conserve mass to rounding (keeping
 // a * lambda_self + backflow instead rounds the same way in every resting
 // voxel and drifts).
-inline float sent_amount(const terrain::Grid3Shape& s, const std::uint8_t* accept, int x, int y,
-                         int z, const D3& d, float a) {
+template <class Accept>
+float sent_amount(const terrain::Grid3Shape& s, const Accept& accept, int x, int y, int z,
+                  const D3& d, float a) {
   const int sx = sign_of(d.x), sy = sign_of(d.y), sz = sign_of(d.z);
+  if (!sx && !sy) {  // straight up or down: the one target (most soil at rest)
+    const int tz = z + sz;
+    return sz && tz >= 0 && tz < s.nz && accept(s.index(x, y, tz)) ? a * axis_share(sz, d.z) : 0.0f;
+  }
   float sent = 0;
   for (int c = 1; c < 8; ++c) {
     if ((c & 1 && !sx) || (c & 2 && !sy) || (c & 4 && !sz)) continue;
@@ -65,15 +70,15 @@ inline float sent_amount(const terrain::Grid3Shape& s, const std::uint8_t* accep
     const float l = axis_share(ox, d.x) * axis_share(oy, d.y) * axis_share(oz, d.z);
     if (l <= 0) continue;
     const int tx = x + ox, ty = y + oy, tz = z + oz;
-    if (s.contains(tx, ty, tz) && accept[s.index(tx, ty, tz)]) sent += a * l;
+    if (s.contains(tx, ty, tz) && accept(s.index(tx, ty, tz))) sent += a * l;
   }
   return sent;
 }
 
 // True if voxel (x, y, z) sends any of its amount to another voxel.
-template <class Disp>
-bool sends(const terrain::Grid3Shape& s, const float* amount, const std::uint8_t* accept,
-           Disp& disp, int x, int y, int z) {
+template <class Disp, class Accept>
+bool sends(const terrain::Grid3Shape& s, const float* amount, const Accept& accept, Disp& disp,
+           int x, int y, int z) {
   const std::size_t i = s.index(x, y, z);
   if (amount[i] <= 0) return false;
   const D3 d = disp(i);
@@ -81,11 +86,14 @@ bool sends(const terrain::Grid3Shape& s, const float* amount, const std::uint8_t
   return sent_amount(s, accept, x, y, z, d, amount[i]) > 0;
 }
 
-// Per column, the z-range [first, last] of senders (first > last: none).
-template <class Disp>
-std::vector<std::pair<int, int>> sender_ranges(const terrain::Grid3Shape& s, const float* amount,
-                                               const std::uint8_t* accept, Disp disp) {
-  std::vector<std::pair<int, int>> ranges(s.columns(), {s.nz, -1});
+// Per column a z-range [first, last] (first > last: empty).
+using Ranges = std::vector<std::pair<int, int>>;
+
+// Per column, the z-range of the voxels that send something.
+template <class Disp, class Accept>
+Ranges sender_ranges(const terrain::Grid3Shape& s, const float* amount, const Accept& accept,
+                     Disp disp) {
+  Ranges ranges(s.columns(), {s.nz, -1});
   tbb::parallel_for(0, s.ny, [&](int y) {
     for (int x = 0; x < s.nx; ++x) {
       auto& r = ranges[static_cast<std::size_t>(y) * s.nx + x];
@@ -100,9 +108,9 @@ std::vector<std::pair<int, int>> sender_ranges(const terrain::Grid3Shape& s, con
 }
 
 // Full gather at one voxel.
-template <class Disp>
-Gathered gather(const terrain::Grid3Shape& s, const float* amount, const std::uint8_t* accept,
-                Disp& disp, const Carried& c, bool backflow_keeps_u, int x, int y, int z) {
+template <class Disp, class Accept>
+Gathered gather(const terrain::Grid3Shape& s, const float* amount, const Accept& accept, Disp& disp,
+                const Carried& c, bool backflow_keeps_u, int x, int y, int z) {
   Gathered g;
   const std::size_t i = s.index(x, y, z);
   const float a = amount[i];
@@ -117,7 +125,7 @@ Gathered gather(const terrain::Grid3Shape& s, const float* amount, const std::ui
       g.f[k] = kept * c.f[k][i];
     }
   }
-  if (!accept[i]) return g;
+  if (!accept(i)) return g;
   for (int oy = -1; oy <= 1; ++oy)
     for (int ox = -1; ox <= 1; ++ox)
       for (int oz = -1; oz <= 1; ++oz) {
@@ -140,40 +148,43 @@ Gathered gather(const terrain::Grid3Shape& s, const float* amount, const std::ui
   return g;
 }
 
-// Runs the transport. Voxels some sender can reach gather their result and
-// `finish(i, gathered)` stores it in a back buffer; once every gather is done
-// `commit(i)` copies it to the front. A voxel out of every sender's reach
-// holding soil gets `idle(i, self_share)` instead, in place: it keeps its
-// amount (what would have left it came back) and only its own share
-// `self_share` stayed in motion. Nobody reads an idle voxel's carried values
-// (only senders' and the gathering voxel's own are read), so the in-place
-// update is safe, and the passes cost what the moving soil covers.
-template <class Disp, class Finish, class Idle, class Commit>
-void transport(const terrain::Grid3Shape& s, const float* amount, const std::uint8_t* accept,
-               Disp disp, const Carried& c, bool backflow_keeps_u, Finish finish, Idle idle,
-               Commit commit) {
-  const auto ranges = sender_ranges(s, amount, accept, disp);
-  std::vector<std::pair<int, int>> reach(s.columns(), {s.nz, -1});
+// Runs the transport from the voxels in `senders` (every voxel that sends
+// anything must lie in its column's range; more is harmless). Voxels some
+// sender can reach gather their result and `finish(i, gathered)` stores it in
+// a back buffer; once every gather is done `commit(i)` copies it to the
+// front. If `with_idle`, a voxel out of every sender's reach holding soil gets
+// `idle(i, self_share)` instead, in place: it keeps its amount (what would
+// have left it came back) and only its own share `self_share` stayed in
+// motion. Nobody reads an idle voxel's carried values (only senders' and the
+// gathering voxel's own are read), so the in-place update is safe, and the
+// passes cost what the moving soil covers. Returns the reach per column.
+template <class Disp, class Accept, class Finish, class Idle, class Commit>
+Ranges transport(const terrain::Grid3Shape& s, const float* amount, const Ranges& senders,
+                 const Accept& accept, Disp disp, const Carried& c, bool backflow_keeps_u,
+                 Finish finish, bool with_idle, Idle idle, Commit commit) {
+  Ranges reach(s.columns(), {s.nz, -1});
   tbb::parallel_for(0, s.ny, [&](int y) {
     Disp local = disp;
     for (int x = 0; x < s.nx; ++x) {
       int lo = s.nz, hi = -1;
       for (int cy = std::max(0, y - 1); cy <= std::min(s.ny - 1, y + 1); ++cy)
         for (int cx = std::max(0, x - 1); cx <= std::min(s.nx - 1, x + 1); ++cx) {
-          const auto& r = ranges[static_cast<std::size_t>(cy) * s.nx + cx];
+          const auto& r = senders[static_cast<std::size_t>(cy) * s.nx + cx];
           if (r.first > r.second) continue;
           lo = std::min(lo, std::max(0, r.first - 1));
           hi = std::max(hi, std::min(s.nz - 1, r.second + 1));
         }
       reach[static_cast<std::size_t>(y) * s.nx + x] = {lo, hi};
+      for (int z = lo; z <= hi; ++z)
+        finish(s.index(x, y, z), gather(s, amount, accept, local, c, backflow_keeps_u, x, y, z));
+      if (!with_idle) continue;
       for (int z = 0; z < s.nz; ++z) {
+        if (z == lo) z = hi + 1;
+        if (z >= s.nz) break;
         const std::size_t i = s.index(x, y, z);
-        if (z >= lo && z <= hi) {
-          finish(i, gather(s, amount, accept, local, c, backflow_keeps_u, x, y, z));
-        } else if (amount[i] > 0) {
-          const D3 d = local(i);
-          idle(i, axis_share(0, d.x) * axis_share(0, d.y) * axis_share(0, d.z));
-        }
+        if (amount[i] <= 0) continue;
+        const D3 d = local(i);
+        idle(i, axis_share(0, d.x) * axis_share(0, d.y) * axis_share(0, d.z));
       }
     }
   });
@@ -183,6 +194,7 @@ void transport(const terrain::Grid3Shape& s, const float* amount, const std::uin
       for (int z = lo; z <= hi; ++z) commit(s.index(x, y, z));
     }
   });
+  return reach;
 }
 
 }  // namespace drift::soil::detail
