@@ -5,33 +5,30 @@
 #include <algorithm>
 #include <cmath>
 
+#include "terrain/bilinear.h"
 #include "terrain/error.h"
+#include "terrain/hash.h"
 
 namespace drift::soil {
 
 namespace {
 
-// Counter-based value noise on a lattice (hash of seed and lattice point), so
-// the terrain does not depend on evaluation order.
+// Counter-based value noise on a lattice (terrain/hash.h), so the terrain
+// does not depend on evaluation order.
 double lattice(long i, long j, unsigned long long seed) {
-  unsigned long long h = seed * 0x9E3779B97F4A7C15ull ^
-                         (static_cast<unsigned long long>(i) * 0xBF58476D1CE4E5B9ull) ^
-                         (static_cast<unsigned long long>(j) * 0x94D049BB133111EBull);
-  h ^= h >> 31;
-  h *= 0xD6E8FEB86659FD93ull;
-  h ^= h >> 32;
-  return static_cast<double>(h >> 11) / static_cast<double>(1ull << 53);
+  using terrain::mix64;
+  return terrain::unit_double(
+      mix64(mix64(mix64(seed) ^ static_cast<std::uint64_t>(i)) ^ static_cast<std::uint64_t>(j)));
 }
 
 double value_noise(double x, double y, unsigned long long seed) {
   const double fx = std::floor(x), fy = std::floor(y);
   const long i = static_cast<long>(fx), j = static_cast<long>(fy);
   double tx = x - fx, ty = y - fy;
-  tx = tx * tx * (3 - 2 * tx);
+  tx = tx * tx * (3 - 2 * tx);  // smoothstep: no creases at lattice lines
   ty = ty * ty * (3 - 2 * ty);
-  const double a = lattice(i, j, seed), b = lattice(i + 1, j, seed), c = lattice(i, j + 1, seed),
-               d = lattice(i + 1, j + 1, seed);
-  return (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
+  return terrain::bilinear_blend(lattice(i, j, seed), lattice(i + 1, j, seed),
+                                 lattice(i, j + 1, seed), lattice(i + 1, j + 1, seed), tx, ty);
 }
 
 void voxelise_heights(const terrain::HeightField& heights, SoilState& s) {
@@ -115,7 +112,14 @@ SoilSimulation make_simulation(const SoilScenario& sc) {
   for (const SoilBody& s : sc.soil) {
     RigidObject probe{s.name, s.primitives, {}};
     validate(probe, "soil body");
-    add_soil(state, s.primitives, s.position);
+    Eigen::Vector3d at = s.position;
+    if (s.on_ground && sc.terrain.kind == TerrainSource::Kind::HeightField) {
+      const auto& hf = sc.terrain.heights;
+      const double col = (at.x() - g.origin.x()) / g.voxel_size - 0.5;
+      const double row = hf.height() - (at.y() - g.origin.y()) / g.voxel_size - 0.5;
+      at.z() += terrain::bilinear_clamped(hf, col, row);
+    }
+    add_soil(state, s.primitives, at);
   }
   std::vector<RigidObject> moving;
   for (const RigidObject& b : sc.bodies)
