@@ -70,6 +70,10 @@ TEST(MarksDrag, NothingIsSentBackwards) {
   const auto h = drag(Motion::Sweep);
   for (int r = 0; r < kHeight; ++r)
     for (int c = 0; c < kStart - 6 - 2; ++c) EXPECT_LE(h(c, r), 1.0 + 1e-12) << c << "," << r;
+  // Nothing falls back into the trough behind the ball: its floor stays at the
+  // ball's bottom (the pressed start, where the rim slumps in, aside).
+  for (int c = kStart + 8; c <= kStart + kSteps * kStride - 8; ++c)
+    EXPECT_LE(h(c, kRow), 1.0 - 0.99 * kDepth) << "trough floor, column " << c;
   // The material goes ahead: a mound in front of the ball's last position.
   double front = 0;
   for (int c = kStart + kSteps * kStride; c < kWidth; ++c) front = std::max(front, h(c, kRow) - 1.0);
