@@ -56,12 +56,27 @@ struct SlopeRelaxReport {
   double moved = 0.0;  // sum of the heights moved (m), for reports
 };
 
+// Scratch space sized to a grid, kept between calls so that a call costs what
+// it touches, not the grid's size.
+class SlopeRelaxWorkspace {
+ public:
+  void fit(std::size_t cells);
+
+ private:
+  friend struct SlopeRelaxPass;
+  std::vector<std::uint32_t> seen_;  // per cell: the last epoch that listed it
+  std::vector<double> in_;           // per cell: material offered to it this pass
+  std::vector<double> in_excess_;    // per cell: the largest excess it is offered from
+  std::uint32_t epoch_ = 0;
+};
+
 // Relaxes `heights` starting from the cells in `active` (flat indices, any order,
-// duplicates allowed). On return `moved_cells` lists, sorted and unique, every
-// cell whose height changed. `disturbed` (optional) accumulates |change| per cell.
+// duplicates allowed). On return `moved_cells` lists, unique, every cell whose
+// height changed. `disturbed` (optional) accumulates |change| per cell.
 SlopeRelaxReport relax_slopes(Grid<double>& heights, std::vector<int> active,
                               const SlopeCells& cells, const SlopeRelaxOptions& options,
-                              std::vector<int>& moved_cells, Grid<float>* disturbed = nullptr);
+                              std::vector<int>& moved_cells, Grid<float>* disturbed = nullptr,
+                              SlopeRelaxWorkspace* workspace = nullptr);
 
 // Largest excess of a neighbour slope over its rule, in metres of height, among
 // the pairs whose higher cell is in `cells` (flat indices; empty: the whole grid)

@@ -48,6 +48,7 @@ struct MarksSimulation::Impl {
   terrain::Grid<int> expiry;         // step until which a cell is remembered (3.5)
   std::vector<int> remembered;       // the cells with expiry >= the current step
   std::vector<BottomMap> last;       // each object's last bottom in this step
+  terrain::SlopeRelaxWorkspace workspace;
 
   explicit Impl(MarksSimulation& s) : sim(s) {}
 
@@ -76,7 +77,7 @@ struct MarksSimulation::Impl {
                                  sim.options_.erosion_passes};
     std::vector<int> moved;
     terrain::relax_slopes(sim.heights_, std::move(seeds), cells, o, moved,
-                          sim.options_.track_disturbed ? &sim.disturbed_ : nullptr);
+                          sim.options_.track_disturbed ? &sim.disturbed_ : nullptr, &workspace);
     remember(moved);
   }
   void claim_material(const CellWindow& w, const MarkObject& object) {
