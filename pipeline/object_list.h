@@ -26,12 +26,12 @@ using ObjectKeys = std::function<void(Section& entry, std::size_t index)>;
 // Reads root's [[objects]] (none: empty). Meshes are loaded, scaled and rotated;
 // errors name the file, the line and the key. `extra` reads further keys of
 // each entry; any key neither reads is an error.
-std::vector<render::PlacedMesh> read_objects(const toml::table& root,
+std::vector<terrain::PlacedMesh> read_objects(const toml::table& root,
                                              const std::filesystem::path& file,
                                              const ObjectKeys& extra = {});
 
 // A TOML file holding only [[objects]] entries.
-std::vector<render::PlacedMesh> read_objects_file(const std::filesystem::path& path);
+std::vector<terrain::PlacedMesh> read_objects_file(const std::filesystem::path& path);
 
 // Throws drift::Error if `raster` (read from `path`) is in a geographic CRS
 // (degrees), telling the user to run drift import first.

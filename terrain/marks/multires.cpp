@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "terrain/bilinear.h"
 #include "terrain/marks/displacement.h"
 #include "terrain/slope_relax.h"
 
@@ -42,16 +43,6 @@ Coarse coarsen(const terrain::Grid<double>& h, const MaterialField& m, const Cel
   return c;
 }
 
-double bilinear_clamped(const terrain::Grid<double>& g, double u, double v) {
-  u = std::clamp(u, 0.0, g.width() - 1.0), v = std::clamp(v, 0.0, g.height() - 1.0);
-  const int i = std::min(static_cast<int>(u), g.width() - 2 < 0 ? 0 : g.width() - 2);
-  const int j = std::min(static_cast<int>(v), g.height() - 2 < 0 ? 0 : g.height() - 2);
-  const double fu = u - i, fv = v - j;
-  const int i1 = std::min(i + 1, g.width() - 1), j1 = std::min(j + 1, g.height() - 1);
-  return (1 - fu) * (1 - fv) * g(i, j) + fu * (1 - fv) * g(i1, j) + (1 - fu) * fv * g(i, j1) +
-         fu * fv * g(i1, j1);
-}
-
 // Adds the coarse change, interpolated, to the fine cells around where it changed.
 void write_back(terrain::Grid<double>& h, const terrain::Grid<double>& delta, const CellWindow& w,
                 int level, CoarseResult& r, terrain::Grid<float>* disturbed) {
@@ -63,9 +54,12 @@ void write_back(terrain::Grid<double>& h, const terrain::Grid<double>& delta, co
   const int x0 = w.col0 + std::max(i0 - 1, 0) * level, x1 = w.col0 + std::min(i1 + 2, delta.width()) * level;
   const int y0 = w.row0 + std::max(j0 - 1, 0) * level, y1 = w.row0 + std::min(j1 + 2, delta.height()) * level;
   const double centre = 0.5 * (level - 1);  // fine offset of a block's centre
+  const auto at = [&](int i, int j) { return delta(i, j); };
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) {
-      const double add = bilinear_clamped(delta, (x - w.col0 - centre) / level, (y - w.row0 - centre) / level);
+      const double add = terrain::bilinear_clamped(at, delta.width(), delta.height(),
+                                                    (x - w.col0 - centre) / level,
+                                                    (y - w.row0 - centre) / level);
       if (add == 0.0) continue;
       h(x, y) += add;
       r.changed.push_back(y * h.width() + x);

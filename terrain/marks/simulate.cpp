@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "terrain/bilinear.h"
 #include "terrain/error.h"
 #include "terrain/marks/marks.h"
 
@@ -12,14 +13,7 @@ namespace {
 // The ground's height under a point (bilinear between cell centres, clamped at
 // the edges), for objects that follow the ground.
 double ground_under(const terrain::HeightField& g, const GridFrame& f, double x, double y) {
-  const double u = std::clamp((x - f.x0) / f.dx, 0.0, g.width() - 1.0);
-  const double v = std::clamp((f.y0 - y) / f.dy, 0.0, g.height() - 1.0);
-  const int i = std::min(static_cast<int>(u), std::max(g.width() - 2, 0));
-  const int j = std::min(static_cast<int>(v), std::max(g.height() - 2, 0));
-  const int i1 = std::min(i + 1, g.width() - 1), j1 = std::min(j + 1, g.height() - 1);
-  const double a = u - i, b = v - j;
-  return (1 - a) * (1 - b) * g(i, j) + a * (1 - b) * g(i1, j) + (1 - a) * b * g(i, j1) +
-         a * b * g(i1, j1);
+  return terrain::bilinear_clamped(g, (x - f.x0) / f.dx, (f.y0 - y) / f.dy);
 }
 
 void validate_objects(const std::vector<MarkObject>& objects) {
