@@ -144,6 +144,14 @@ def foot():
     return sole(inside, bottom, -0.135, 0.125, -0.05, 0.05, 0.0025, 0.06)
 
 
+def mirrored(o):
+    """The mirror image across the x-z plane (a left foot from a right one)."""
+    m = Obj()
+    m.v = [(x, -y, z) for x, y, z in o.v]
+    m.f = [(a, c, b) for a, b, c in o.f]  # mirroring turns faces inside out
+    return m
+
+
 def tyre():
     """A 66 cm tyre, 20 cm wide, axle along y, origin at its centre, with
     transverse tread blocks 12 mm deep in two staggered rows."""
@@ -230,6 +238,7 @@ if __name__ == "__main__":
     os.makedirs(OUT, exist_ok=True)
     shoe().write("shoe.obj", "shoe sole with chevron tread, 28 cm, x forward, origin under the sole")
     foot().write("foot.obj", "bare right foot, 26 cm, x forward, origin under the sole")
+    mirrored(foot()).write("foot_left.obj", "bare left foot, 26 cm, x forward, origin under the sole")
     tyre().write("tyre.obj", "treaded tyre, 66 cm, axle along y, origin at the centre")
     ball().write("ball.obj", "ball, 20 cm, origin at the centre")
     for w in ("SAND", "MUD", "SNOW"):
