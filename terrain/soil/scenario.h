@@ -31,6 +31,9 @@ struct SoilBody {
   std::string name;
   std::vector<Primitive> primitives;
   Eigen::Vector3d position{0, 0, 0};
+  // With a height-field terrain: position.z is above the ground under
+  // (position.x, position.y) rather than above the grid's origin.
+  bool on_ground = false;
 };
 
 struct SoilScenario {
