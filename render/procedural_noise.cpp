@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "render/random.h"
+#include "terrain/hash.h"
 
 namespace drift::render {
 
@@ -11,7 +11,7 @@ namespace {
 
 // Lattice value in [-1, 1] of cell (i, j).
 float lattice(std::int64_t i, std::int64_t j, std::uint64_t seed) {
-  const std::uint64_t h = mix64(mix64(seed ^ static_cast<std::uint64_t>(i)) ^
+  const std::uint64_t h = terrain::mix64(terrain::mix64(seed ^ static_cast<std::uint64_t>(i)) ^
                                 (static_cast<std::uint64_t>(j) * 0x9e3779b97f4a7c15ULL));
   return static_cast<float>(h >> 40) * (2.0f / 16777216.0f) - 1.0f;
 }
