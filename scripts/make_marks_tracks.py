@@ -57,7 +57,7 @@ def tyres(path):
 
 if __name__ == "__main__":
     walk("marks_walk_ripples.toml",
-         "Bare footprints across wind ripples (paper 000, fig. 13): six steps east,\n"
+         "Bare footprints across wind ripples (paper 000, fig. 13): five steps east,\n"
          "# across the crests of a ripple field from drift dunes (wind from the west).",
-         "sand", 0.6, -1.92, 6, 1.1, 0.05, 0.012)
+         "sand", 0.45, -1.54, 5, 1.2, 0.05, 0.02)
     tyres("marks_tyres.toml")

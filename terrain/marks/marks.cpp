@@ -25,6 +25,21 @@ std::optional<Eigen::Vector2d> drag_direction(const Eigen::Vector3d& d, const Gr
   return cells;
 }
 
+// How the object's lowest point moves from pose a to pose b: the motion of
+// the object where it meets the ground. A sliding object drags the ground
+// with it; a rolling wheel's lowest point barely moves, so it presses.
+Eigen::Vector3d contact_motion(const ObjectShape& shape, const Pose& a, const Pose& b) {
+  const Eigen::Matrix3d ra = a.rotation.toRotationMatrix(), rb = b.rotation.toRotationMatrix();
+  std::size_t lowest = 0;
+  double z = kInf;
+  for (std::size_t i = 0; i < shape.mesh.positions.size(); ++i) {
+    const double zi = (rb * shape.mesh.positions[i].cast<double>()).z();
+    if (zi < z) z = zi, lowest = i;
+  }
+  const Eigen::Vector3d p = shape.mesh.positions[lowest].cast<double>();
+  return (b.position + rb * p) - (a.position + ra * p);
+}
+
 }  // namespace
 
 void MarksOptions::validate() const {
@@ -177,7 +192,7 @@ StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& obj
     const bool sweep = !first && object.motion == Motion::Sweep;
     const CellTriangles tris = sweep ? swept_triangles(shape, a.position, b, frame_)
                                      : posed_triangles(shape, b, frame_);
-    const auto drag = first ? std::nullopt : drag_direction(b.position - a.position, frame_);
+    const auto drag = first ? std::nullopt : drag_direction(contact_motion(shape, a, b), frame_);
     if (level == 1) {
       last = impl_->deform(tris, object, drag, report);
     } else {
