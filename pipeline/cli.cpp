@@ -25,6 +25,17 @@ CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::s
   return sub;
 }
 
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
+                         std::function<void(const CLI::App&)> run) {
+  // The App exists only once add_subcommand returns: the action finds it
+  // through a slot filled in afterwards.
+  auto self = std::make_shared<CLI::App*>(nullptr);
+  CLI::App* sub =
+      add_subcommand(parent, name, description, [self, run = std::move(run)] { run(**self); });
+  *self = sub;
+  return sub;
+}
+
 CLI::App& command_group(CLI::App& root, const std::string& name, const std::string& description) {
   for (CLI::App* existing : root.get_subcommands({})) {
     if (existing->get_name() == name) return *existing;

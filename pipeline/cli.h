@@ -22,6 +22,10 @@ namespace drift::pipeline {
 // called (with TBB limited to N threads when N > 0) once its options are parsed.
 CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
                          std::function<void()> run);
+// The same for an action that reads its own App (e.g. to ask whether a flag
+// was given): `run` receives the subcommand.
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
+                         std::function<void(const CLI::App&)> run);
 
 // A group of subcommands such as `drift snow cover` / `drift snow fall`: returns
 // the group `name` under `root`, creating it on first use.

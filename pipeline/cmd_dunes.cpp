@@ -77,11 +77,9 @@ void run_dunes(const DunesCommand& c, const CLI::App& sub) {
 
 void add_dunes_command(CLI::App& root) {
   auto c = std::make_shared<DunesCommand>();
-  auto self = std::make_shared<CLI::App*>(nullptr);
   CLI::App* sub = add_subcommand(
       root, "dunes", "wind ripples or dunes by saltation, creep and avalanching (Nishimori-Ouchi)",
-      [c, self] { run_dunes(*c, **self); });
-  *self = sub;
+      [c](const CLI::App& self) { run_dunes(*c, self); });
   dunes::SandOptions& o = c->given;
   sub->footer(
       "Defaults (ripples | dunes): --cell 0.015 | 1 m, --height-unit 0.0025 | 0.25 m,\n"

@@ -58,12 +58,10 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
 void add_snow_cover_command(CLI::App& root) {
   CLI::App& group = command_group(root, "snow", "snow stages: cover (descriptor), fall");
   auto c = std::make_shared<CoverCommand>();
-  auto self = std::make_shared<CLI::App*>(nullptr);
   CLI::App* sub = add_subcommand(group, "cover",
                                  "snow-cover descriptor of a DEM (tangent sphere accessibility, "
                                  "altitude, sun aspect; paper 001)",
-                                 [c, self] { run_cover(*c, **self); });
-  *self = sub;
+                                 [c](const CLI::App& self) { run_cover(*c, self); });
   snow::CoverOptions& o = c->options;
   sub->add_option("dem", c->dem, "DEM GeoTIFF in metres (drift import)")->required();
   sub->add_option("-o,--output", c->output, "snow cover GeoTIFF, 1 - t in [0, 1]")->required();
