@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <memory>
 
+#include "terrain/parameter.h"
+
 namespace drift::pipeline {
 
 CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
@@ -48,6 +50,21 @@ CLI::App& command_group(CLI::App& root, const std::string& name, const std::stri
 void add_seed_option(CLI::App& sub, unsigned long long& seed) {
   sub.add_option("--seed", seed, "random seed; the same seed gives the same bits")
       ->capture_default_str();
+}
+
+void validate_flags(const std::function<void()>& validate, const FlagNames& flags, bool usage) {
+  try {
+    validate();
+  } catch (const terrain::ParameterError& e) {
+    for (const auto& [field, flag] : flags) {
+      if (field != e.field()) continue;
+      const std::string message = flag + " " + e.problem();
+      if (usage) usage_error(message);
+      throw Error(message);
+    }
+    if (usage) usage_error(e.what());
+    throw;
+  }
 }
 
 void usage_error(const std::string& message) { throw CLI::ValidationError(message); }

@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace CLI {
@@ -33,6 +34,16 @@ CLI::App& command_group(CLI::App& root, const std::string& name, const std::stri
 
 // Adds the standard --seed option (a 64-bit unsigned seed).
 void add_seed_option(CLI::App& sub, unsigned long long& seed);
+
+// The flags that set an options struct's fields, as (field, flag) pairs.
+using FlagNames = std::vector<std::pair<std::string, std::string>>;
+
+// Runs `validate` (an options struct's validate()) and turns a
+// terrain::ParameterError about a field into one about its flag ("--region is
+// 40; it must lie in [1, 32]"): a usage error (exit 2) if `usage`, else a
+// drift::Error (exit 1). Fields without a flag keep the library's message.
+void validate_flags(const std::function<void()>& validate, const FlagNames& flags,
+                    bool usage = true);
 
 // Throws a usage error (exit 2) with `message`, e.g. for incompatible options.
 [[noreturn]] void usage_error(const std::string& message);

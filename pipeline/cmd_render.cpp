@@ -100,7 +100,13 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
     }
   }
   if (o.tile.empty()) return;
-  const auto [index, count] = render::parse_tile(o.tile);
+  std::pair<int, int> tile;
+  try {
+    tile = render::parse_tile(o.tile);
+  } catch (const Error& e) {
+    usage_error(std::string("--") + e.what());
+  }
+  const auto [index, count] = tile;
   const render::RowRange rows = render::tile_rows(scene.settings.height, index, count);
   scene.settings.row_begin = rows.begin;
   scene.settings.row_end = rows.end;

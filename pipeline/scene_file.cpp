@@ -19,6 +19,7 @@
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/mesh_io.h"
+#include "terrain/products.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -427,7 +428,7 @@ void place_snowy_objects(SceneFile& scene) {
   const terrain::Mesh snowy = terrain::read_ply(scene.snow_objects);
   std::vector<terrain::Mesh> parts;
   try {
-    parts = terrain::split_by_attribute(snowy, "object");
+    parts = terrain::split_by_attribute(snowy, terrain::products::kObjectIndex);
   } catch (const Error& e) {
     throw Error("'" + scene.snow_objects.string() + "': " + e.what() +
                 " (write it with drift snow fall --mesh-out)");
@@ -438,7 +439,7 @@ void place_snowy_objects(SceneFile& scene) {
                 "; give the scene the objects file drift snow fall was given");
   }
   for (std::size_t o = 0; o < parts.size(); ++o) {
-    const std::vector<float>* cover = parts[o].attribute("snow_coverage");
+    const std::vector<float>* cover = parts[o].attribute(terrain::products::kSnowCoverage);
     meshes[o].position = parts[o].origin;
     meshes[o].snow_coverage = cover ? *cover : std::vector<float>{};
     meshes[o].mesh = std::move(parts[o]);

@@ -14,6 +14,7 @@
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/parameter.h"
 
 namespace drift::snow {
 
@@ -143,13 +144,7 @@ HeightField tangent_sphere_accessibility(const HeightField& dem) {
 namespace {
 
 void check_cover_input(const HeightField& dem, const CoverOptions& o) {
-  require(o.region >= 1 && o.region <= 32, "--region must be 1..32 cells");
-  require(o.iterations >= 0 && o.iterations <= 100, "--iterations must be 0..100");
-  require(o.floor >= 0.0 && o.floor <= 1.0, "--floor must lie in [0, 1]");
-  require(o.sun_range_deg >= 0.0 && o.sun_range_deg <= 90.0, "--sun-range must lie in [0, 90]");
-  require(o.radius_m >= 0.0 && std::isfinite(o.radius_m), "--radius must be positive (metres)");
-  require(o.radius_cells > 0.0, "--radius-cells must be positive");
-  require(o.band_m > 0.0, "--band must be positive (metres)");
+  o.validate();
   require(dem.width() >= 3 && dem.height() >= 3, "the DEM must be at least 3 x 3 cells");
   require(dem.geo().north_up() && dem.geo().cell_size_x() > 0 && dem.geo().cell_size_y() > 0,
           "the DEM must be north-up with positive cell sizes; warp it with drift import");
@@ -244,6 +239,18 @@ HeightField sun_correction(const HeightField& smoothed, const HeightField& t, do
 }
 
 }  // namespace
+
+void CoverOptions::validate() const {
+  terrain::require_in("region", region, 1, 32, "cells");
+  terrain::require_in("iterations", iterations, 0, 100);
+  terrain::require_in("floor", floor, 0.0, 1.0);
+  terrain::require_in("sun_range_deg", sun_range_deg, 0.0, 90.0, "degrees");
+  terrain::require_field(radius_m >= 0.0 && std::isfinite(radius_m), "radius_m", radius_m,
+                         "[0, inf) m (0: radius_cells)");
+  terrain::require_field(radius_cells > 0.0 && std::isfinite(radius_cells), "radius_cells",
+                         radius_cells, "(0, inf)");
+  terrain::require_field(band_m > 0.0 && std::isfinite(band_m), "band_m", band_m, "(0, inf) m");
+}
 
 CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {
   check_cover_input(dem, o);

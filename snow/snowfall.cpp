@@ -11,17 +11,16 @@
 #include "snow/stabilise_mesh.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
+#include "terrain/parameter.h"
+#include "terrain/products.h"
 
 namespace drift::snow {
 
 namespace {
 
-void check(bool ok, const char* name, double value, const char* range) {
-  if (ok) return;
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", value);
-  throw Error(std::string("snowfall parameter '") + name + "' is " + buf + "; it must lie in " +
-              range);
+// The one idiom of options structs (terrain/parameter.h).
+void check(bool ok, const char* field, double value, const char* range) {
+  terrain::require_field(ok, field, value, range);
 }
 
 // Snow on one object: the polygon variant.
@@ -147,33 +146,36 @@ void write_snowy_objects(const SnowScene& scene, const std::vector<ObjectSnow>& 
     for (auto t : m.triangles)
       result.objects.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   }
-  result.objects.vertex_attributes = {{"snow_depth", std::move(a_depth)},
-                                      {"snow_probability", std::move(a_prob)},
-                                      {"snow_coverage", std::move(a_cover)},
-                                      {"snow_adhesion", std::move(a_adhesion)},
-                                      {"object", std::move(a_object)}};
+  namespace products = terrain::products;
+  result.objects.vertex_attributes = {{products::kSnowDepth, std::move(a_depth)},
+                                      {products::kSnowProbability, std::move(a_prob)},
+                                      {products::kSnowCoverage, std::move(a_cover)},
+                                      {products::kSnowAdhesion, std::move(a_adhesion)},
+                                      {products::kObjectIndex, std::move(a_object)}};
 }
 
 }  // namespace
 
 void SnowfallOptions::validate() const {
-  check(azimuth_deg >= 0 && azimuth_deg <= 360, "azimuth", azimuth_deg, "[0, 360]");
-  check(elevation_deg > 0 && elevation_deg <= 90, "elevation", elevation_deg, "(0, 90]");
-  check(spread_deg >= 0 && spread_deg <= 30, "spread", spread_deg, "[0, 30]");
+  check(azimuth_deg >= 0 && azimuth_deg <= 360, "azimuth_deg", azimuth_deg, "[0, 360]");
+  check(elevation_deg > 0 && elevation_deg <= 90, "elevation_deg", elevation_deg, "(0, 90]");
+  check(spread_deg >= 0 && spread_deg <= 30, "spread_deg", spread_deg, "[0, 30]");
   check(maps >= 1 && maps <= 1024, "maps", maps, "[1, 1024]");
-  check(rate_m_per_h > 0 && rate_m_per_h <= 10, "rate", rate_m_per_h, "(0, 10] m/h");
+  check(rate_m_per_h > 0 && rate_m_per_h <= 10, "rate_m_per_h", rate_m_per_h, "(0, 10] m/h");
   check(hours > 0 && hours <= 1e4, "hours", hours, "(0, 10000]");
-  check(repose_deg > 0 && repose_deg < 90, "repose", repose_deg, "(0, 90)");
+  check(repose_deg > 0 && repose_deg < 90, "repose_deg", repose_deg, "(0, 90)");
   check(mesh_max_edge >= 0 && std::isfinite(mesh_max_edge), "mesh_max_edge", mesh_max_edge,
         "[0, inf) m (0 keeps the meshes)");
-  check(occlusion.object_texel >= 0 && std::isfinite(occlusion.object_texel), "object_texel",
-        occlusion.object_texel, "[0, inf) m (0 = automatic)");
-  check(coverage.thin_depth > 0 && coverage.thin_depth <= 10, "thin_depth", coverage.thin_depth,
-        "(0, 10] m");
-  check(coverage.adhesion >= 0 && coverage.adhesion <= 1, "adhesion", coverage.adhesion, "[0, 1]");
-  check(coverage.adhesion_min_slope >= 0 && coverage.adhesion_min_slope < 90, "adhesion_min_slope",
-        coverage.adhesion_min_slope, "[0, 90)");
-  check(coverage.adhesion_depth > 0, "adhesion_depth", coverage.adhesion_depth, "(0, inf) m");
+  check(occlusion.object_texel >= 0 && std::isfinite(occlusion.object_texel),
+        "occlusion.object_texel", occlusion.object_texel, "[0, inf) m (0 = automatic)");
+  check(coverage.thin_depth > 0 && coverage.thin_depth <= 10, "coverage.thin_depth",
+        coverage.thin_depth, "(0, 10] m");
+  check(coverage.adhesion >= 0 && coverage.adhesion <= 1, "coverage.adhesion", coverage.adhesion,
+        "[0, 1]");
+  check(coverage.adhesion_min_slope >= 0 && coverage.adhesion_min_slope < 90,
+        "coverage.adhesion_min_slope", coverage.adhesion_min_slope, "[0, 90)");
+  check(coverage.adhesion_depth > 0, "coverage.adhesion_depth", coverage.adhesion_depth,
+        "(0, inf) m");
   check(tolerance > 0, "tolerance", tolerance, "(0, inf) m");
   check(max_iterations >= 1, "max_iterations", max_iterations, "[1, inf)");
 }

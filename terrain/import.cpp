@@ -11,6 +11,7 @@
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
+#include "terrain/parameter.h"
 #include "terrain/raster_io.h"
 
 namespace drift::terrain {
@@ -143,7 +144,6 @@ WarpPlan plan_warp(const fs::path& path, const RasterHeader& header, const Impor
     if (plan.has_crs) plan.args.insert(plan.args.end(), {"-te_srs", header.geo.crs_wkt});
   } else if (o.crop_lonlat) {
     const auto& b = *o.crop_lonlat;
-    if (!(b[0] < b[2] && b[1] < b[3])) throw Error("--crop-lonlat needs W < E and S < N");
     plan.args.insert(plan.args.end(),
                      {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3]), "-te_srs", "EPSG:4326"});
   }
@@ -190,14 +190,23 @@ HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const Impor
 
 }  // namespace
 
+void ImportOptions::validate() const {
+  if (crop && crop_lonlat)
+    throw ParameterError("crop_lonlat", "and crop are both given; give one, not both");
+  if (resample_m) {
+    require_field(*resample_m > 0 && std::isfinite(*resample_m), "resample_m", *resample_m,
+                  "(0, inf) m, a cell size");
+  }
+  require_field(exaggeration > 0 && exaggeration <= 100, "exaggeration", exaggeration, "(0, 100]");
+  if (crop_lonlat) {
+    const auto& b = *crop_lonlat;
+    if (!(b[0] < b[2] && b[1] < b[3]))
+      throw ParameterError("crop_lonlat", "needs west < east and south < north");
+  }
+}
+
 ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
-  if (o.crop && o.crop_lonlat) throw Error("give --crop or --crop-lonlat, not both");
-  if (o.resample_m && !(*o.resample_m > 0 && std::isfinite(*o.resample_m))) {
-    throw Error("--resample must be a positive cell size in metres");
-  }
-  if (!(o.exaggeration > 0 && o.exaggeration <= 100)) {
-    throw Error("--exaggerate must lie in (0, 100], got " + fmt(o.exaggeration));
-  }
+  o.validate();
   const RasterHeader header = read_raster_header(path);  // clear errors for bad files
   ImportResult result;
   result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
@@ -206,7 +215,7 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   // The warped grid covers at most about the source's area at `cell`: check it fits.
   const double src_area_cells = static_cast<double>(header.width) * header.height;
   require_memory(static_cast<std::uint64_t>(src_area_cells * 4.0 * 6.0),
-                 "importing '" + path.string() + "'", "crop it with --crop-lonlat first");
+                 "importing '" + path.string() + "'", "crop it first (a lon/lat crop box)");
   result.grid = warp_to_grid(path, plan, o);
   result.report.push_back("grid " + std::to_string(result.grid.width()) + " x " +
                           std::to_string(result.grid.height()) + " cells of " + fmt(plan.cell) +
