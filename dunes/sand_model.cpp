@@ -13,7 +13,7 @@
 #include "dunes/height_range.h"
 #include "dunes/lattice.h"
 #include "dunes/sand_parameters.h"
-#include "dunes/tiles.h"
+#include "dunes/sweep_tiles.h"
 #include "dunes/wind_frame.h"
 #include "terrain/error.h"
 #include "terrain/hash.h"
@@ -183,11 +183,11 @@ DRIFT_SIMD_KERNEL void flights_kernel(const float* __restrict c, int n, float be
     const float along = length * per_cell;
     const float positive = along > 0.0f ? along : 0.0f;
     const float bounded = positive < max_columns ? positive : max_columns;
-    const float to_shadow = static_cast<float>(s >> 1);
+    const float to_shadow = static_cast<float>(columns_to_shadow(s));
     const float columns = bounded < to_shadow ? bounded : to_shadow;
     // Times 1 or 0 (lifts are >= 0, so exact; GCC vectorises it, unlike a
     // select).
-    const float lifted = lift * static_cast<float>(~s & 1) * recovery[x];
+    const float lifted = lift * static_cast<float>(lit(s)) * recovery[x];
     const int whole = static_cast<int>(columns);
     land[x] = x + whole;
     part[x] = lifted;
