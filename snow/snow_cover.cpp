@@ -14,6 +14,7 @@
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/parameter.h"
 
 namespace drift::snow {
 
@@ -160,15 +161,7 @@ HeightField tangent_sphere_accessibility(const HeightField& dem) {
 namespace {
 
 void validate(const HeightField& dem, const CoverOptions& o) {
-  require(o.region > 0.0 && o.region <= 32.0, "--region must lie in (0, 32] (paper's 50 m cells)");
-  require(o.region_cells >= 0 && o.region_cells <= 256, "--region-cells must be 1..256");
-  require(o.iterations >= 0 && o.iterations <= 100, "--iterations must be 0..100");
-  require(o.floor >= 0.0 && o.floor <= 1.0, "--floor must lie in [0, 1]");
-  require(o.sun_range_deg >= 0.0 && o.sun_range_deg <= 90.0, "--sun-range must lie in [0, 90]");
-  require(o.radius_m > 0.0 && std::isfinite(o.radius_m), "--radius must be positive (metres)");
-  require(o.radius_cells >= 0.0 && std::isfinite(o.radius_cells),
-          "--radius-cells must be positive");
-  require(o.band_m > 0.0, "--band must be positive (metres)");
+  o.validate();
   require(dem.width() >= 3 && dem.height() >= 3, "the DEM must be at least 3 x 3 cells");
   require(dem.geo().north_up() && dem.geo().cell_size_x() > 0 && dem.geo().cell_size_y() > 0,
           "the DEM must be north-up with positive cell sizes; warp it with drift import");
@@ -273,6 +266,20 @@ HeightField apply_sun(const HeightField& t, const HeightField& smoothed, const C
 }
 
 }  // namespace
+
+void CoverOptions::validate() const {
+  terrain::require_field(region > 0.0 && region <= 32.0, "region", region,
+                         "(0, 32] (the paper's 50 m cells)");
+  terrain::require_in("region_cells", region_cells, 0, 256, "cells (0: from region)");
+  terrain::require_in("iterations", iterations, 0, 100);
+  terrain::require_in("floor", floor, 0.0, 1.0);
+  terrain::require_in("sun_range_deg", sun_range_deg, 0.0, 90.0, "degrees");
+  terrain::require_field(radius_m > 0.0 && std::isfinite(radius_m), "radius_m", radius_m,
+                         "(0, inf) m");
+  terrain::require_field(radius_cells >= 0.0 && std::isfinite(radius_cells), "radius_cells",
+                         radius_cells, "[0, inf) (0: radius_m)");
+  terrain::require_field(band_m > 0.0 && std::isfinite(band_m), "band_m", band_m, "(0, inf) m");
+}
 
 CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {
   validate(dem, o);
