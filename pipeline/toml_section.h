@@ -38,8 +38,10 @@ inline toml::table parse_toml_file(const std::filesystem::path& path, const char
 // over is reported as unknown (like pbrt's ReportUnused).
 class Section {
  public:
-  Section(const toml::table* table, std::string name, const std::filesystem::path& file)
-      : table_(table), name_(std::move(name)), file_(file) {}
+  // `doc` names the page listing the table's keys, for unknown-key errors.
+  Section(const toml::table* table, std::string name, const std::filesystem::path& file,
+          std::string doc = "docs/rendering.md")
+      : table_(table), name_(std::move(name)), file_(file), doc_(std::move(doc)) {}
 
   double number(const char* key, double fallback, double lo, double hi) {
     const toml::node* node = take(key);
@@ -153,7 +155,7 @@ class Section {
     for (const auto& [k, node] : *table_) {
       if (!used_.count(std::string(k.str()))) {
         throw Error(where(node) + ": unknown key '" + name_ + "." + std::string(k.str()) +
-                    "' (see docs/rendering.md for the keys of [" + name_ + "])");
+                    "' (see " + doc_ + " for the keys of [" + name_ + "])");
       }
     }
   }
@@ -180,6 +182,7 @@ class Section {
   const toml::table* table_;
   std::string name_;
   std::filesystem::path file_;
+  std::string doc_;
   std::set<std::string> used_;
 };
 
