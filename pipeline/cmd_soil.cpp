@@ -22,7 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct SoilCommand {
-  std::string scenario, output, vdb, surface, collision, frames, soil_type, terrain;
+  std::string scenario, output, vdb, surface, collision, frames, soil_type, terrain, ground;
+  int ground_margin = 32;
   int steps = -1, frame_every = 10;
   double phi = NAN, cohesion = NAN, gamma = NAN, moisture = NAN;
   bool no_ridge_fix = false;
@@ -111,6 +112,11 @@ void run_soil(SoilCommand& c) {
     terrain::write_geotiff(top, c.surface, {"top of soil and ground (m)", "m"});
     std::printf("soil: wrote %s\n", c.surface.c_str());
   }
+  if (!c.ground.empty()) {
+    terrain::write_geotiff(soil::ground_raster(sc.shape, sc.terrain.heights, c.ground_margin),
+                           c.ground, {"ground under the soil (m)", "m"});
+    std::printf("soil: wrote %s\n", c.ground.c_str());
+  }
   const double mass1 = sim.state().mass();
   std::printf(
       "soil: %d steps of %dx%dx%d voxels (%.3g m) in %.2f s (%.1f steps/s); soil %.6g -> "
@@ -146,6 +152,11 @@ void add_soil_command(CLI::App& root) {
   sub->add_option("--surface", c->surface,
                   "GeoTIFF of the top of the soil and what it rests on (m), georeferenced");
   sub->add_option("--collision", c->collision, "mesh of the terrain and bodies (iso-0.5 of psi)");
+  sub->add_option("--ground", c->ground,
+                  "GeoTIFF of the ground under the soil (terrain or the grid's floor), widened by "
+                  "--ground-margin columns, in the meshes' frame: a terrain to render them on");
+  sub->add_option("--ground-margin", c->ground_margin, "columns added around the grid")
+      ->capture_default_str();
   sub->add_flag("--no-ridge-fix", c->no_ridge_fix,
                 "extract the raw density (shows the thesis's vertical ridges)");
 }
