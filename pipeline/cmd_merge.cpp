@@ -8,6 +8,7 @@
 #include "render/image_io.h"
 #include "render/tiles.h"
 #include "terrain/error.h"
+#include "terrain/output_set.h"
 
 namespace drift::pipeline {
 
@@ -33,16 +34,15 @@ render::DisplayTransform display_of(const render::Image& frame, const CLI::App& 
 }
 
 void run_merge(const MergeOptions& o, const CLI::App& sub) {
+  std::vector<std::filesystem::path> names(o.tiles.begin(), o.tiles.end());
+  OutputSet outputs({o.outputs.begin(), o.outputs.end()}, names);
   std::vector<render::Image> tiles;
-  std::vector<std::filesystem::path> names;
-  for (const auto& t : o.tiles) {
-    names.emplace_back(t);
-    tiles.push_back(render::read_image(t));
-  }
+  for (const auto& t : names) tiles.push_back(render::read_image(t));
   const render::Image frame = render::merge_tiles(tiles, names);
   tiles.clear();
   const render::DisplayTransform display = display_of(frame, sub, o.exposure);
   for (const auto& f : o.outputs) render::write_image(frame, f, display);
+  outputs.commit();
   std::printf("merged %zu tiles into %dx%d -> ", names.size(), frame.width, frame.height);
   for (const auto& f : o.outputs) std::printf("%s ", f.c_str());
   std::printf("\n");

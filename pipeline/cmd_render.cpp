@@ -12,6 +12,7 @@
 #include "render/renderer.h"
 #include "render/tiles.h"
 #include "terrain/error.h"
+#include "terrain/output_set.h"
 
 namespace drift::pipeline {
 
@@ -104,6 +105,9 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       }
     }
   }
+  std::vector<std::filesystem::path> inputs = scene_inputs(scene);
+  inputs.emplace_back(o.scene);
+  OutputSet outputs(scene.outputs, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
   const render::TerrainScene embree_scene(scene.input);
@@ -121,6 +125,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       {"white_balance",
        scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
   for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
+  outputs.commit();
   if (scene.settings.noise_target > 0.0f) {
     const double mean_spp =
         static_cast<double>(stats.camera_rays) / (static_cast<double>(image.width) * image.height);

@@ -8,6 +8,7 @@
 #include "pipeline/progress_bar.h"
 #include "snow/snow_cover.h"
 #include "terrain/error.h"
+#include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -30,6 +31,7 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
   o.hemisphere = c.hemisphere == "north"   ? snow::Hemisphere::North
                  : c.hemisphere == "south" ? snow::Hemisphere::South
                                            : snow::Hemisphere::Auto;
+  OutputSet outputs({c.output, c.descriptor, c.accessibility}, {c.dem});
   const terrain::HeightField dem = terrain::read_raster(c.dem);
   snow::CoverResult r;
   try {
@@ -45,6 +47,7 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
     terrain::write_geotiff(r.descriptor, c.descriptor, {"snow descriptor t (0 snow, 1 rock)", ""});
   if (!c.accessibility.empty())
     terrain::write_geotiff(r.accessibility, c.accessibility, {"tangent sphere accessibility", "m"});
+  outputs.commit();
   double mean = 0;
   for (float v : cover.values()) mean += v;
   std::printf("snow cover: %d x %d cells, mean cover %.3f, sun from the %s -> %s\n", cover.width(),

@@ -452,4 +452,12 @@ void load_scene_terrain(SceneFile& scene) {
   }
 }
 
+std::vector<fs::path> scene_inputs(const SceneFile& scene) {
+  std::vector<fs::path> inputs = {scene.terrain_raster, scene.snow_cover, scene.snow_depth,
+                                  scene.ripples,        scene.albedo_map, scene.snow_objects};
+  inputs.insert(inputs.end(), scene.layer_masks.begin(), scene.layer_masks.end());
+  std::erase_if(inputs, [](const fs::path& p) { return p.empty(); });
+  return inputs;
+}
+
 }  // namespace drift::pipeline

@@ -3,7 +3,6 @@
 #include <gdal_priv.h>
 #include <gdal_utils.h>
 #include <ogr_spatialref.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <memory>
@@ -11,11 +10,14 @@
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
+#include "terrain/raster_dataset.h"
 #include "terrain/raster_io.h"
 
 namespace drift::terrain {
 
 namespace fs = std::filesystem;
+
+std::array<double, 2> metres_per_degree(double lat_deg);
 
 namespace {
 
@@ -23,6 +25,72 @@ std::string fmt(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
+}
+
+// Crop boxes of positive, finite area; lon/lat boxes on the globe.
+void check_crop_boxes(const ImportOptions& o) {
+  if (o.crop) {
+    const auto& b = *o.crop;
+    for (double v : b) {
+      if (!std::isfinite(v)) throw Error("--crop values must be finite numbers, got " + fmt(v));
+    }
+    if (!(b[0] < b[2] && b[1] < b[3])) {
+      throw Error("--crop " + fmt(b[0]) + "," + fmt(b[1]) + "," + fmt(b[2]) + "," + fmt(b[3]) +
+                  " has no area: give xmin,ymin,xmax,ymax with xmin < xmax and ymin < ymax");
+    }
+  }
+  if (o.crop_lonlat) {
+    const auto& b = *o.crop_lonlat;
+    for (double v : b) {
+      if (!std::isfinite(v)) {
+        throw Error("--crop-lonlat values must be finite numbers, got " + fmt(v));
+      }
+    }
+    if (b[1] < -90 || b[3] > 90 || b[0] < -180 || b[2] > 180) {
+      throw Error("--crop-lonlat " + fmt(b[0]) + "," + fmt(b[1]) + "," + fmt(b[2]) + "," +
+                  fmt(b[3]) +
+                  " leaves the globe: longitudes lie in [-180, 180], latitudes in "
+                  "[-90, 90]");
+    }
+    if (!(b[0] < b[2] && b[1] < b[3])) throw Error("--crop-lonlat needs W < E and S < N");
+  }
+}
+
+// Metres per CRS unit along x of a raster kept in its CRS (1 for a local grid).
+double metres_per_unit(const RasterHeader& h) {
+  const double dx = std::fabs(h.geo.cell_size_x());
+  return dx > 0 ? cell_size_metres(h.geo, h.width, h.height)[0] / dx : 1.0;
+}
+
+// The warped grid covers the crop box (or the source) at `cell`: checks it fits
+// in memory three times over (GDAL's grid, ours, the nodata filling's copy)
+// before GDAL allocates it. `unit_m` converts `cell` to metres.
+void require_warp_memory(const RasterHeader& h, const ImportOptions& o, double unit_m, double cell,
+                         const fs::path& path) {
+  const auto metric = cell_size_metres(h.geo, h.width, h.height);
+  double width_m = h.width * metric[0], height_m = h.height * metric[1];
+  if (o.crop) {
+    const auto& b = *o.crop;
+    const double dx = std::fabs(h.geo.cell_size_x()), dy = std::fabs(h.geo.cell_size_y());
+    width_m = (b[2] - b[0]) * (dx > 0 ? metric[0] / dx : 1.0);
+    height_m = (b[3] - b[1]) * (dy > 0 ? metric[1] / dy : 1.0);
+  } else if (o.crop_lonlat) {
+    const auto& b = *o.crop_lonlat;
+    const auto m = metres_per_degree(0.5 * (b[1] + b[3]));
+    width_m = (b[2] - b[0]) * m[0];
+    height_m = (b[3] - b[1]) * m[1];
+  }
+  const double cell_m = cell * unit_m;
+  const double cells = std::ceil(width_m / cell_m) * std::ceil(height_m / cell_m);
+  const double bytes = cells * sizeof(float) * 3.0;
+  const std::string what = "importing '" + path.string() + "' at " + fmt(cell_m) +
+                           " m cells (about " + fmt(std::ceil(width_m / cell_m)) + " x " +
+                           fmt(std::ceil(height_m / cell_m)) + ")";
+  const std::string fix = "crop it (--crop, --crop-lonlat) or give a coarser --resample";
+  if (!(cells < 2.0e9) || !std::isfinite(bytes)) {
+    throw Error(what + " is too large a grid; " + fix);
+  }
+  require_memory(static_cast<std::uint64_t>(bytes), what, fix);
 }
 
 }  // namespace
@@ -97,6 +165,7 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   if (!(o.exaggeration > 0 && o.exaggeration <= 100)) {
     throw Error("--exaggerate must lie in (0, 100], got " + fmt(o.exaggeration));
   }
+  check_crop_boxes(o);
   const RasterHeader header = read_raster_header(path);  // clear errors for bad files
   ImportResult result;
   result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
@@ -108,8 +177,9 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   const bool geographic = has_crs && srs.IsGeographic();
   const bool reproject = geographic && !o.keep_crs;
 
-  std::vector<std::string> args = {"-of",      "GTiff",      "-ot", "Float32",   "-r",
-                                   "bilinear", "-dstnodata", "nan", "-overwrite"};
+  // Warped into memory: no temporary file at all.
+  std::vector<std::string> args = {"-of", "MEM",      "-ot",        "Float32",
+                                   "-r",  "bilinear", "-dstnodata", "nan"};
   double cell = 0.0;
   if (reproject) {
     const auto lonlat = centre_lonlat(header.geo, header.width, header.height);
@@ -142,10 +212,7 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
     args.insert(args.end(),
                 {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3]), "-te_srs", "EPSG:4326"});
   }
-  // The warped grid covers at most about the source's area at `cell`: check it fits.
-  const double src_area_cells = static_cast<double>(header.width) * header.height;
-  require_memory(static_cast<std::uint64_t>(src_area_cells * 4.0 * 6.0),
-                 "importing '" + path.string() + "'", "crop it with --crop-lonlat first");
+  require_warp_memory(header, o, reproject ? 1.0 : metres_per_unit(header), cell, path);
 
   ensure_gdal();
   std::vector<char*> argv;
@@ -157,27 +224,20 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   if (!wopts) throw Error("internal: bad warp options for '" + path.string() + "'");
   GDALDatasetH src = GDALOpen(path.c_str(), GA_ReadOnly);
   if (!src) throw Error("cannot open '" + path.string() + "': " + last_gdal_message());
-  const fs::path temp =
-      fs::temp_directory_path() / ("drift-import-" + std::to_string(getpid()) + ".tif");
   int usage_error = 0;
-  GDALDatasetH dst = GDALWarp(temp.c_str(), nullptr, 1, &src, wopts.get(), &usage_error);
+  GDALDatasetH dst = GDALWarp("", nullptr, 1, &src, wopts.get(), &usage_error);
   GDALClose(src);
   if (!dst) {
-    std::error_code ec;
-    fs::remove(temp, ec);
     throw Error("cannot warp '" + path.string() + "': " + last_gdal_message() +
                 (o.crop || o.crop_lonlat ? " (does the crop box overlap the DEM?)" : ""));
   }
-  GDALClose(dst);
   try {
-    result.grid = read_raster(temp);
+    result.grid = read_dataset(*GDALDataset::FromHandle(dst), path);
   } catch (...) {
-    std::error_code ec;
-    fs::remove(temp, ec);
+    GDALClose(dst);
     throw;
   }
-  std::error_code ec;
-  fs::remove(temp, ec);
+  GDALClose(dst);
   result.report.push_back("grid " + std::to_string(result.grid.width()) + " x " +
                           std::to_string(result.grid.height()) + " cells of " + fmt(cell) +
                           (reproject || !geographic ? " m" : " deg"));

@@ -12,16 +12,14 @@
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
+#include "terrain/input_path.h"
 
 namespace drift::terrain {
 
 namespace fs = std::filesystem;
 
 Mesh read_obj(const fs::path& path, bool y_up) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    throw Error("cannot read mesh '" + path.string() + "': no such file");
-  }
+  check_input_file(path, "mesh");
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
@@ -140,6 +138,7 @@ std::vector<Mesh> split_by_attribute(const Mesh& mesh, const std::string& name) 
 }
 
 Mesh read_ply(const fs::path& path) {
+  check_input_file(path, "mesh");
   std::ifstream f(path, std::ios::binary);
   if (!f) throw Error("cannot read mesh '" + path.string() + "': no such file");
   auto bad = [&](const std::string& what) {

@@ -11,7 +11,9 @@
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
+#include "terrain/input_path.h"
 #include "terrain/memory.h"
+#include "terrain/raster_dataset.h"
 
 namespace drift::terrain {
 
@@ -34,13 +36,7 @@ using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
 
 DatasetPtr open_raster(const fs::path& path) {
   ensure_gdal();
-  std::error_code ec;
-  if (!fs::exists(path, ec)) {
-    throw Error("cannot read '" + path.string() + "': no such file");
-  }
-  if (fs::is_directory(path, ec)) {
-    throw Error("cannot read '" + path.string() + "': it is a directory, not a raster file");
-  }
+  check_input_file(path, "raster");
   g_last_gdal_message.clear();
   auto* ds = static_cast<GDALDataset*>(
       GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
@@ -102,6 +98,11 @@ RasterHeader read_raster_header(const fs::path& path) {
 
 HeightField read_raster(const fs::path& path, const ReadOptions& options) {
   DatasetPtr ds = open_raster(path);
+  return read_dataset(*ds, path, options);
+}
+
+HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadOptions& options) {
+  GDALDataset* ds = &dataset;
   if (options.band < 1 || options.band > ds->GetRasterCount()) {
     throw Error("cannot read band " + std::to_string(options.band) + " of '" + path.string() +
                 "': it has " + std::to_string(ds->GetRasterCount()) + " band(s)");
