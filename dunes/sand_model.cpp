@@ -15,6 +15,7 @@
 #include "dunes/tiles.h"
 #include "dunes/wind_frame.h"
 #include "terrain/error.h"
+#include "terrain/hash.h"
 #include "terrain/memory.h"
 #include "terrain/simd.h"
 
@@ -27,13 +28,6 @@ namespace {
 constexpr int kSweepsPerStep = 4;
 // At the end, relax fully (to a thousandth of a height unit).
 constexpr int kFinalSweeps = 20000;
-
-std::uint64_t mix64(std::uint64_t z) {  // SplitMix64's finaliser
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
 
 void require_range(const char* name, double v, double lo, double hi) {
   if (!std::isfinite(v) || v < lo || v > hi) {
@@ -118,9 +112,9 @@ void validate(const SandOptions& o) {
 terrain::HeightField initial_field(const SandOptions& o) {
   const WindLattice l = wind_lattice(o.wind_from_deg, o.size);
   terrain::HeightField h(l.columns, l.rows, 0.0f, terrain::local_georeference(o.cell_m));
-  const std::uint64_t key = mix64(o.seed);
+  const std::uint64_t key = terrain::mix64(o.seed);
   for (std::size_t i = 0; i < h.size(); ++i) {
-    const double u = static_cast<double>(mix64(key ^ mix64(i)) >> 11) * 0x1.0p-53;
+    const double u = terrain::unit_double(terrain::mix64(key ^ terrain::mix64(i)));
     h.values()[i] = static_cast<float>(u * o.initial_amplitude);
   }
   return h;

@@ -45,11 +45,8 @@ void run_snowfall(SnowfallCommand& c) {
   OutputSet outputs({c.output, c.cover, c.mesh_out}, {c.ground, c.objects});
   const terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);
-  std::vector<snow::SnowObject> objects;
-  if (!c.objects.empty()) {
-    for (auto& placed : read_objects_file(c.objects))
-      objects.push_back({std::move(placed.mesh), placed.position});
-  }
+  const std::vector<terrain::PlacedMesh> objects =
+      c.objects.empty() ? std::vector<terrain::PlacedMesh>{} : read_objects_file(c.objects);
   const snow::SnowfallResult r =
       snow::simulate_snowfall(ground, objects, o, terminal_progress("snow fall"));
 

@@ -1,19 +1,18 @@
 #include "pipeline/object_list.h"
 
-#include <ogr_spatialref.h>
-
 #include <cmath>
 
 #include "pipeline/toml_section.h"
 #include "terrain/error.h"
+#include "terrain/geodesy.h"
 #include "terrain/mesh_io.h"
 
 namespace drift::pipeline {
 
 namespace fs = std::filesystem;
 
-std::vector<render::PlacedMesh> read_objects(const toml::table& root, const fs::path& file) {
-  std::vector<render::PlacedMesh> out;
+std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs::path& file) {
+  std::vector<terrain::PlacedMesh> out;
   if (const toml::node* objects = root.get("objects")) {
     const toml::array* list = objects->as_array();
     if (!list) throw Error(file.string() + ": 'objects' must be an array of tables ([[objects]])");
@@ -28,7 +27,7 @@ std::vector<render::PlacedMesh> read_objects(const toml::table& root, const fs::
       const auto position = obj.vector<3>("position", -1e8, 1e8);
       const double scale = obj.number("scale", 1.0, 1e-6, 1e6);
       const double rotate = obj.number("rotate_z", 0.0, -360.0, 360.0);
-      render::PlacedMesh placed;
+      terrain::PlacedMesh placed;
       placed.albedo = obj.color("color", placed.albedo);
       obj.finish();
       const fs::path mp = fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path)
@@ -48,7 +47,7 @@ std::vector<render::PlacedMesh> read_objects(const toml::table& root, const fs::
   return out;
 }
 
-std::vector<render::PlacedMesh> read_objects_file(const fs::path& path) {
+std::vector<terrain::PlacedMesh> read_objects_file(const fs::path& path) {
   const toml::table root = parse_toml_file(path, "objects file");
   for (const auto& [k, node] : root) {
     if (k.str() != "objects") {
@@ -61,10 +60,7 @@ std::vector<render::PlacedMesh> read_objects_file(const fs::path& path) {
 }
 
 void require_metric_crs(const terrain::HeightField& raster, const fs::path& path) {
-  const std::string& wkt = raster.geo().crs_wkt;
-  if (wkt.empty()) return;
-  OGRSpatialReference srs;
-  if (srs.importFromWkt(wkt.c_str()) == OGRERR_NONE && srs.IsGeographic()) {
+  if (terrain::is_geographic(raster.geo().crs_wkt)) {
     throw Error("raster '" + path.string() +
                 "' is in degrees (geographic CRS); convert it to metres first: drift import " +
                 path.string() + " -o DEM_metric.tif");

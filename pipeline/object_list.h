@@ -17,11 +17,11 @@ namespace drift::pipeline {
 
 // Reads root's [[objects]] (none: empty). Meshes are loaded, scaled and rotated;
 // errors name the file, the line and the key.
-std::vector<render::PlacedMesh> read_objects(const toml::table& root,
-                                             const std::filesystem::path& file);
+std::vector<terrain::PlacedMesh> read_objects(const toml::table& root,
+                                              const std::filesystem::path& file);
 
 // A TOML file holding only [[objects]] entries.
-std::vector<render::PlacedMesh> read_objects_file(const std::filesystem::path& path);
+std::vector<terrain::PlacedMesh> read_objects_file(const std::filesystem::path& path);
 
 // Throws drift::Error if `raster` (read from `path`) is in a geographic CRS
 // (degrees), telling the user to run drift import first.

@@ -373,7 +373,7 @@ void place_sun(SceneFile& scene) {
 // the same objects in the same order, raised by their snow, keeping their
 // colours, with per-vertex snow coverage.
 void place_snowy_objects(SceneFile& scene) {
-  std::vector<render::PlacedMesh>& meshes = scene.input.meshes;
+  std::vector<terrain::PlacedMesh>& meshes = scene.input.meshes;
   const terrain::Mesh snowy = terrain::read_ply(scene.snow_objects);
   std::vector<terrain::Mesh> parts;
   try {

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <string>
 
+#include "terrain/bilinear.h"
 #include "terrain/error.h"
 
 namespace drift::render {
@@ -106,7 +107,7 @@ Spectrum bilinear(const std::vector<Spectrum>& table, int na, int nm, double fa,
   const Spectrum& s10 = table[(a0 + 1) * nm + m0];
   const Spectrum& s11 = table[(a0 + 1) * nm + m0 + 1];
   for (int b = 0; b < kBands; ++b) {
-    out[b] = (1 - ta) * ((1 - tm) * s00[b] + tm * s01[b]) + ta * ((1 - tm) * s10[b] + tm * s11[b]);
+    out[b] = terrain::bilinear_blend(s00[b], s01[b], s10[b], s11[b], tm, ta);
   }
   return out;
 }

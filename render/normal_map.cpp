@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "terrain/bilinear.h"
 #include "terrain/error.h"
 
 namespace drift::render {
@@ -94,8 +95,8 @@ T bilinear(const terrain::Grid<T>& g, double tile_x, double tile_y, double u, do
   // Wrap in double first: u and v may be large (UTM metres).
   const int xi = static_cast<int>(x0 - g.width() * std::floor(x0 / g.width()));
   const int ri = static_cast<int>(r0 - g.height() * std::floor(r0 / g.height()));
-  return (1 - tr) * ((1 - tx) * g.wrapped(xi, ri) + tx * g.wrapped(xi + 1, ri)) +
-         tr * ((1 - tx) * g.wrapped(xi, ri + 1) + tx * g.wrapped(xi + 1, ri + 1));
+  return terrain::bilinear_blend(g.wrapped(xi, ri), g.wrapped(xi + 1, ri), g.wrapped(xi, ri + 1),
+                                 g.wrapped(xi + 1, ri + 1), tx, tr);
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "terrain/bilinear.h"
+
 namespace drift::render {
 
 namespace {
@@ -109,8 +111,8 @@ Eigen::Vector3f PhysicalSky::sky(const Eigen::Vector3f& dir) const {
   const int a0 = std::clamp(static_cast<int>(fa), 0, kSkyAzimuths - 2);
   const float te = std::clamp(fe - e0, 0.0f, 1.0f), ta = std::clamp(fa - a0, 0.0f, 1.0f);
   auto at = [&](int e, int a) { return sky_table_[e * kSkyAzimuths + a]; };
-  return lerp(lerp(at(e0, a0), at(e0, a0 + 1), ta), lerp(at(e0 + 1, a0), at(e0 + 1, a0 + 1), ta),
-              te);
+  return terrain::bilinear_blend(at(e0, a0), at(e0, a0 + 1), at(e0 + 1, a0), at(e0 + 1, a0 + 1), ta,
+                                 te);
 }
 
 AirSegment PhysicalSky::from_camera(const Eigen::Vector3f& dir, float distance) const {

@@ -5,27 +5,18 @@
 
 #include <cstdint>
 
-namespace drift::render {
+#include "terrain/hash.h"
 
-// SplitMix64 finaliser (Steele, Lea & Flood 2014): a strong 64-bit mixer.
-inline std::uint64_t mix64(std::uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
+namespace drift::render {
 
 // The random stream of one pixel sample; next() walks its dimensions.
 class SampleStream {
  public:
   SampleStream(std::uint64_t seed, std::uint64_t pixel, std::uint64_t sample)
-      : key_(mix64(mix64(mix64(seed) ^ pixel) ^ sample)) {}
+      : key_(terrain::mix64(terrain::mix64(terrain::mix64(seed) ^ pixel) ^ sample)) {}
 
   // Uniform in [0, 1), 24 bits so that the float is exact.
-  float next() {
-    const std::uint64_t bits = mix64(key_ ^ dimension_++);
-    return static_cast<float>(bits >> 40) * (1.0f / 16777216.0f);
-  }
+  float next() { return terrain::unit_float(terrain::mix64(key_ ^ dimension_++)); }
 
  private:
   std::uint64_t key_;

@@ -58,16 +58,6 @@ struct Camera {
   std::optional<double> focus_distance;
 };
 
-struct PlacedMesh {
-  terrain::Mesh mesh;  // in its own frame (metres), already rotated and scaled
-  // Where the mesh's origin stands, in the raster's CRS. Kept in double: UTM
-  // coordinates in float would lose half a metre.
-  Eigen::Vector3d position{0, 0, 0};
-  Eigen::Vector3f albedo{0.5f, 0.5f, 0.5f};
-  // Per-vertex snow coverage in [0, 1] (from drift snow fall), or empty.
-  std::vector<float> snow_coverage;
-};
-
 struct RenderSettings {
   int width = 960;
   int height = 540;
@@ -93,7 +83,7 @@ struct SceneInput {
   terrain::HeightField terrain;  // metric CRS (or local), heights in metres
   double vertical_exaggeration = 1.0;
   TerrainSurface surface;  // materials and the layers that place them
-  std::vector<PlacedMesh> meshes;
+  std::vector<terrain::PlacedMesh> meshes;
   Sun sun;
   Sky sky;
   std::optional<Camera> camera;  // none: the default view of the terrain

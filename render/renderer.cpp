@@ -20,6 +20,7 @@
 #include "render/random.h"
 #include "render/sampling.h"
 #include "render/sky_sampler.h"
+#include "terrain/direction.h"
 #include "terrain/error.h"
 
 namespace drift::render {
@@ -28,14 +29,6 @@ namespace {
 
 using Eigen::Vector3f;
 constexpr float kPi = std::numbers::pi_v<float>;
-
-Vector3f direction_from_az_el(double azimuth_deg, double elevation_deg) {
-  const double az = azimuth_deg * std::numbers::pi / 180.0;
-  const double el = elevation_deg * std::numbers::pi / 180.0;
-  return Vector3f(static_cast<float>(std::sin(az) * std::cos(el)),
-                  static_cast<float>(std::cos(az) * std::cos(el)),
-                  static_cast<float>(std::sin(el)));
-}
 
 float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCoeff()); }
 
@@ -178,7 +171,8 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const CameraRays camera_rays = make_camera_rays(scene, camera, settings.width, settings.height);
 
   const Sun& sun = input.sun;
-  const Vector3f sun_dir = direction_from_az_el(sun.azimuth_deg, sun.elevation_deg);
+  const Vector3f sun_dir =
+      terrain::direction_from_az_el(sun.azimuth_deg, sun.elevation_deg).cast<float>();
   const float sun_cos_max =
       static_cast<float>(std::cos(sun.angular_diameter_deg * std::numbers::pi / 360.0));
   const Vector3f sun_irradiance = sun.color * static_cast<float>(sun.irradiance);

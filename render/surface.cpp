@@ -5,6 +5,7 @@
 #include <string>
 
 #include "render/tonemap.h"
+#include "terrain/bilinear.h"
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
 
@@ -22,8 +23,8 @@ float sample_raster(const terrain::HeightField& raster, double x, double y, floa
     const float v = raster.clamped(xx, rr);
     return std::isnan(v) ? outside : v;
   };
-  return (1 - tr) * ((1 - tx) * at(x0, r0) + tx * at(x0 + 1, r0)) +
-         tr * ((1 - tx) * at(x0, r0 + 1) + tx * at(x0 + 1, r0 + 1));
+  return terrain::bilinear_blend(at(x0, r0), at(x0 + 1, r0), at(x0, r0 + 1), at(x0 + 1, r0 + 1), tx,
+                                 tr);
 }
 
 std::array<terrain::HeightField, 3> read_albedo_map(const std::filesystem::path& path) {

@@ -9,8 +9,10 @@
 #include <numbers>
 #include <string>
 
+#include "terrain/bilinear.h"
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
+#include "terrain/local_frame.h"
 #include "terrain/memory.h"
 
 namespace drift::render {
@@ -52,6 +54,27 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
           ? std::optional(add_snow_depth(input.terrain, *input.surface.snow_depth))
           : std::nullopt;
   const terrain::HeightField& dem = snowy ? *snowy : input.terrain;
+  check_terrain(dem);
+  surface_ = input.surface;
+  coverage_ = coverage_channels(surface_);
+  fill_vertices(dem, static_cast<float>(input.vertical_exaggeration));
+
+  embree_->device = rtcNewDevice("threads=0");
+  if (!embree_->device) throw Error("cannot create an Embree device");
+  rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
+  embree_->scene = rtcNewScene(embree_->device);
+  rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
+  attach_terrain_grids();
+  for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
+  rtcCommitScene(embree_->scene);
+  check_device(embree_->device, "build the scene");
+  RTCBounds bounds;
+  rtcGetSceneBounds(embree_->scene, &bounds);
+  bottom_ = bounds.lower_z;
+  top_ = bounds.upper_z;
+}
+
+void TerrainScene::check_terrain(const terrain::HeightField& dem) {
   if (dem.width() < 2 || dem.height() < 2) {
     throw Error("the terrain raster must be at least 2 x 2 cells, got " +
                 std::to_string(dem.width()) + " x " + std::to_string(dem.height()));
@@ -66,31 +89,24 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   if (!(dx_ > 0) || !(dy_ > 0)) {
     throw Error("the terrain raster's cell size must be positive (north-up, metres)");
   }
-  surface_ = input.surface;
-  coverage_ = coverage_channels(surface_);
-  const std::size_t n = dem.size();
   // Vertices and Embree's own grid data (~17.5 B per vertex).
-  require_memory(n * (12 + 20), "the terrain scene", "crop or resample the DEM");
+  require_memory(dem.size() * (12 + 20), "the terrain scene", "crop or resample the DEM");
+}
 
-  // Heights: nodata cells become the lowest valid height.
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  for (float v : dem.values()) {
-    if (!std::isnan(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-  }
-  if (!std::isfinite(lo)) throw Error("the terrain raster holds no valid height (all nodata)");
-  const float k = static_cast<float>(input.vertical_exaggeration);
-  exaggeration_ = k;
+void TerrainScene::fill_vertices(const terrain::HeightField& dem, float k) {
   // Local frame: origin at the DEM's centre (cell centres) and lowest height, so
-  // float coordinates stay small.
-  const auto centre = dem.geo().cell_center((width_ - 1) / 2.0, (height_ - 1) / 2.0);
-  origin_ = Eigen::Vector3d(centre[0], centre[1], static_cast<double>(lo) * k);
-  const auto nw = dem.geo().cell_center(0, 0);
-  const float x0 = static_cast<float>(nw[0] - origin_.x());
-  const float y0 = static_cast<float>(nw[1] - origin_.y());
+  // float coordinates stay small. Nodata cells become the lowest valid height.
+  const terrain::LocalFrame frame = terrain::local_frame(dem, "the terrain raster", k);
+  const float lo = frame.lowest;
+  exaggeration_ = k;
+  origin_ = frame.origin;
+  const float x0 = static_cast<float>(frame.x0);
+  const float y0 = static_cast<float>(frame.y0);
 
   // The vertex buffer is the only copy of the heights the scene keeps: shading
   // normals are computed from it at each hit (vertex_normal), so a DEM costs
   // 12 bytes a vertex here plus Embree's own grid data.
+  const std::size_t n = dem.size();
   vertices_.resize(n);
   const float z0 = static_cast<float>(origin_.z());
   tbb::parallel_for(0, height_, [&](int row) {
@@ -108,15 +124,11 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   highest_ = vertices_[hi_i];
   lowest_ = vertices_[lo_i];
   extent_ = {(width_ - 1) * dx_, (height_ - 1) * dy_};
+}
 
-  embree_->device = rtcNewDevice("threads=0");
-  if (!embree_->device) throw Error("cannot create an Embree device");
-  rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
-  embree_->scene = rtcNewScene(embree_->device);
-  rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
-
-  // Terrain: grids of at most kMaxGridSide vertices a side over one shared
-  // vertex buffer (stride = raster width); neighbours share their edge row.
+void TerrainScene::attach_terrain_grids() {
+  // Grids of at most kMaxGridSide vertices a side over one shared vertex
+  // buffer (stride = raster width); neighbours share their edge row.
   for (int gy = 0; gy < height_ - 1; gy += kMaxGridSide - 1) {
     for (int gx = 0; gx < width_ - 1; gx += kMaxGridSide - 1) {
       RTCGrid g;
@@ -129,7 +141,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   }
   RTCGeometry grid_geometry = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_GRID);
   rtcSetSharedGeometryBuffer(grid_geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                             vertices_.data(), 0, sizeof(Eigen::Vector3f), n);
+                             vertices_.data(), 0, sizeof(Eigen::Vector3f), vertices_.size());
   rtcSetSharedGeometryBuffer(grid_geometry, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
                              embree_->grids.data(), 0, sizeof(RTCGrid), embree_->grids.size());
   rtcCommitGeometry(grid_geometry);
@@ -139,63 +151,50 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   mesh_albedo_.push_back(surface_.ground.albedo);
   mesh_snow_.emplace_back();
   mesh_snow_triangles_.emplace_back();
+}
 
-  // Meshes: triangle geometry with their own (copied, shifted) buffers.
-  for (const PlacedMesh& placed : input.meshes) {
-    RTCGeometry geom = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                          placed.mesh.positions.size()));
-    const Eigen::Vector3d shift = placed.position - origin_;  // CRS -> local
-    for (std::size_t i = 0; i < placed.mesh.positions.size(); ++i) {
-      const Eigen::Vector3d local = placed.mesh.positions[i].cast<double>() + shift;
-      for (int c = 0; c < 3; ++c) v[3 * i + c] = static_cast<float>(local[c]);
-    }
-    auto* idx = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                3 * sizeof(unsigned), placed.mesh.triangles.size()));
-    for (std::size_t t = 0; t < placed.mesh.triangles.size(); ++t) {
-      for (int c = 0; c < 3; ++c)
-        idx[3 * t + c] = static_cast<unsigned>(placed.mesh.triangles[t][c]);
-    }
-    rtcCommitGeometry(geom);
-    const unsigned id = rtcAttachGeometry(embree_->scene, geom);
-    rtcReleaseGeometry(geom);
-    if (mesh_albedo_.size() <= id) {
-      mesh_albedo_.resize(id + 1);
-      mesh_snow_.resize(id + 1);
-      mesh_snow_triangles_.resize(id + 1);
-    }
-    mesh_albedo_[id] = placed.albedo;
-    if (!placed.snow_coverage.empty()) {
-      if (placed.snow_coverage.size() != placed.mesh.positions.size())
-        throw Error("a mesh's snow coverage must have one value per vertex");
-      mesh_snow_[id] = placed.snow_coverage;
-      mesh_snow_triangles_[id] = placed.mesh.triangles;
-    }
+void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
+  // Triangle geometry with its own (copied, shifted) buffers.
+  RTCGeometry geom = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                        RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                        placed.mesh.positions.size()));
+  const Eigen::Vector3d shift = placed.position - origin_;  // CRS -> local
+  for (std::size_t i = 0; i < placed.mesh.positions.size(); ++i) {
+    const Eigen::Vector3d local = placed.mesh.positions[i].cast<double>() + shift;
+    for (int c = 0; c < 3; ++c) v[3 * i + c] = static_cast<float>(local[c]);
   }
-  rtcCommitScene(embree_->scene);
-  check_device(embree_->device, "build the scene");
-  RTCBounds bounds;
-  rtcGetSceneBounds(embree_->scene, &bounds);
-  bottom_ = bounds.lower_z;
-  top_ = bounds.upper_z;
+  auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0,
+                                                             RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                                             placed.mesh.triangles.size()));
+  for (std::size_t t = 0; t < placed.mesh.triangles.size(); ++t) {
+    for (int c = 0; c < 3; ++c) idx[3 * t + c] = static_cast<unsigned>(placed.mesh.triangles[t][c]);
+  }
+  rtcCommitGeometry(geom);
+  const unsigned id = rtcAttachGeometry(embree_->scene, geom);
+  rtcReleaseGeometry(geom);
+  if (mesh_albedo_.size() <= id) {
+    mesh_albedo_.resize(id + 1);
+    mesh_snow_.resize(id + 1);
+    mesh_snow_triangles_.resize(id + 1);
+  }
+  mesh_albedo_[id] = placed.albedo;
+  if (!placed.snow_coverage.empty()) {
+    if (placed.snow_coverage.size() != placed.mesh.positions.size())
+      throw Error("a mesh's snow coverage must have one value per vertex");
+    mesh_snow_[id] = placed.snow_coverage;
+    mesh_snow_triangles_[id] = placed.mesh.triangles;
+  }
 }
 
 TerrainScene::~TerrainScene() = default;
 
 float TerrainScene::height_at(float x, float y) const {
-  const auto nwx = vertices_.front().x(), nwy = vertices_.front().y();
-  const float fx = std::clamp((x - nwx) / dx_, 0.0f, static_cast<float>(width_ - 1));
-  const float fr = std::clamp((nwy - y) / dy_, 0.0f, static_cast<float>(height_ - 1));
-  const int x0 = std::min(static_cast<int>(fx), width_ - 2);
-  const int r0 = std::min(static_cast<int>(fr), height_ - 2);
-  const float tx = fx - x0, tr = fr - r0;
+  const auto nw = vertices_.front();
   auto h = [&](int xx, int rr) {
     return vertices_[static_cast<std::size_t>(rr) * width_ + xx].z();
   };
-  return (1 - tr) * ((1 - tx) * h(x0, r0) + tx * h(x0 + 1, r0)) +
-         tr * ((1 - tx) * h(x0, r0 + 1) + tx * h(x0 + 1, r0 + 1));
+  return terrain::bilinear_clamped(h, width_, height_, (x - nw.x()) / dx_, (nw.y() - y) / dy_);
 }
 
 Eigen::Vector3f TerrainScene::vertex_normal(int x, int row) const {
@@ -227,14 +226,9 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   if (rh.hit.geomID < terrain_geometries_) {
     // Smooth shading: bilinear vertex normals at the hit's cell position.
     const auto nw = vertices_.front();
-    const float fx = std::clamp((hit.position.x() - nw.x()) / dx_, 0.0f, width_ - 1.0f);
-    const float fr = std::clamp((nw.y() - hit.position.y()) / dy_, 0.0f, height_ - 1.0f);
-    const int x0 = std::min(static_cast<int>(fx), width_ - 2);
-    const int r0 = std::min(static_cast<int>(fr), height_ - 2);
-    const float tx = fx - x0, tr = fr - r0;
     auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
-    n = ((1 - tr) * ((1 - tx) * vn(x0, r0) + tx * vn(x0 + 1, r0)) +
-         tr * ((1 - tx) * vn(x0, r0 + 1) + tx * vn(x0 + 1, r0 + 1)))
+    n = terrain::bilinear_clamped(vn, width_, height_, (hit.position.x() - nw.x()) / dx_,
+                                  (nw.y() - hit.position.y()) / dy_)
             .normalized();
     const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
     // Material rules see the real relief: heights and slopes without the

@@ -68,6 +68,14 @@ class TerrainScene {
   float top() const { return top_; }
 
  private:
+  // The constructor's steps: checks the raster's shape and takes its size;
+  // fills the vertex buffer in the local frame; adds the grids over it; adds
+  // one object.
+  void check_terrain(const terrain::HeightField& dem);
+  void fill_vertices(const terrain::HeightField& dem, float vertical_exaggeration);
+  void attach_terrain_grids();
+  void attach_mesh(const terrain::PlacedMesh& placed);
+
   // The unit shading normal at vertex (x, row), from the vertex buffer.
   Eigen::Vector3f vertex_normal(int x, int row) const;
 

@@ -85,15 +85,4 @@ ShadowSurface HorizonSweeper::shadow(const Eigen::Vector3d& toward_source) {
   return out;
 }
 
-float bilinear(const terrain::Grid<float>& g, double col, double row) {
-  const double x = std::clamp(col, 0.0, static_cast<double>(g.width() - 1));
-  const double y = std::clamp(row, 0.0, static_cast<double>(g.height() - 1));
-  const int x0 = std::min(static_cast<int>(x), std::max(g.width() - 2, 0));
-  const int y0 = std::min(static_cast<int>(y), std::max(g.height() - 2, 0));
-  const int x1 = std::min(x0 + 1, g.width() - 1), y1 = std::min(y0 + 1, g.height() - 1);
-  const double tx = x - x0, ty = y - y0;
-  return static_cast<float>((g(x0, y0) * (1 - tx) + g(x1, y0) * tx) * (1 - ty) +
-                            (g(x0, y1) * (1 - tx) + g(x1, y1) * tx) * ty);
-}
-
 }  // namespace drift::snow

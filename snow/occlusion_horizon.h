@@ -11,22 +11,21 @@
 
 #include <Eigen/Core>
 
+#include "terrain/bilinear.h"
 #include "terrain/grid.h"
 
 namespace drift::snow {
 
-// Bilinear value at fractional (col, row) clamped to the grid.
-float bilinear(const terrain::Grid<float>& g, double col, double row);
-
 // S for one direction. When the sweep runs along columns the surface is kept
 // transposed (width = the ground's rows), saving a transposition per direction;
-// read it through at() and bilinear().
+// read it through at() and bilinear_at().
 struct ShadowSurface {
   terrain::Grid<float> s;
   bool transposed = false;
   float at(int col, int row) const { return transposed ? s(row, col) : s(col, row); }
   float bilinear_at(double col, double row) const {
-    return transposed ? bilinear(s, row, col) : bilinear(s, col, row);
+    return transposed ? terrain::bilinear_clamped(s, row, col)
+                      : terrain::bilinear_clamped(s, col, row);
   }
 };
 

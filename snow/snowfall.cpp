@@ -55,7 +55,7 @@ void SnowfallOptions::validate() const {
 }
 
 SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
-                                 const std::vector<SnowObject>& objects,
+                                 const std::vector<terrain::PlacedMesh>& objects,
                                  const SnowfallOptions& options, const ProgressFn& progress) {
   options.validate();
   const ProgressFn report = progress ? progress : ProgressFn(no_progress);

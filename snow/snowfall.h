@@ -76,7 +76,7 @@ struct SnowfallResult {
 };
 
 SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
-                                 const std::vector<SnowObject>& objects,
+                                 const std::vector<terrain::PlacedMesh>& objects,
                                  const SnowfallOptions& options,
                                  const ProgressFn& progress = no_progress);
 

@@ -5,28 +5,25 @@
 #include <numbers>
 #include <string>
 
-#include "render/random.h"  // header-only counter-based RNG shared with the renderer
+#include "terrain/direction.h"
 #include "terrain/error.h"
+#include "terrain/hash.h"
 
 namespace drift::snow {
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kDeg = terrain::kRadiansPerDegree;
 
 double uniform(std::uint64_t seed, std::uint64_t index) {
-  return static_cast<double>(render::mix64(render::mix64(seed) ^ index) >> 11) * 0x1.0p-53;
+  return terrain::unit_double(terrain::mix64(terrain::mix64(seed) ^ index));
 }
 }  // namespace
-
-Eigen::Vector3d direction_from_az_el(double azimuth_deg, double elevation_deg) {
-  const double az = azimuth_deg * kDeg, el = elevation_deg * kDeg;
-  return {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
-}
 
 std::vector<FallDirection> jittered_directions(double azimuth_deg, double elevation_deg,
                                                double spread_deg, int maps, std::uint64_t seed) {
   if (maps < 1) throw Error("the number of snowfall maps must be at least 1");
-  const Eigen::Vector3d mean = direction_from_az_el(azimuth_deg, elevation_deg);
+  // Where the snow comes from, like a sun position.
+  const Eigen::Vector3d mean = terrain::direction_from_az_el(azimuth_deg, elevation_deg);
   std::vector<FallDirection> out(static_cast<std::size_t>(maps));
   if (maps == 1 || spread_deg <= 0.0) {
     for (auto& d : out) d = {mean, 1.0f / static_cast<float>(maps), 0.0};

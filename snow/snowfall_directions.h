@@ -10,10 +10,6 @@
 
 namespace drift::snow {
 
-// Unit vector pointing to where the snow comes from, like a sun position:
-// azimuth clockwise from north, elevation above the horizon; (any, 90) is straight up.
-Eigen::Vector3d direction_from_az_el(double azimuth_deg, double elevation_deg);
-
 struct FallDirection {
   Eigen::Vector3d toward_source;  // unit; snow travels along -toward_source
   float weight = 1.0f;            // normalised: the weights of a set sum to 1 (in float, in order)

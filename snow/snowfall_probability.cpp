@@ -226,8 +226,6 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
 
     // Cells in 64 x 64 blocks: a transposed shadow surface reads well within a block.
     constexpr int B = 64;
-    const float* hgt = scene.ground.data();
-    const double gx_scale = 1.0 / (2.0 * scene.dx), gy_scale = 1.0 / (2.0 * scene.dy);
     tbb::parallel_for(
         tbb::blocked_range2d<int>(0, (H + B - 1) / B, 0, (W + B - 1) / B),
         [&](const tbb::blocked_range2d<int>& blocks) {
@@ -238,16 +236,7 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
                   float lit = 0.0f;
                   double cos_phi;
                   if (!near_object(col, row)) {
-                    // n . w from central differences (the interior case of ground_normal).
-                    if (col > 0 && row > 0 && col < W - 1 && row < H - 1) {
-                      const std::size_t i = static_cast<std::size_t>(row) * W + col;
-                      const double gx = (hgt[i + 1] - hgt[i - 1]) * gx_scale;
-                      const double gy = (hgt[i - W] - hgt[i + W]) * gy_scale;
-                      cos_phi =
-                          (w.z() - gx * w.x() - gy * w.y()) / std::sqrt(1.0 + gx * gx + gy * gy);
-                    } else {
-                      cos_phi = scene.ground_normal(col, row).dot(w);
-                    }
+                    cos_phi = scene.ground_normal(col, row).dot(w);
                     lit = terrain_occluder.cell_lit(col, row, cos_phi) ? 1.0f : 0.0f;
                   } else {
                     const Vector3d n = scene.ground_normal(col, row);
@@ -258,7 +247,7 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
                         const double c = std::clamp(col + (i + 0.5) / K - 0.5, 0.0, W - 1.0);
                         const double r = std::clamp(row + (j + 0.5) / K - 0.5, 0.0, H - 1.0);
                         const Vector3d p(scene.x0 + c * scene.dx, scene.y0 - r * scene.dy,
-                                         bilinear(scene.ground, c, r));
+                                         terrain::bilinear_clamped(scene.ground, c, r));
                         const bool seen = (i * 2 + 1 == K && j * 2 + 1 == K)
                                               ? terrain_occluder.cell_lit(col, row, cos_phi)
                                               : cos_phi > 0 && terrain_occluder.point_lit(p, n);

@@ -11,13 +11,6 @@
 
 namespace drift::snow {
 
-// An object as the scene file places it: the mesh in its own frame (metres,
-// already scaled and rotated) standing at `position` in the raster's CRS.
-struct SnowObject {
-  terrain::Mesh mesh;
-  Eigen::Vector3d position{0, 0, 0};
-};
-
 struct SnowScene {
   terrain::Grid<float> ground;        // local heights; nodata filled with the lowest height
   double x0 = 0, y0 = 0;              // local position of the centre of cell (0, 0)
@@ -31,7 +24,9 @@ struct SnowScene {
   Eigen::Vector3d cell_point(int col, int row) const {
     return {x0 + col * dx, y0 - row * dy, ground(col, row)};
   }
-  // Unit normal by central differences (one-sided at the edges).
+  // Gradient and unit normal of the ground by central differences (one-sided
+  // at the edges; terrain/derivatives.h).
+  Eigen::Vector2d ground_gradient(int col, int row) const;
   Eigen::Vector3d ground_normal(int col, int row) const;
 };
 
@@ -39,6 +34,6 @@ struct SnowScene {
 // smaller than 2 x 2, or all nodata. Object meshes are refined to max_edge (m;
 // 0 keeps them).
 SnowScene make_snow_scene(const terrain::HeightField& ground,
-                          const std::vector<SnowObject>& objects, double max_edge);
+                          const std::vector<terrain::PlacedMesh>& objects, double max_edge);
 
 }  // namespace drift::snow

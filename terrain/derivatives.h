@@ -43,6 +43,26 @@ template <class HeightAt>
 Gradient horn_gradient(const HeightAt& z_at, int width, int height, float ew, float ns, int x,
                        int row);
 
+// Central differences at cell (x, row) of a `width` x `height` grid read
+// through `z_at(x, row)`, cells `ew` by `ns` metres: (dz/dx east, dz/dy north),
+// one-sided at the border. The snowfall's ground normals (paper 003 needs only
+// n . w per cell, and the plain 4-neighbour stencil follows the grid's facets);
+// rasters that must agree with gdaldem use Horn's gradient above.
+template <class HeightAt>
+Eigen::Vector2d central_gradient(const HeightAt& z_at, int width, int height, double ew, double ns,
+                                 int x, int row) {
+  const int xl = std::max(x - 1, 0), xr = std::min(x + 1, width - 1);
+  const int rn = std::max(row - 1, 0), rs = std::min(row + 1, height - 1);
+  return {(z_at(xr, row) - z_at(xl, row)) / ((xr - xl) * ew),
+          (z_at(x, rn) - z_at(x, rs)) / ((rs - rn) * ns)};
+}
+
+// The unit upward normal (x east, y north, z up) of a surface whose gradient is
+// `g` (dz/dx, dz/dy).
+inline Eigen::Vector3d normal_from_gradient(const Eigen::Vector2d& g) {
+  return Eigen::Vector3d(-g.x(), -g.y(), 1.0).normalized();
+}
+
 // Per-cell gradient, computed in parallel.
 Grid<Gradient> gradient(const HeightField& dem);
 

@@ -30,4 +30,16 @@ struct Mesh {
   std::size_t triangle_count() const { return triangles.size(); }
 };
 
+// An object as a scene places it (rocks, trees, huts): what snow falls on and
+// the renderer traces.
+struct PlacedMesh {
+  Mesh mesh;  // in its own frame (metres), already rotated and scaled
+  // Where the mesh's origin stands, in the raster's CRS. Kept in double: UTM
+  // coordinates in float would lose half a metre.
+  Eigen::Vector3d position{0, 0, 0};
+  Eigen::Vector3f albedo{0.5f, 0.5f, 0.5f};
+  // Per-vertex snow coverage in [0, 1] (from drift snow fall), or empty.
+  std::vector<float> snow_coverage;
+};
+
 }  // namespace drift::terrain

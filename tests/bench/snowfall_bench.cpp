@@ -29,14 +29,15 @@ drift::terrain::HeightField mountains(int n) {
 
 // Hut, bench, tree and eight rocks near the middle, standing on the ground
 // (same formula as mountains(), y north = -row): ~11k triangles.
-std::vector<SnowObject> objects(int n) {
-  std::vector<SnowObject> out;
+std::vector<drift::terrain::PlacedMesh> objects(int n) {
+  std::vector<drift::terrain::PlacedMesh> out;
   auto put = [&](const char* name, double x, double y) {
     const double z = 200 * std::sin(x / 300.0) * std::cos(-y / 450.0) +
                      60 * std::sin(x / 70.0 - y / 90.0) +
                      10 * std::sin(x / 13.0) * std::cos(-y / 17.0);
-    out.push_back({drift::terrain::read_obj(std::string(DRIFT_SOURCE_DIR "/data/objects/") + name),
-                   Eigen::Vector3d(x, y, z)});
+    drift::terrain::PlacedMesh& placed = out.emplace_back();
+    placed.mesh = drift::terrain::read_obj(std::string(DRIFT_SOURCE_DIR "/data/objects/") + name);
+    placed.position = Eigen::Vector3d(x, y, z);
   };
   const double c = n / 2.0;
   put("hut.obj", c, -c);

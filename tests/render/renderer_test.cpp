@@ -224,7 +224,7 @@ TEST(Renderer, MeshRoofShadowsTheGround) {
   in.sun.color = {1, 1, 1};
   in.sun.irradiance = 1.0;
   const TerrainScene probe(in);
-  PlacedMesh roof;
+  drift::terrain::PlacedMesh roof;
   roof.position = probe.origin();  // the DEM's centre, ground level
   const float z = 20.0f;
   for (auto [x, y] : {std::pair{-20.f, -20.f}, {20.f, -20.f}, {20.f, 20.f}, {-20.f, 20.f}}) {

@@ -240,7 +240,7 @@ TEST(Snow, MeshCoverageBlendsTheObjectsMaterial) {
   // vertices and bare on the others.
   SceneInput in;
   in.terrain = HeightField(16, 16, 0.0f, local_georeference(1.0));
-  PlacedMesh roof;
+  drift::terrain::PlacedMesh roof;
   roof.mesh.positions = {{0, 0, 10}, {4, 0, 10}, {0, 4, 10}, {4, 4, 10}};
   roof.mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
   roof.position = Eigen::Vector3d(6.0, -10.0, 0.0);

@@ -25,10 +25,12 @@ HeightField flat_ground() {
   return g;
 }
 
-std::vector<SnowObject> hut(const HeightField& g) {
+std::vector<drift::terrain::PlacedMesh> hut(const HeightField& g) {
   const auto c = g.geo().cell_center(27.5, 27.5);
-  return {{drift::terrain::read_obj(DRIFT_SOURCE_DIR "/data/objects/hut.obj"),
-           Eigen::Vector3d(c[0], c[1], 2000.0)}};
+  drift::terrain::PlacedMesh placed;
+  placed.mesh = drift::terrain::read_obj(DRIFT_SOURCE_DIR "/data/objects/hut.obj");
+  placed.position = Eigen::Vector3d(c[0], c[1], 2000.0);
+  return {placed};
 }
 
 // Cell of CRS point (x, y) (hut frame: metres from the hut's centre).
