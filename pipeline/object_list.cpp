@@ -1,5 +1,6 @@
 #include "pipeline/object_list.h"
 
+#include <cctype>
 #include <cmath>
 
 #include "pipeline/toml_section.h"
@@ -11,7 +12,23 @@ namespace drift::pipeline {
 
 namespace fs = std::filesystem;
 
-std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs::path& file) {
+namespace {
+
+// OBJ, or PLY (as drift snow fall --mesh-out writes) by the file's extension.
+terrain::Mesh mesh_file(const fs::path& path, bool y_up) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".ply") return terrain::read_obj(path, y_up);
+  terrain::Mesh m = terrain::read_ply(path);
+  if (y_up)
+    for (auto& p : m.positions) p = Eigen::Vector3f(p.x(), -p.z(), p.y());
+  return m;
+}
+
+}  // namespace
+
+std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs::path& file,
+                                             const ObjectKeys& extra) {
   std::vector<terrain::PlacedMesh> out;
   if (const toml::node* objects = root.get("objects")) {
     const toml::array* list = objects->as_array();
@@ -22,17 +39,18 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs:
       Section obj(entry.as_table(), "objects", file);
       const auto mesh_path = obj.string("mesh");
       if (!mesh_path)
-        throw Error(file.string() + ": an [[objects]] entry needs 'mesh' (an OBJ file)");
+        throw Error(file.string() + ": an [[objects]] entry needs 'mesh' (an OBJ or PLY file)");
       const bool y_up = obj.boolean("y_up", false);
       const auto position = obj.vector<3>("position", -1e8, 1e8);
       const double scale = obj.number("scale", 1.0, 1e-6, 1e6);
       const double rotate = obj.number("rotate_z", 0.0, -360.0, 360.0);
       terrain::PlacedMesh placed;
       placed.albedo = obj.color("color", placed.albedo);
+      if (extra) extra(obj, out.size());
       obj.finish();
       const fs::path mp = fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path)
                                                              : file.parent_path() / *mesh_path;
-      placed.mesh = terrain::read_obj(mp, y_up);
+      placed.mesh = mesh_file(mp, y_up);
       const double a = rotate * M_PI / 180.0;
       placed.position = position ? *position : Eigen::Vector3d::Zero();
       for (auto& p : placed.mesh.positions) {

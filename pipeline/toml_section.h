@@ -114,6 +114,9 @@ class Section {
     return v ? v->cast<float>() : fallback;
   }
 
+  // The key's node as it is (null if absent), for values of more than one type.
+  const toml::node* raw(const char* key) { return take(key); }
+
   // An array of tables ([[name.key]] entries), empty if absent.
   std::vector<const toml::table*> tables(const char* key) {
     const toml::node* node = take(key);

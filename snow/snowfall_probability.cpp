@@ -10,16 +10,21 @@
 #include <memory>
 #include <optional>
 
-#include "snow/occlusion_depth_map.h"
 #include "snow/occlusion_horizon.h"
-#include "snow/occlusion_osmesa.h"
 #include "terrain/error.h"
+#include "terrain/offscreen/depth_map.h"
+#include "terrain/offscreen/osmesa_depth_renderer.h"
 
 namespace drift::snow {
 
 namespace {
 
 using Eigen::Vector3d;
+using terrain::depth_bias;
+using terrain::DepthMap;
+using terrain::GroundGeometry;
+using terrain::LightFrame;
+using terrain::OsmesaDepthRenderer;
 
 struct Box {
   Vector3d lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};

@@ -1,14 +1,16 @@
-// An orthographic depth map along the snowfall direction (paper 003, 2.1(1),
-// after Segal et al. 1992): the snowfall direction is treated as a light; a
-// point hidden from it by something nearer the source is in "shadow" and gets
-// no snow.
+// An orthographic depth map along a direction (after Segal et al. 1992),
+// shared by the stages that render depth off-screen: snowfall treats its
+// direction as a light, and a point hidden from it by something nearer the
+// source is in "shadow" and gets no snow (paper 003, 2.1(1)); marks look up
+// from below the ground, so the surface nearest the source is an object's
+// bottom (paper 000, 3.3).
 #pragma once
 
 #include <Eigen/Core>
 #include <limits>
 #include <vector>
 
-namespace drift::snow {
+namespace drift::terrain {
 
 // Light space: a = p.u, b = p.v across the map, c = p.w towards the source.
 struct LightFrame {
@@ -49,4 +51,4 @@ struct DepthMap {
 // Slope-scaled bias for a surface whose unit normal makes cos_phi with w.
 double depth_bias(double texel, double cos_phi);
 
-}  // namespace drift::snow
+}  // namespace drift::terrain

@@ -1,7 +1,8 @@
-// Depth maps rendered off-screen with OSMesa (Mesa's llvmpipe), as the paper
-// rendered its shadow maps on graphics hardware (paper 003, 2.1(1)). A 32-bit
-// float depth attachment (GL_DEPTH_COMPONENT32F) keeps the depth precise over
-// kilometres of relief; maps larger than a tile are drawn tile by tile.
+// Depth maps rendered off-screen with OSMesa (Mesa's llvmpipe), as the papers
+// used graphics hardware for shadow maps (paper 003, 2.1(1)) and collisions
+// (paper 000, 3.3). A 32-bit float depth attachment (GL_DEPTH_COMPONENT32F)
+// keeps the depth precise over kilometres of relief; maps larger than a tile
+// are drawn tile by tile.
 //
 // One renderer owns one OSMesa context, current on the thread that made it:
 // create, use and destroy it on one thread.
@@ -11,16 +12,16 @@
 #include <memory>
 #include <vector>
 
-#include "snow/occlusion_depth_map.h"
+#include "terrain/offscreen/depth_map.h"
 #include "terrain/grid.h"
 #include "terrain/mesh.h"
 
-namespace drift::snow {
+namespace drift::terrain {
 
 // A height field as triangles: vertex (col, row) stands at
 // (x0 + col * dx, y0 - row * dy, heights(col, row)) in the local frame.
 struct GroundGeometry {
-  const terrain::Grid<float>* heights = nullptr;
+  const Grid<float>* heights = nullptr;
   double x0 = 0, y0 = 0, dx = 1, dy = 1;
 };
 
@@ -35,11 +36,11 @@ class OsmesaDepthRenderer {
   // with the nearest surface among `meshes` (positions in the local frame) and
   // `ground` (may be null). [c_lo, c_hi] must enclose the geometry's depths.
   void render(DepthMap& map, double c_lo, double c_hi,
-              const std::vector<const terrain::Mesh*>& meshes, const GroundGeometry* ground);
+              const std::vector<const Mesh*>& meshes, const GroundGeometry* ground);
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace drift::snow
+}  // namespace drift::terrain

@@ -1,4 +1,4 @@
-#include "snow/occlusion_osmesa.h"
+#include "terrain/offscreen/osmesa_depth_renderer.h"
 
 #include <GL/gl.h>
 #include <GL/glext.h>
@@ -11,7 +11,7 @@
 
 #include "terrain/error.h"
 
-namespace drift::snow {
+namespace drift::terrain {
 
 namespace {
 constexpr int kTile = 4096;       // texels a side per draw (64 MiB of float depth)
@@ -52,7 +52,7 @@ OsmesaDepthRenderer::OsmesaDepthRenderer() : impl_(std::make_unique<Impl>()) {
   }
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDisable(GL_CULL_FACE);  // snow is stopped by either side of a surface
+  glDisable(GL_CULL_FACE);  // either side of a surface stops snow or touches ground
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   check_gl("set up the depth framebuffer");
 }
@@ -65,7 +65,7 @@ OsmesaDepthRenderer::~OsmesaDepthRenderer() {
 }
 
 void OsmesaDepthRenderer::render(DepthMap& map, double c_lo, double c_hi,
-                                 const std::vector<const terrain::Mesh*>& meshes,
+                                 const std::vector<const Mesh*>& meshes,
                                  const GroundGeometry* ground) {
   if (!OSMesaMakeCurrent(impl_->context, impl_->pixel.data(), GL_UNSIGNED_BYTE, 1, 1)) {
     throw Error("cannot make the OSMesa context current");
@@ -117,7 +117,7 @@ void OsmesaDepthRenderer::render(DepthMap& map, double c_lo, double c_hi,
       glClearDepth(1.0);
       glClear(GL_DEPTH_BUFFER_BIT);
 
-      for (const terrain::Mesh* mesh : meshes) {
+      for (const Mesh* mesh : meshes) {
         vertices.resize(mesh->positions.size() * 3);
         for (std::size_t i = 0; i < mesh->positions.size(); ++i)
           for (int k = 0; k < 3; ++k) vertices[3 * i + k] = mesh->positions[i][k];
@@ -167,7 +167,7 @@ void OsmesaDepthRenderer::render(DepthMap& map, double c_lo, double c_hi,
       }
       depth.resize(static_cast<std::size_t>(tw) * th);
       glReadPixels(0, 0, tw, th, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
-      check_gl("render a snowfall depth map");
+      check_gl("render a depth map");
       for (int j = 0; j < th; ++j)
         for (int i = 0; i < tw; ++i) {
           const float d = depth[static_cast<std::size_t>(j) * tw + i];
@@ -180,4 +180,4 @@ void OsmesaDepthRenderer::render(DepthMap& map, double c_lo, double c_hi,
   glDisableClientState(GL_VERTEX_ARRAY);
 }
 
-}  // namespace drift::snow
+}  // namespace drift::terrain

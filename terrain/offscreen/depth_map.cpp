@@ -1,10 +1,10 @@
-#include "snow/occlusion_depth_map.h"
+#include "terrain/offscreen/depth_map.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
-namespace drift::snow {
+namespace drift::terrain {
 
 LightFrame LightFrame::toward(const Eigen::Vector3d& toward_source) {
   LightFrame f;
@@ -44,4 +44,4 @@ bool DepthMap::lit_biased(const Eigen::Vector3d& p, double bias) const {
   return q.z() - c_ref >= static_cast<double>(top) - bias;
 }
 
-}  // namespace drift::snow
+}  // namespace drift::terrain

@@ -1,0 +1,135 @@
+// drift marks GROUND.tif --track TRACK.toml -o OUT.tif: marks that objects
+// moving along keyframes leave in soft ground (paper 000, terrain/marks/marks.h).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "pipeline/cli.h"
+#include "pipeline/object_list.h"
+#include "pipeline/progress_bar.h"
+#include "pipeline/track_file.h"
+#include "terrain/error.h"
+#include "terrain/marks/marks.h"
+#include "terrain/raster_io.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct MarksCommand {
+  std::string ground, track, output, material, disturbed, frames, snow_depth, renderer = "cpu";
+  double snow_min = 0.01;
+  marks::MarksOptions options;
+};
+
+// Outputs must not be the run's inputs (a failed run must leave inputs alone).
+void refuse_input_as_output(const MarksCommand& c) {
+  std::error_code ec;
+  for (const std::string* out : {&c.output, &c.disturbed}) {
+    if (out->empty()) continue;
+    for (const std::string* in : {&c.ground, &c.track, &c.snow_depth})
+      if (!in->empty() && fs::equivalent(*out, *in, ec))
+        usage_error("output '" + *out + "' is also an input; write it elsewhere");
+  }
+  if (!c.disturbed.empty() && c.disturbed == c.output)
+    usage_error("--disturbed and -o name the same file");
+}
+
+marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
+                                      const terrain::HeightField& ground) {
+  marks::Material base = track.material.value_or(*marks::material_preset("sand"));
+  if (!c.material.empty()) base = *marks::material_preset(c.material);
+  if (c.snow_depth.empty()) return marks::MaterialField{{base}, {}};
+  const terrain::HeightField depth = terrain::read_raster(c.snow_depth);
+  if (depth.width() != ground.width() || depth.height() != ground.height()) {
+    throw Error("snow depth '" + c.snow_depth + "' is " + std::to_string(depth.width()) + " x " +
+                std::to_string(depth.height()) + " cells but the ground is " +
+                std::to_string(ground.width()) + " x " + std::to_string(ground.height()) +
+                "; give the depth drift snow fall made on this ground");
+  }
+  const marks::Material snow =
+      c.material.empty() ? *marks::material_preset("snow") : *marks::material_preset(c.material);
+  return marks::materials_from_snow_depth(depth, c.snow_min, base, snow);
+}
+
+void run_marks(MarksCommand& c) {
+  refuse_input_as_output(c);
+  TrackFile track = read_track_file(c.track);
+  marks::MarksOptions o = c.options;
+  o.step = track.step;
+  o.camera = track.camera;
+  o.renderer = c.renderer == "opengl" ? marks::BottomRenderer::OpenGL : marks::BottomRenderer::Cpu;
+  o.track_disturbed = !c.disturbed.empty();
+  if (!c.material.empty())
+    for (marks::MarkObject& obj : track.objects) obj.material.reset();  // --material overrides all
+  const terrain::HeightField ground = terrain::read_raster(c.ground);
+  require_metric_crs(ground, c.ground);
+  marks::MaterialField materials = ground_materials(c, track, ground);
+  if (!c.frames.empty()) fs::create_directories(c.frames);
+  marks::StepFn on_step;
+  if (!c.frames.empty()) {
+    on_step = [&](int step, const marks::MarksSimulation& sim) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05d.tif", step);
+      terrain::write_geotiff(sim.heights_as_float(), fs::path(c.frames) / name,
+                             {"ground height with marks (m)", "m"});
+      return true;
+    };
+  }
+  const marks::MarksResult r = marks::simulate_marks(ground, track.objects, std::move(materials),
+                                                     o, on_step, terminal_progress("marks"));
+  terrain::write_geotiff(r.heights, c.output, {"ground height with marks (m)", "m"});
+  std::printf("marks: wrote %s\n", c.output.c_str());
+  if (!c.disturbed.empty()) {
+    terrain::write_geotiff(r.disturbed, c.disturbed,
+                           {"ground disturbed by marks (m compressed, displaced or slid)", "m"});
+    std::printf("marks: wrote %s\n", c.disturbed.c_str());
+  }
+  std::printf("marks: %d steps; %.6g m3 under objects: %.6g displaced, %.6g compressed away\n",
+              r.report.steps, r.report.collided, r.report.displaced, r.report.compressed);
+}
+
+}  // namespace
+
+void add_marks_command(CLI::App& root) {
+  auto c = std::make_shared<MarksCommand>();
+  CLI::App* sub = add_subcommand(
+      root, "marks",
+      "marks of objects in soft ground: footprints, tyre tracks, dragged objects in sand, mud "
+      "and snow (paper 000)",
+      [c] { run_marks(*c); });
+  sub->add_option("ground", c->ground, "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
+      ->required();
+  sub->add_option("--track", c->track, "TOML track file: step, material, [[objects]] with keyframes")
+      ->required();
+  sub->add_option("-o,--output", c->output, "ground with the marks, GeoTIFF (m)")->required();
+  sub->add_option("--material", c->material, "overrides every material: sand, mud or snow")
+      ->check(CLI::IsMember({"sand", "mud", "snow"}));
+  sub->add_option("--disturbed", c->disturbed,
+                  "GeoTIFF of how much each cell was compressed, displaced or slid (m)");
+  sub->add_option("--frames", c->frames, "directory for the field after every step (frame_NNNNN.tif)");
+  sub->add_option("--snow-depth", c->snow_depth,
+                  "snow depth GeoTIFF (drift snow fall): snow where it lies, the ground's material "
+                  "elsewhere");
+  sub->add_option("--snow-min", c->snow_min, "snow shallower than this (m) leaves the ground's material")
+      ->capture_default_str();
+  sub->add_option("--memory-steps", c->options.memory_steps,
+                  "steps a cell that slid keeps relaxing (paper 000, 3.5)")
+      ->capture_default_str();
+  sub->add_option("--erosion-passes", c->options.erosion_passes, "most relaxation passes per erosion")
+      ->capture_default_str();
+  sub->add_option("--margin", c->options.margin, "free cells kept around an object's footprint")
+      ->capture_default_str();
+  sub->add_option("--renderer", c->renderer,
+                  "how the object's bottom is rendered: cpu (z-buffer, faster at these sizes) or "
+                  "opengl (OSMesa)")
+      ->check(CLI::IsMember({"cpu", "opengl"}))
+      ->capture_default_str();
+}
+
+DRIFT_COMMAND(50, add_marks_command);
+
+}  // namespace drift::pipeline

@@ -1,0 +1,48 @@
+// Compression and displacement of the ground an object presses into (paper
+// 000, 3.4, fig. 4, after Sumner et al. 1999). In a collided cell (object
+// bottom b below the ground g) the ground drops to b; of the h' = g - b it
+// loses, delta h = alpha h' is displaced and the rest is compressed away.
+//
+// Pressing (the object not dragged): the displaced material moves from the
+// inside of the contact region outwards along a distance transform (chessboard
+// distance to the nearest free cell): each contact cell, deepest first, hands
+// its material in equal shares to its neighbours nearer the boundary, and the
+// contour hands it to the ring of free cells just outside.
+//
+// Dragging (paper 000, 3.4, second paragraph): the contact cells are taken from
+// the side opposite the motion forwards, and each hands its material to its
+// neighbours ahead (contact or free) and to free cells beside it; nothing goes
+// backwards.
+//
+// In both, a free cell that the object overhangs takes no more than reaches
+// the object's bottom and pushes its excess on to the free cells farther from
+// the contact (never backwards when dragging).
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "terrain/grid.h"
+#include "terrain/marks/material.h"
+#include "terrain/marks/object_bottom.h"
+
+namespace drift::marks {
+
+struct DisplacementReport {
+  double collided = 0.0;     // sum of h' over the contact (m of height, times cell area = m3)
+  double displaced = 0.0;    // sum of alpha h'
+  double compressed = 0.0;   // sum of (1 - alpha) h'
+  std::vector<int> contact;  // flat indices of the collided cells
+  std::vector<int> received; // flat indices of the free cells that took material
+};
+
+// heights: the whole field (m), updated in the bottom map's window.
+// drag: the horizontal motion in cell space (any length), or none when pressing.
+// disturbed (optional): accumulates |change| per cell.
+DisplacementReport compress_and_displace(terrain::Grid<double>& heights, const BottomMap& bottom,
+                                         const MaterialField& materials,
+                                         const std::optional<Eigen::Vector2d>& drag,
+                                         terrain::Grid<float>* disturbed = nullptr);
+
+}  // namespace drift::marks

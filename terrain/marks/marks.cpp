@@ -1,0 +1,219 @@
+#include "terrain/marks/marks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "terrain/error.h"
+#include "terrain/marks/displacement.h"
+#include "terrain/marks/multires.h"
+#include "terrain/memory.h"
+#include "terrain/slope_relax.h"
+
+namespace drift::marks {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Paper 000, 3.4: an object is dragged when it moves sideways (more than a
+// twentieth of a cell) rather than down (motion at most 45 degrees below level).
+std::optional<Eigen::Vector2d> drag_direction(const Eigen::Vector3d& d, const GridFrame& f) {
+  const Eigen::Vector2d cells(d.x() / f.dx, -d.y() / f.dy);
+  const double level = std::hypot(d.x(), d.y());
+  if (cells.norm() <= 0.05 || d.z() < -level) return std::nullopt;
+  return cells;
+}
+
+}  // namespace
+
+void MarksOptions::validate() const {
+  if (!(step > 0.0 && step <= 3600.0))
+    throw Error("marks: step is " + std::to_string(step) + " s; it must lie in (0, 3600]");
+  if (memory_steps < 0 || memory_steps > 1000000)
+    throw Error("marks: memory_steps must lie in [0, 1000000]");
+  if (erosion_passes < 1 || erosion_passes > 100000)
+    throw Error("marks: erosion_passes must lie in [1, 100000]");
+  if (margin < 2 || margin > 1000) throw Error("marks: margin must lie in [2, 1000] cells");
+  if (camera && (!camera->position.allFinite() || !(camera->fov_deg > 0 && camera->fov_deg < 180) ||
+                 camera->width_px < 1))
+    throw Error("marks: the camera needs a finite position, a field of view in (0, 180) degrees "
+                "and a width of at least 1 pixel");
+}
+
+struct MarksSimulation::Impl {
+  MarksSimulation& sim;
+  std::unique_ptr<BottomRasteriser> rasteriser;
+  terrain::Grid<double> ceiling;     // the objects' bottoms during erosion, +inf elsewhere
+  terrain::Grid<int> expiry;         // step until which a cell is remembered (3.5)
+  std::vector<int> remembered;       // the cells with expiry >= the current step
+  std::vector<BottomMap> last;       // each object's last bottom in this step
+  terrain::SlopeRelaxWorkspace workspace;
+
+  explicit Impl(MarksSimulation& s) : sim(s) {}
+
+  void remember(const std::vector<int>& cells) {
+    for (int c : cells) {
+      int& e = expiry.values()[static_cast<std::size_t>(c)];
+      if (e < sim.step_) remembered.push_back(c);
+      e = sim.step_ + sim.options_.memory_steps;
+    }
+  }
+  void set_ceiling(const BottomMap& b, bool on) {
+    const CellWindow& w = b.window;
+    for (int r = 0; r < w.height; ++r)
+      for (int c = 0; c < w.width; ++c) {
+        double& v = ceiling(w.col0 + c, w.row0 + r);
+        const double z = b.z[static_cast<std::size_t>(r) * w.width + c];
+        v = on ? std::min(v, z) : kInf;
+      }
+  }
+  void erode(std::vector<int> seeds) {
+    std::vector<terrain::SlopeRule> rules;
+    for (const Material& m : sim.materials_.table) rules.push_back(m.slope_rule());
+    terrain::SlopeCells cells{rules, sim.materials_.index.empty() ? nullptr : &sim.materials_.index,
+                              &ceiling, nullptr};
+    terrain::SlopeRelaxOptions o{sim.frame_.dx, sim.frame_.dy, 1e-4 * std::min(sim.frame_.dx, sim.frame_.dy),
+                                 sim.options_.erosion_passes};
+    std::vector<int> moved;
+    terrain::relax_slopes(sim.heights_, std::move(seeds), cells, o, moved,
+                          sim.options_.track_disturbed ? &sim.disturbed_ : nullptr, &workspace);
+    remember(moved);
+  }
+  void claim_material(const CellWindow& w, const MarkObject& object) {
+    if (!object.material) return;
+    MaterialField& m = sim.materials_;
+    const std::uint8_t id = m.add(*object.material);
+    if (m.index.empty()) m.index = terrain::Grid<std::uint8_t>(sim.heights_.width(), sim.heights_.height(), 0);
+    for (int r = w.row0; r < w.row0 + w.height; ++r)
+      for (int c = w.col0; c < w.col0 + w.width; ++c) m.index(c, r) = id;
+  }
+  // Paper 000, 3.3-3.5 on the full-resolution field: collision, displacement, erosion.
+  BottomMap deform(const CellTriangles& tris, const MarkObject& object,
+                   const std::optional<Eigen::Vector2d>& drag, StepReport& report) {
+    BottomMap bottom;
+    bottom.window = footprint_window(tris, sim.options_.margin, sim.heights_.width(), sim.heights_.height());
+    if (bottom.window.empty()) return bottom;
+    rasteriser->render(tris, bottom);
+    claim_material(bottom.window, object);
+    const DisplacementReport d = compress_and_displace(
+        sim.heights_, bottom, sim.materials_, drag, sim.options_.track_disturbed ? &sim.disturbed_ : nullptr);
+    const double area = sim.frame_.dx * sim.frame_.dy;
+    report.collided += d.collided * area, report.displaced += d.displaced * area;
+    report.compressed += d.compressed * area;
+    report.contact_cells += static_cast<int>(d.contact.size());
+    if (d.contact.empty()) return bottom;
+    std::vector<int> seeds = d.received;
+    seeds.insert(seeds.end(), d.contact.begin(), d.contact.end());
+    // Remember the contact and its rim even where the object holds them now:
+    // they slide once it has gone (3.5).
+    remember(seeds);
+    set_ceiling(bottom, true);
+    erode(std::move(seeds));
+    set_ceiling(bottom, false);
+    return bottom;
+  }
+};
+
+MarksSimulation::MarksSimulation(const terrain::HeightField& ground, MaterialField materials,
+                                 const MarksOptions& options)
+    : materials_(std::move(materials)), frame_(GridFrame::of(ground.geo())), options_(options) {
+  options_.validate();
+  const std::uint64_t cells = static_cast<std::uint64_t>(ground.width()) * ground.height();
+  require_memory(cells * (8 + 8 + 4 + 4 + 1) + cells * 4,
+                 "marks state for a " + std::to_string(ground.width()) + " x " +
+                     std::to_string(ground.height()) + " ground",
+                 "crop the ground (drift import --crop) or coarsen it (drift import --resample)");
+  if (!materials_.index.empty() &&
+      (materials_.index.width() != ground.width() || materials_.index.height() != ground.height()))
+    throw Error("marks: the material raster is " + std::to_string(materials_.index.width()) + " x " +
+                std::to_string(materials_.index.height()) + " but the ground is " +
+                std::to_string(ground.width()) + " x " + std::to_string(ground.height()));
+  for (const Material& m : materials_.table) m.validate("marks");
+  heights_ = terrain::Grid<double>(ground.width(), ground.height(), 0.0, ground.geo());
+  for (std::size_t i = 0; i < ground.size(); ++i) {
+    const float v = ground.values()[i];
+    if (!std::isfinite(v)) throw Error("marks: the ground has a cell that is not a finite number (nodata); fill it first (drift import)");
+    heights_.values()[i] = v;
+  }
+  if (options_.track_disturbed) disturbed_ = terrain::Grid<float>(ground.width(), ground.height(), 0.0f, ground.geo());
+  impl_ = std::make_unique<Impl>(*this);
+  impl_->rasteriser = make_bottom_rasteriser(options_.renderer);
+  impl_->ceiling = terrain::Grid<double>(ground.width(), ground.height(), kInf);
+  impl_->expiry = terrain::Grid<int>(ground.width(), ground.height(), -1);
+}
+
+MarksSimulation::~MarksSimulation() = default;
+
+int MarksSimulation::resolution_for(const MarkObject& object, const Eigen::Vector3d& where) const {
+  if (object.resolution > 0) return object.resolution;
+  if (!options_.camera) return 1;
+  // Paper 000, 3.6 A: the projected size of a cell against a pixel.
+  const double distance = (options_.camera->position - where).norm();
+  const double focal_px = 0.5 * options_.camera->width_px /
+                          std::tan(0.5 * options_.camera->fov_deg * std::numbers::pi / 180.0);
+  const double cell_px = std::min(frame_.dx, frame_.dy) * focal_px / std::max(distance, 1e-9);
+  return cell_px <= 0.25 ? 4 : cell_px <= 0.5 ? 2 : 1;
+}
+
+StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& object,
+                                 const Pose& from, const Pose& to, bool first) {
+  StepReport report;
+  const Eigen::Vector3d d = to.position - from.position;
+  const double cells_moved = std::hypot(d.x() / frame_.dx, d.y() / frame_.dy);
+  const double turned = from.rotation.angularDistance(to.rotation) * shape.radius /
+                        std::min(frame_.dx, frame_.dy);  // cells a vertex moves by rotation
+  int n = 1;
+  if (!first) {
+    const double per = object.motion == Motion::SubSteps ? std::max(cells_moved, turned) : turned;
+    if (object.motion != Motion::Place) n = std::clamp(static_cast<int>(std::ceil(per - 1e-9)), 1, 10000);
+  }
+  const int level = resolution_for(object, to.position);
+  BottomMap last;
+  for (int i = 1; i <= n; ++i) {
+    const double s0 = static_cast<double>(i - 1) / n, s1 = static_cast<double>(i) / n;
+    const Pose a{from.position + s0 * d, from.rotation.slerp(s0, to.rotation)};
+    const Pose b{from.position + s1 * d, from.rotation.slerp(s1, to.rotation)};
+    const bool sweep = !first && object.motion == Motion::Sweep;
+    const CellTriangles tris = sweep ? swept_triangles(shape, a.position, b, frame_)
+                                     : posed_triangles(shape, b, frame_);
+    const auto drag = first ? std::nullopt : drag_direction(b.position - a.position, frame_);
+    if (level == 1) {
+      last = impl_->deform(tris, object, drag, report);
+    } else {
+      impl_->claim_material(footprint_window(tris, options_.margin * level, heights_.width(), heights_.height()), object);
+      CoarseResult c = deform_coarse(heights_, materials_, tris, level, frame_.dx, frame_.dy,
+                                     options_.margin, options_.erosion_passes, *impl_->rasteriser,
+                                     drag, options_.track_disturbed ? &disturbed_ : nullptr);
+      const double area = frame_.dx * frame_.dy * level * level;
+      report.collided += c.collided * area, report.displaced += c.displaced * area;
+      report.compressed += c.compressed * area;
+      report.contact_cells += c.contact_cells;
+      impl_->remember(c.changed);
+      last = std::move(c.bottom);
+    }
+    ++report.substeps;
+  }
+  if (!last.window.empty()) impl_->last.push_back(std::move(last));
+  return report;
+}
+
+void MarksSimulation::end_step() {
+  for (const BottomMap& b : impl_->last) impl_->set_ceiling(b, true);
+  std::vector<int> active;
+  for (int c : impl_->remembered)
+    if (impl_->expiry.values()[static_cast<std::size_t>(c)] >= step_) active.push_back(c);
+  impl_->remembered = active;
+  if (!active.empty()) impl_->erode(std::move(active));
+  for (const BottomMap& b : impl_->last) impl_->set_ceiling(b, false);
+  impl_->last.clear();
+  ++step_;
+}
+
+terrain::HeightField MarksSimulation::heights_as_float() const {
+  terrain::HeightField out(heights_.width(), heights_.height(), 0.0f, heights_.geo());
+  for (std::size_t i = 0; i < out.size(); ++i) out.values()[i] = static_cast<float>(heights_.values()[i]);
+  return out;
+}
+
+}  // namespace drift::marks

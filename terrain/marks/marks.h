@@ -1,0 +1,141 @@
+// Marks that objects leave in soft ground: footprints, tyre tracks, dragged
+// objects in sand, mud and snow (paper 000, Onoue & Nishita, after Sumner,
+// O'Brien & Hodgins 1999). One simulation step, per object and sub-step:
+//   1. collision by z-buffer: the object's bottom over the ground's cells,
+//      looking up from below (object_bottom.h; 3.3), swept when dragged;
+//   2. compression and displacement along a distance transform
+//      (displacement.h; 3.4);
+//   3. erosion from the contact outwards where slopes exceed the material's
+//      angle, never above the object's bottom (terrain/slope_relax.h; 3.5);
+// and at the end of the step, erosion of the cells remembered from earlier
+// steps, so material goes on sliding after an object leaves (3.5).
+// Objects far from a camera, or marked so by the user, work on a half or
+// quarter resolution copy of their window, written back by linear
+// interpolation (multires.h; 3.6).
+//
+// Options (units, defaults, ranges):
+//   step            s     0.1      (0, 3600]  simulated time per step
+//   memory_steps    steps 20       [0, 1e6]   how long a cell that slid keeps relaxing
+//   erosion_passes  -     100      [1, 1e5]   most relaxation passes per erosion
+//   margin          cells 4        [2, 1000]  free cells around a footprint for rims
+//   renderer        -     cpu      cpu|opengl how the object's bottom is rendered
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "terrain/grid.h"
+#include "terrain/marks/material.h"
+#include "terrain/marks/object_bottom.h"
+#include "terrain/marks/object_geometry.h"
+#include "terrain/marks/trajectory.h"
+#include "terrain/mesh.h"
+#include "terrain/progress.h"
+
+namespace drift::marks {
+
+// How an object moving more than a cell per step is handled (paper 000,
+// table 1): swept (default), cut into sub-steps of at most a cell each, or
+// simply placed at each step (leaves streaks: for comparison only).
+enum class Motion { Sweep, SubSteps, Place };
+
+struct MarkObject {
+  std::string name;            // for messages
+  terrain::Mesh mesh;          // in its own frame (m), scaled and turned z-up
+  Trajectory trajectory;       // keyframes in the ground's CRS
+  bool follow_ground = false;  // keyframe z = height of the origin above the ground
+  std::optional<Material> material;  // the ground's material where it walks
+  Motion motion = Motion::Sweep;
+  int resolution = 1;  // 1 full, 2 half, 4 quarter; 0: chosen from the camera
+};
+
+// A camera to choose resolutions by (paper 000, 3.6 A): a cell projects to
+// about cell x focal / distance pixels.
+struct MarksCamera {
+  Eigen::Vector3d position{0, 0, 0};
+  double fov_deg = 40.0;  // horizontal
+  int width_px = 1280;
+};
+
+struct MarksOptions {
+  double step = 0.1;
+  int memory_steps = 20;
+  int erosion_passes = 100;
+  int margin = 4;
+  BottomRenderer renderer = BottomRenderer::Cpu;
+  std::optional<MarksCamera> camera;
+  bool track_disturbed = true;  // keep the per-cell disturbance raster
+  // Throws drift::Error naming the option.
+  void validate() const;
+};
+
+struct StepReport {
+  double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m3
+  int contact_cells = 0;
+  int substeps = 0;
+};
+
+// The state of a run, for callers that drive it step by step (benchmarks,
+// tests, interactive tools). Not thread-safe; one per thread.
+class MarksSimulation {
+ public:
+  MarksSimulation(const terrain::HeightField& ground, MaterialField materials,
+                  const MarksOptions& options);
+  ~MarksSimulation();
+
+  // The object (its shape made once with ObjectShape::of) moves from `from`
+  // to `to` within the current step; `first`: it appears at `to` (no motion).
+  StepReport move(const ObjectShape& shape, const MarkObject& object, const Pose& from,
+                  const Pose& to, bool first);
+  // Ends the step: erosion of remembered cells under the objects' last bottoms.
+  void end_step();
+
+  const terrain::Grid<double>& heights() const { return heights_; }
+  const terrain::Grid<float>& disturbed() const { return disturbed_; }
+  const MaterialField& materials() const { return materials_; }
+  const GridFrame& frame() const { return frame_; }
+  int step_index() const { return step_; }
+  terrain::HeightField heights_as_float() const;
+
+  // The level (1, 2, 4) an object at `where` is worked at.
+  int resolution_for(const MarkObject& object, const Eigen::Vector3d& where) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  terrain::Grid<double> heights_;
+  terrain::Grid<float> disturbed_;
+  MaterialField materials_;
+  GridFrame frame_;
+  MarksOptions options_;
+  int step_ = 0;
+  friend struct Impl;
+};
+
+struct MarksReport {
+  int steps = 0;
+  double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m3 over the run
+};
+
+struct MarksResult {
+  terrain::HeightField heights;
+  terrain::Grid<float> disturbed;  // m of height compressed, displaced or slid per cell
+  MarksReport report;
+};
+
+// Called after every step with its index and the field (for --frames); return
+// false to cancel.
+using StepFn = std::function<bool(int step, const MarksSimulation& state)>;
+
+// Runs every object along its keyframes from the first keyframe of any to the
+// last. Throws drift::Error for bad options, trajectories or meshes, and when
+// the state does not fit in memory (checked before allocating).
+MarksResult simulate_marks(const terrain::HeightField& ground,
+                           const std::vector<MarkObject>& objects, MaterialField materials,
+                           const MarksOptions& options, const StepFn& on_step = {},
+                           const ProgressFn& progress = no_progress);
+
+}  // namespace drift::marks

@@ -1,0 +1,62 @@
+#include "terrain/marks/material.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "terrain/error.h"
+
+namespace drift::marks {
+
+void Material::validate(const std::string& what) const {
+  auto bad = [&](const char* key, double v, const char* range) {
+    throw Error(what + ": material '" + name + "' has " + key + " = " + std::to_string(v) +
+                "; it must lie in " + range);
+  };
+  if (!(theta_deg > 0.0 && theta_deg <= 90.0)) bad("theta", theta_deg, "(0, 90] degrees");
+  if (!(alpha >= 0.0 && alpha <= 1.0)) bad("alpha", alpha, "[0, 1]");
+  if (!(sigma > 0.0 && sigma <= 0.5)) bad("sigma (roughness)", sigma, "(0, 0.5]");
+}
+
+terrain::SlopeRule Material::slope_rule() const {
+  terrain::SlopeRule r;
+  // 90 degrees: the material stands vertical and never slips (paper: snow).
+  r.tan_repose = theta_deg >= 90.0 ? std::numeric_limits<double>::infinity()
+                                   : std::tan(theta_deg * std::numbers::pi / 180.0);
+  r.fraction = sigma;
+  return r;
+}
+
+std::optional<Material> material_preset(const std::string& name) {
+  // Paper 000, section 4: figs. 7 (sand), 8 (mud), 9 (snow); sigma 0.2 (3.5).
+  if (name == "sand") return Material{"sand", 30.0, 1.0, 0.2};
+  if (name == "mud") return Material{"mud", 60.0, 0.8, 0.2};
+  if (name == "snow") return Material{"snow", 90.0, 0.0, 0.2};
+  return std::nullopt;
+}
+
+std::string material_preset_names() { return "sand, mud, snow"; }
+
+std::uint8_t MaterialField::add(const Material& m) {
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const Material& t = table[i];
+    if (t.name == m.name && t.theta_deg == m.theta_deg && t.alpha == m.alpha && t.sigma == m.sigma)
+      return static_cast<std::uint8_t>(i);
+  }
+  if (table.size() >= 255) throw Error("more than 255 different ground materials");
+  table.push_back(m);
+  return static_cast<std::uint8_t>(table.size() - 1);
+}
+
+MaterialField materials_from_snow_depth(const terrain::Grid<float>& snow_depth, double min_depth,
+                                        const Material& ground, const Material& snow) {
+  MaterialField f;
+  f.table = {ground, snow};
+  f.index = terrain::Grid<std::uint8_t>(snow_depth.width(), snow_depth.height(), 0);
+  for (std::size_t i = 0; i < snow_depth.size(); ++i) {
+    const float d = snow_depth.values()[i];
+    f.index.values()[i] = (std::isfinite(d) && d > min_depth) ? 1 : 0;
+  }
+  return f;
+}
+
+}  // namespace drift::marks

@@ -1,0 +1,58 @@
+// Ground materials for marks (paper 000, 3.4-3.5 and section 4): how steep the
+// ground stands after slipping (theta), how much of the material an object
+// pushes aside is displaced rather than compressed (alpha), and how rough the
+// slipped slopes are (sigma). The paper's presets:
+//
+//   name   theta (deg)  alpha  sigma   look (paper figs. 7-9)
+//   sand   30           1.0    0.2     crumbled rims
+//   mud    60           0.8    0.2     sharp walls, a packed floor
+//   snow   90           0.0    0.2     clean compressed prints, no rim
+//
+// theta in (0, 90] (90: never slips), alpha in [0, 1], sigma in (0, 0.5].
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "terrain/grid.h"
+#include "terrain/slope_relax.h"
+
+namespace drift::marks {
+
+struct Material {
+  std::string name = "sand";
+  double theta_deg = 30.0;  // angle of the slope after slipping (deg)
+  double alpha = 1.0;       // displaced share of the material an object pushes out
+  double sigma = 0.2;       // roughness: share of a slope's excess moved per pass
+
+  // Throws drift::Error naming `what` and the bad value.
+  void validate(const std::string& what) const;
+  terrain::SlopeRule slope_rule() const;
+};
+
+// The paper's preset by name (sand, mud, snow), or nothing.
+std::optional<Material> material_preset(const std::string& name);
+std::string material_preset_names();  // "sand, mud, snow"
+
+// Materials per cell: a table and, per cell, an index into it (all cells index 0
+// while `index` is empty).
+struct MaterialField {
+  std::vector<Material> table{Material{}};
+  terrain::Grid<std::uint8_t> index;
+
+  // The table's index of `m` (added if it is not there yet; at most 255).
+  std::uint8_t add(const Material& m);
+  const Material& at(int cell) const {
+    return table[index.empty() ? 0 : index.values()[static_cast<std::size_t>(cell)]];
+  }
+};
+
+// Per-region materials from a snow-depth raster (drift snow fall): `snow` where
+// the snow is deeper than `min_depth` (m), `ground` elsewhere. The raster must
+// match the ground's size.
+MaterialField materials_from_snow_depth(const terrain::Grid<float>& snow_depth, double min_depth,
+                                        const Material& ground, const Material& snow);
+
+}  // namespace drift::marks

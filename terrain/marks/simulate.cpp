@@ -1,0 +1,77 @@
+// simulate_marks: the run over every object's keyframes (marks.h).
+#include <algorithm>
+#include <cmath>
+
+#include "terrain/bilinear.h"
+#include "terrain/error.h"
+#include "terrain/marks/marks.h"
+
+namespace drift::marks {
+
+namespace {
+
+// The ground's height under a point (bilinear between cell centres, clamped at
+// the edges), for objects that follow the ground.
+double ground_under(const terrain::HeightField& g, const GridFrame& f, double x, double y) {
+  return terrain::bilinear_clamped(g, (x - f.x0) / f.dx, (f.y0 - y) / f.dy);
+}
+
+void validate_objects(const std::vector<MarkObject>& objects) {
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const MarkObject& o = objects[i];
+    const std::string what = "object " + std::to_string(i + 1) + (o.name.empty() ? "" : " ('" + o.name + "')");
+    if (o.mesh.triangles.empty()) throw Error(what + ": the mesh has no triangles");
+    for (const auto& p : o.mesh.positions)
+      if (!p.allFinite()) throw Error(what + ": the mesh has a vertex that is not finite");
+    o.trajectory.validate(what);
+    if (o.material) o.material->validate(what);
+    if (o.resolution != 0 && o.resolution != 1 && o.resolution != 2 && o.resolution != 4)
+      throw Error(what + ": resolution is " + std::to_string(o.resolution) + "; use 1, 2, 4 or 0 (auto)");
+  }
+}
+
+}  // namespace
+
+MarksResult simulate_marks(const terrain::HeightField& ground, const std::vector<MarkObject>& objects,
+                           MaterialField materials, const MarksOptions& options, const StepFn& on_step,
+                           const ProgressFn& progress) {
+  options.validate();
+  validate_objects(objects);
+  if (objects.empty()) throw Error("marks: no objects to move");
+  MarksSimulation sim(ground, std::move(materials), options);
+  std::vector<ObjectShape> shapes;
+  for (const MarkObject& o : objects) shapes.push_back(ObjectShape::of(o.mesh));
+  double t0 = 1e300, t1 = -1e300;
+  for (const MarkObject& o : objects) t0 = std::min(t0, o.trajectory.start()), t1 = std::max(t1, o.trajectory.end());
+  const double span = (t1 - t0) / options.step;
+  if (span > 1e7) throw Error("marks: the keyframes span " + std::to_string(span) + " steps; raise 'step'");
+  const int steps = static_cast<int>(std::ceil(span - 1e-9));
+  auto pose_of = [&](const MarkObject& o, double t) {
+    Pose p = o.trajectory.at(t);
+    if (o.follow_ground) p.position.z() += ground_under(ground, sim.frame(), p.position.x(), p.position.y());
+    return p;
+  };
+  MarksResult result;
+  if (progress && !progress(0.0, "marks")) throw Cancelled();
+  for (int k = 0; k <= steps; ++k) {
+    const double t = std::min(t0 + k * options.step, t1), t_prev = t0 + (k - 1) * options.step;
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      const MarkObject& o = objects[i];
+      if (!o.trajectory.active_at(t)) continue;
+      const bool first = k == 0 || !o.trajectory.active_at(t_prev);
+      const Pose to = pose_of(o, t), from = first ? to : pose_of(o, t_prev);
+      const StepReport r = sim.move(shapes[i], o, from, to, first);
+      result.report.collided += r.collided, result.report.displaced += r.displaced;
+      result.report.compressed += r.compressed;
+    }
+    sim.end_step();
+    if (on_step && !on_step(k, sim)) throw Cancelled();
+    if (progress && !progress(static_cast<double>(k + 1) / (steps + 1), "marks")) throw Cancelled();
+  }
+  result.report.steps = steps + 1;
+  result.heights = sim.heights_as_float();
+  result.disturbed = sim.disturbed();
+  return result;
+}
+
+}  // namespace drift::marks

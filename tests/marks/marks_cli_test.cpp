@@ -1,0 +1,109 @@
+// drift marks: writes the marked ground, the disturbance raster and frames;
+// bad track files and keyframes exit 1 naming the file, line and value, and
+// write nothing.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "terrain/raster_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path dir() {
+  const fs::path d = fs::temp_directory_path() / "drift_marks_cli" /
+                     ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// A flat metric ground (1 cm cells, UTM-sized coordinates) at 2000 m.
+fs::path ground(const fs::path& d) {
+  drift::terrain::HeightField g(64, 64, 2000.0f, drift::terrain::local_georeference(0.01));
+  g.geo().geotransform[0] = 600000.0;
+  g.geo().geotransform[3] = 4000000.0;
+  drift::terrain::write_geotiff(g, d / "ground.tif");
+  return d / "ground.tif";
+}
+
+// A ball pressed 3 cm into the ground's middle and lifted again.
+std::string track(const std::string& keyframes_extra = "", const std::string& top = "") {
+  return "step = 0.1\n" + top +
+         "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR "/data/objects/ball.obj\"\n"
+         "scale = 0.5\n"
+         "[[objects.keyframes]]\ntime = 0.0\nposition = [600000.32, 3999999.68, 2000.08]\n"
+         "[[objects.keyframes]]\ntime = 0.3\nposition = [600000.32, 3999999.68, 2000.02]\n"
+         "[[objects.keyframes]]\ntime = 0.5\nposition = [600000.32, 3999999.68, 2000.1]\n" +
+         keyframes_extra;
+}
+
+int run(const std::string& args, const fs::path& d) {
+  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " marks " + args + " > " +
+                          (d / "out.txt").string() + " 2>&1";
+  return WEXITSTATUS(std::system(cmd.c_str()));
+}
+
+std::string output(const fs::path& d) {
+  std::ifstream f(d / "out.txt");
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+TEST(MarksCli, WritesTheMarkedGroundDisturbanceAndFrames) {
+  const fs::path d = dir(), g = ground(d);
+  std::ofstream(d / "track.toml") << track();
+  ASSERT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " +
+                    (d / "out.tif").string() + " --disturbed " + (d / "dist.tif").string() +
+                    " --frames " + (d / "frames").string() + " --material snow",
+                d),
+            0)
+      << output(d);
+  const auto out = drift::terrain::read_raster(d / "out.tif");
+  EXPECT_EQ(out.geo().geotransform[0], 600000.0);
+  // Snow: compressed 3 cm under the ball's bottom (1 cm tessellation allowance).
+  EXPECT_NEAR(out(32, 32), 2000.0f - 0.03f, 0.002f);
+  EXPECT_LE(out(5, 5), 2000.0f);
+  const auto dist = drift::terrain::read_raster(d / "dist.tif");
+  EXPECT_NEAR(dist(32, 32), 0.03f, 0.002f);
+  EXPECT_EQ(dist(2, 2), 0.0f);
+  EXPECT_TRUE(fs::exists(d / "frames" / "frame_00000.tif"));
+  EXPECT_TRUE(fs::exists(d / "frames" / "frame_00005.tif"));
+}
+
+TEST(MarksCli, BadTrackFilesExitOneNamingTheProblemAndWriteNothing) {
+  const fs::path d = dir(), g = ground(d);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {track("[[objects.keyframes]]\ntime = 0.2\nposition = [600000.3, 3999999.6, 2000.0]\n"),
+       "not after the keyframe before it"},
+      {track("", "material = \"gravel\"\n"), "known materials: sand, mud, snow"},
+      {"step = 0.1\n[[objects]]\nmesh = \"missing.obj\"\n[[objects.keyframes]]\ntime = 0\n"
+       "position = [0, 0, 0]\n",
+       "missing.obj"},
+      {track("", "wind = 3\n"), "unknown key 'wind'"},
+      {"step = 0.1\n[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR "/data/objects/ball.obj\"\n",
+       "needs keyframes"},
+      {track().replace(track().find("2000.08"), 7, "nan"), "objects.keyframes.position"},
+  };
+  for (const auto& [text, message] : cases) {
+    std::ofstream(d / "track.toml") << text;
+    EXPECT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " +
+                      (d / "out.tif").string(),
+                  d),
+              1)
+        << text;
+    EXPECT_NE(output(d).find(message), std::string::npos) << output(d);
+    EXPECT_FALSE(fs::exists(d / "out.tif"));
+  }
+}
+
+TEST(MarksCli, AnOutputThatIsAnInputIsAUsageError) {
+  const fs::path d = dir(), g = ground(d);
+  std::ofstream(d / "track.toml") << track();
+  EXPECT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " + g.string(), d), 2)
+      << output(d);
+}
+
+}  // namespace
