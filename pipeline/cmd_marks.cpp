@@ -11,6 +11,7 @@
 #include "pipeline/track_file.h"
 #include "terrain/error.h"
 #include "terrain/marks/marks.h"
+#include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -24,19 +25,6 @@ struct MarksCommand {
   double snow_min = 0.01;
   marks::MarksOptions options;
 };
-
-// Outputs must not be the run's inputs (a failed run must leave inputs alone).
-void refuse_input_as_output(const MarksCommand& c) {
-  std::error_code ec;
-  for (const std::string* out : {&c.output, &c.disturbed}) {
-    if (out->empty()) continue;
-    for (const std::string* in : {&c.ground, &c.track, &c.snow_depth})
-      if (!in->empty() && fs::equivalent(*out, *in, ec))
-        usage_error("output '" + *out + "' is also an input; write it elsewhere");
-  }
-  if (!c.disturbed.empty() && c.disturbed == c.output)
-    usage_error("--disturbed and -o name the same file");
-}
 
 marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
                                       const terrain::HeightField& ground) {
@@ -56,7 +44,9 @@ marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& tr
 }
 
 void run_marks(MarksCommand& c) {
-  refuse_input_as_output(c);
+  // Frames are each complete when written (they come one by one); the marked
+  // ground and the disturbed raster replace their files together at the end.
+  OutputSet outputs({c.output, c.disturbed}, {c.ground, c.track, c.snow_depth});
   TrackFile track = read_track_file(c.track);
   marks::MarksOptions o = c.options;
   o.step = track.step;
@@ -79,15 +69,16 @@ void run_marks(MarksCommand& c) {
       return true;
     };
   }
-  const marks::MarksResult r = marks::simulate_marks(ground, track.objects, std::move(materials),
-                                                     o, on_step, terminal_progress("marks"));
+  const marks::MarksResult r = marks::simulate_marks(ground, track.objects, std::move(materials), o,
+                                                     on_step, terminal_progress("marks"));
   terrain::write_geotiff(r.heights, c.output, {"ground height with marks (m)", "m"});
-  std::printf("marks: wrote %s\n", c.output.c_str());
   if (!c.disturbed.empty()) {
     terrain::write_geotiff(r.disturbed, c.disturbed,
                            {"ground disturbed by marks (m compressed, displaced or slid)", "m"});
-    std::printf("marks: wrote %s\n", c.disturbed.c_str());
   }
+  outputs.commit();
+  std::printf("marks: wrote %s\n", c.output.c_str());
+  if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
   std::printf("marks: %d steps; %.6g m3 under objects: %.6g displaced, %.6g compressed away\n",
               r.report.steps, r.report.collided, r.report.displaced, r.report.compressed);
 }
@@ -101,25 +92,30 @@ void add_marks_command(CLI::App& root) {
       "marks of objects in soft ground: footprints, tyre tracks, dragged objects in sand, mud "
       "and snow (paper 000)",
       [c] { run_marks(*c); });
-  sub->add_option("ground", c->ground, "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
+  sub->add_option("ground", c->ground,
+                  "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
       ->required();
-  sub->add_option("--track", c->track, "TOML track file: step, material, [[objects]] with keyframes")
+  sub->add_option("--track", c->track,
+                  "TOML track file: step, material, [[objects]] with keyframes")
       ->required();
   sub->add_option("-o,--output", c->output, "ground with the marks, GeoTIFF (m)")->required();
   sub->add_option("--material", c->material, "overrides every material: sand, mud or snow")
       ->check(CLI::IsMember({"sand", "mud", "snow"}));
   sub->add_option("--disturbed", c->disturbed,
                   "GeoTIFF of how much each cell was compressed, displaced or slid (m)");
-  sub->add_option("--frames", c->frames, "directory for the field after every step (frame_NNNNN.tif)");
+  sub->add_option("--frames", c->frames,
+                  "directory for the field after every step (frame_NNNNN.tif)");
   sub->add_option("--snow-depth", c->snow_depth,
                   "snow depth GeoTIFF (drift snow fall): snow where it lies, the ground's material "
                   "elsewhere");
-  sub->add_option("--snow-min", c->snow_min, "snow shallower than this (m) leaves the ground's material")
+  sub->add_option("--snow-min", c->snow_min,
+                  "snow shallower than this (m) leaves the ground's material")
       ->capture_default_str();
   sub->add_option("--memory-steps", c->options.memory_steps,
                   "steps a cell that slid keeps relaxing (paper 000, 3.5)")
       ->capture_default_str();
-  sub->add_option("--erosion-passes", c->options.erosion_passes, "most relaxation passes per erosion")
+  sub->add_option("--erosion-passes", c->options.erosion_passes,
+                  "most relaxation passes per erosion")
       ->capture_default_str();
   sub->add_option("--margin", c->options.margin, "free cells kept around an object's footprint")
       ->capture_default_str();

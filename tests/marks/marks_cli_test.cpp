@@ -33,7 +33,8 @@ fs::path ground(const fs::path& d) {
 // A ball pressed 3 cm into the ground's middle and lifted again.
 std::string track(const std::string& keyframes_extra = "", const std::string& top = "") {
   return "step = 0.1\n" + top +
-         "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR "/data/objects/ball.obj\"\n"
+         "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
+         "/data/objects/ball.obj\"\n"
          "scale = 0.5\n"
          "[[objects.keyframes]]\ntime = 0.0\nposition = [600000.32, 3999999.68, 2000.08]\n"
          "[[objects.keyframes]]\ntime = 0.3\nposition = [600000.32, 3999999.68, 2000.02]\n"
@@ -42,8 +43,8 @@ std::string track(const std::string& keyframes_extra = "", const std::string& to
 }
 
 int run(const std::string& args, const fs::path& d) {
-  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " marks " + args + " > " +
-                          (d / "out.txt").string() + " 2>&1";
+  const std::string cmd =
+      std::string(DRIFT_EXECUTABLE) + " marks " + args + " > " + (d / "out.txt").string() + " 2>&1";
   return WEXITSTATUS(std::system(cmd.c_str()));
 }
 
@@ -99,10 +100,11 @@ TEST(MarksCli, BadTrackFilesExitOneNamingTheProblemAndWriteNothing) {
   }
 }
 
-TEST(MarksCli, AnOutputThatIsAnInputIsAUsageError) {
+// Refused like any output that is an input (docs/outputs.md): exit 1.
+TEST(MarksCli, AnOutputThatIsAnInputIsRefused) {
   const fs::path d = dir(), g = ground(d);
   std::ofstream(d / "track.toml") << track();
-  EXPECT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " + g.string(), d), 2)
+  EXPECT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " + g.string(), d), 1)
       << output(d);
 }
 

@@ -112,7 +112,7 @@ std::vector<std::string> hidden_files(const fs::path& dir) {
 
 // A small metric DEM, a scene rendering it, two tiles and a PNG of it.
 struct Inputs {
-  fs::path dir, dem, scene, png, tile0, tile1;
+  fs::path dir, dem, scene, png, tile0, tile1, marks_ground, track;
 };
 
 // Made once per build of drift and shared by the test processes (CTest runs
@@ -127,6 +127,8 @@ Inputs make_inputs() {
   made.png = made.dir / "frame.png";
   made.tile0 = made.dir / "t0.exr";
   made.tile1 = made.dir / "t1.exr";
+  made.marks_ground = made.dir / "marks_ground.tif";
+  made.track = made.dir / "track.toml";
   fs::create_directories(made.dir);
   const int lock = open((made.dir / "lock").c_str(), O_RDWR | O_CREAT, 0644);
   flock(lock, LOCK_EX);
@@ -142,6 +144,16 @@ Inputs make_inputs() {
     EXPECT_EQ(drift(base + "-o " + made.png.string(), made.dir / "r0").status, 0);
     EXPECT_EQ(drift(base + "--tile 0/2 -o " + made.tile0.string(), made.dir / "r1").status, 0);
     EXPECT_EQ(drift(base + "--tile 1/2 -o " + made.tile1.string(), made.dir / "r2").status, 0);
+    // A ball pressed into 1 cm cells (as tests/marks/marks_cli_test.cpp).
+    drift::terrain::HeightField m(32, 32, 2000.0f, drift::terrain::local_georeference(0.01));
+    m.geo().geotransform[0] = 600000.0;
+    m.geo().geotransform[3] = 4000000.0;
+    drift::terrain::write_geotiff(m, made.marks_ground);
+    put(made.track,
+        "step = 0.1\n[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
+        "/data/objects/ball.obj\"\nscale = 0.2\n"
+        "[[objects.keyframes]]\ntime = 0.0\nposition = [600000.16, 3999999.84, 2000.04]\n"
+        "[[objects.keyframes]]\ntime = 0.2\nposition = [600000.16, 3999999.84, 2000.01]\n");
     put(made.dir / "stamp", stamp);
   }
   flock(lock, LOCK_UN);
@@ -169,12 +181,14 @@ const std::vector<Command>& commands() {
        in.tile0},
       {"compare", "compare " + png + " " + png + " --diff OUT", ".png", in.png},
       {"sheet", "sheet " + png + " -o OUT", ".png", in.png},
+      {"marks", "marks " + in.marks_ground.string() + " --track " + in.track.string() + " -o OUT",
+       ".tif", in.marks_ground},
   };
   return all;
 }
 
-const std::vector<std::string> kCommandNames = {"import", "dunes", "snow cover", "snow fall",
-                                                "render", "merge", "compare",    "sheet"};
+const std::vector<std::string> kCommandNames = {
+    "import", "dunes", "snow cover", "snow fall", "render", "merge", "compare", "sheet", "marks"};
 
 // The tests below run once per subcommand that writes (named in the test's name).
 class EachCommand : public ::testing::TestWithParam<std::string> {
