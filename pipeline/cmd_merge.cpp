@@ -24,12 +24,18 @@ struct MergeOptions {
 render::DisplayTransform display_of(const render::Image& frame, const CLI::App& sub,
                                     double exposure) {
   render::DisplayTransform d;
-  if (const std::string* e = frame.attribute("exposure")) d.exposure_ev = std::stod(*e);
+  if (const std::string* e = frame.attribute("exposure")) {
+    // "auto": the merged frame is metered (render/auto_exposure.h).
+    d.auto_exposure = *e == "auto";
+    d.exposure_ev = d.auto_exposure ? 0.0 : std::stod(*e);
+  }
+  if (const std::string* c = frame.attribute("exposure_compensation"); c && d.auto_exposure)
+    d.exposure_ev = std::stod(*c);
   if (const std::string* t = frame.attribute("tone"); t && *t == "clamp")
     d.curve = render::ToneCurve::Clamp;
   if (const std::string* w = frame.attribute("white_balance"); w && *w == "daylight")
     d.white_balance = render::kDaylightWhiteBalance;
-  if (sub.count("--exposure")) d.exposure_ev = exposure;
+  if (sub.count("--exposure")) d.exposure_ev = exposure, d.auto_exposure = false;
   return d;
 }
 

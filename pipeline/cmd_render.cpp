@@ -47,6 +47,14 @@ render::LocalTime parse_sun_time(const std::string& text) {
   }
 }
 
+// Says which exposure the PNGs got (a tile is metered when merged).
+void print_exposure(const render::Image& image, const render::DisplayTransform& display,
+                    bool whole_frame) {
+  if (!display.auto_exposure || !whole_frame) return;
+  const render::DisplayTransform fixed = render::resolve_exposure(image, display);
+  std::printf("exposure: metered %+.2f EV (--exposure EV fixes it)\n", fixed.exposure_ev);
+}
+
 void run_render(const RenderOptions& o, const CLI::App& sub) {
   SceneFile scene = read_scene_file(o.scene);
   if (o.spp > 0) scene.settings.samples_per_pixel = o.spp;
@@ -66,7 +74,10 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   if (sub.count("--seed")) scene.settings.seed = o.seed;
   // Placed over the DEM when the terrain is loaded, replacing [sun]'s direction.
   if (!o.sun_time.empty()) scene.sun_time = parse_sun_time(o.sun_time);
-  if (sub.count("--exposure")) scene.display.exposure_ev = o.exposure_ev;
+  if (sub.count("--exposure")) {  // a fixed exposure instead of the meter
+    scene.display.exposure_ev = o.exposure_ev;
+    scene.display.auto_exposure = false;
+  }
   if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
   if (!o.snow_cover.empty()) scene.snow_cover = o.snow_cover;
   if (!o.snow_depth.empty()) scene.snow_depth = o.snow_depth;
@@ -120,7 +131,9 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The display settings ride along so that `drift merge` can write the PNG.
   image.attributes = {
-      {"exposure", std::to_string(scene.display.exposure_ev)},
+      {"exposure", scene.display.auto_exposure ? "auto" : std::to_string(scene.display.exposure_ev)},
+      {"exposure_compensation",
+       std::to_string(scene.display.auto_exposure ? scene.display.exposure_ev : 0.0)},
       {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"},
       {"white_balance",
        scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
@@ -138,6 +151,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   }
   for (const auto& f : scene.outputs) std::printf("%s ", f.c_str());
   std::printf("\n");
+  print_exposure(image, scene.display, o.tile.empty());
 }
 
 }  // namespace
@@ -174,7 +188,8 @@ void add_render_command(CLI::App& root) {
                   "\"YYYY-MM-DD HH:MM[:SS] [UTC offset]\" (e.g. \"2026-10-15 17:05 +09:00\"; "
                   "default offset UTC); overrides [sun] azimuth/elevation or date/time");
   sub->add_option("--exposure", o->exposure_ev,
-                  "exposure of the PNG in EV (overrides [output] exposure; EXR stays linear)")
+                  "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
+                  "EXR stays linear)")
       ->check(CLI::Range(-20.0, 20.0));
   add_seed_option(*sub, o->seed);
 }

@@ -11,6 +11,7 @@
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
 #include "render/atmosphere.h"
+#include "render/land_form.h"
 #include "render/material.h"
 #include "render/solar_position.h"
 #include "render/surface.h"
@@ -32,6 +33,38 @@ const toml::table* subtable(const toml::table& root, const char* name, const fs:
     throw Error(file.string() + ": '" + name + "' must be a table ([" + name + "])");
   }
   return node->as_table();
+}
+
+// [output] exposure: "auto" (the default: metered, render/auto_exposure.h,
+// plus `exposure_compensation`) or a fixed number of EV.
+void read_exposure(Section& out, const toml::table* table, render::DisplayTransform& display) {
+  const toml::node* node = table ? table->get("exposure") : nullptr;
+  display.auto_exposure = !node || node->is_string();
+  if (node && node->is_string()) {
+    const std::string mode = *out.string("exposure");
+    if (mode != "auto") out.invalid("exposure", "is '" + mode + "'; use \"auto\" or a number of EV");
+  } else if (node) {
+    display.exposure_ev = out.number("exposure", 0.0, -20.0, 20.0);
+  }
+  const double compensation = out.number("exposure_compensation", 0.0, -20.0, 20.0);
+  if (compensation != 0.0 && !display.auto_exposure)
+    out.invalid("exposure_compensation", "needs exposure = \"auto\"; with a fixed exposure set that instead");
+  if (display.auto_exposure) display.exposure_ev = compensation;
+}
+
+
+// The detail keys of a material (render/ground_detail.h): `variation`,
+// `bump`, `bump_scale`, each over the preset's (or none).
+void read_detail(Section& s, render::MaterialOverride& m) {
+  const double variation = s.number("variation", -1.0, 0.0, 1.0);
+  const double bump = s.number("bump", -1.0, 0.0, 2.0);
+  const double scale = s.number("bump_scale", -1.0, 0.01, 100.0);
+  if (variation < 0.0 && bump < 0.0 && scale < 0.0) return;
+  render::GroundDetail d = m.detail.value_or(render::GroundDetail{});
+  if (variation >= 0.0) d.variation = static_cast<float>(variation);
+  if (bump >= 0.0) d.bump = static_cast<float>(bump);
+  if (scale >= 0.0) d.scale = static_cast<float>(scale);
+  m.detail = d;
 }
 
 // The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
@@ -56,6 +89,7 @@ render::MaterialOverride read_material(Section& s, std::string& preset) {
     m.roughness = static_cast<float>(r);
   if (const double w = s.number("wetness", -1.0, 0.0, 1.0); w >= 0.0)
     m.wetness = static_cast<float>(w);
+  read_detail(s, m);
   return m;
 }
 
@@ -105,6 +139,8 @@ render::MaterialRule read_rule(const toml::table* table, const fs::path& file, s
   rule.name = coverage_name(s, preset, "rule" + std::to_string(index + 1));
   rule.altitude = read_range(s, "altitude", -1e4, 1e5, 100.0);
   rule.slope = read_range(s, "slope", 0.0, 90.0, 5.0);
+  rule.position = read_range(s, "position", -5000.0, 5000.0, 10.0);
+  rule.altitude_jitter = static_cast<float>(s.number("altitude_jitter", 0.0, 0.0, 5000.0));
   rule.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
   s.finish();
   require_material(s, rule.material);
@@ -156,6 +192,7 @@ SceneFile read_scene_file(const fs::path& path) {
   scene.terrain_raster = resolve(*raster);
   in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
   scene.terrain_repeat = terrain.integer("repeat", 1, 1, 9);
+  scene.position_radius = terrain.number("position_radius", scene.position_radius, 1.0, 1e5);
   if (const auto map = terrain.string("albedo_map")) scene.albedo_map = resolve(*map);
   // Objects standing on the terrain from an objects file (as `drift snow fall
   // --objects` reads), in addition to any [[objects]] here.
@@ -324,7 +361,7 @@ SceneFile read_scene_file(const fs::path& path) {
 
   Section out(subtable(root, "output", path), "output", path);
   for (const std::string& f : out.strings("files")) scene.outputs.emplace_back(f);
-  scene.display.exposure_ev = out.number("exposure", 0.0, -20.0, 20.0);
+  read_exposure(out, subtable(root, "output", path), scene.display);
   const auto tone = out.string("tone");
   if (tone && *tone != "filmic" && *tone != "clamp") {
     throw Error(path.string() + ": 'output.tone' is '" + *tone + "'; use \"filmic\" or \"clamp\"");
@@ -416,6 +453,13 @@ void place_lonlat_camera(SceneFile& scene) {
   if (scene.camera_to_lonlat) scene.input.camera->to = place(*scene.camera_to_lonlat, "to_lonlat");
 }
 
+// True if a rule places its material by topographic position.
+bool uses_position(const render::TerrainSurface& surface) {
+  for (const render::MaterialRule& rule : surface.rules)
+    if (std::isfinite(rule.position.lo) || std::isfinite(rule.position.hi)) return true;
+  return false;
+}
+
 }  // namespace
 
 void load_scene_terrain(SceneFile& scene) {
@@ -433,6 +477,8 @@ void load_scene_terrain(SceneFile& scene) {
   }
   for (std::size_t i = 0; i < scene.layer_masks.size(); ++i)
     surface.layers[i].mask = read_metric_raster(scene.layer_masks[i]);
+  if (uses_position(surface))
+    surface.position = render::topographic_position(scene.input.terrain, scene.position_radius);
   if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);
   if (!scene.snow_depth.empty()) surface.snow_depth = read_metric_raster(scene.snow_depth);
   if (!scene.ripples.empty() && surface.ripples) {

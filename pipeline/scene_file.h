@@ -32,6 +32,7 @@ struct SceneFile {
   // with per-vertex "object" and "snow_coverage"), replacing their meshes.
   std::filesystem::path snow_objects;
   std::optional<double> ripple_texel_metres;  // default: the ripple raster's cell size
+  double position_radius = 150.0;  // [terrain] position_radius: metres (render/land_form.h)
   int terrain_repeat = 1;  // [terrain] repeat: a tileable terrain laid out n x n (odd)
   // [camera] from_lonlat / to_lonlat: resolved into input.camera by
   // load_scene_terrain.

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "render/auto_exposure.h"
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
 
@@ -173,6 +174,14 @@ static std::vector<std::uint8_t> to_srgb8(const Image& linear, const DisplayTran
   return out;
 }
 
+DisplayTransform resolve_exposure(const Image& linear, const DisplayTransform& display) {
+  if (!display.auto_exposure) return display;
+  DisplayTransform fixed = display;
+  fixed.exposure_ev += meter_exposure(linear, display.white_balance).exposure_ev;
+  fixed.auto_exposure = false;
+  return fixed;
+}
+
 void write_png(const Image& linear, const std::filesystem::path& path,
                const DisplayTransform& display) {
   if (lower_extension(path) != ".png") {
@@ -187,7 +196,7 @@ void write_png(const Image& linear, const std::filesystem::path& path,
     throw Error("exposure " + std::to_string(display.exposure_ev) + " EV for " + path.string() +
                 " is out of range; use a value in [-64, 64]");
   }
-  const std::vector<std::uint8_t> bytes = to_srgb8(linear, display, path);
+  const std::vector<std::uint8_t> bytes = to_srgb8(linear, resolve_exposure(linear, display), path);
   AtomicFile file(path);
   OIIO::ImageSpec spec(linear.width, linear.height, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");

@@ -17,10 +17,14 @@ Image read_image(const std::filesystem::path& path);
 // Float32 EXR with ZIP compression holding every channel; written atomically.
 void write_exr(const Image& image, const std::filesystem::path& path);
 
-// 8-bit sRGB PNG of the R, G, B channels after `display` (exposure, tone curve);
-// written atomically.
+// 8-bit sRGB PNG of the R, G, B channels after `display` (exposure, metered
+// if display.auto_exposure, tone curve); written atomically.
 void write_png(const Image& linear, const std::filesystem::path& path,
                const DisplayTransform& display = {});
+
+// `display` with a metered exposure (render/auto_exposure.h) made fixed:
+// its exposure_ev added to the meter's when auto_exposure is on.
+DisplayTransform resolve_exposure(const Image& linear, const DisplayTransform& display);
 
 // Chooses by extension: .exr or .png (case-insensitive); anything else is an
 // error naming the path and the extensions allowed.

@@ -14,28 +14,55 @@ struct Preset {
 };
 
 // Linear sRGB albedos in the visible (what an RGB render sees), picked inside
-// the broadband ranges of Hartmann 1994 ("Global Physical Climatology",
-// table 4.2) and Oke 1987 ("Boundary Layer Climates", table 1.1):
+// measured ranges. Broadband figures (Hartmann 1994, "Global Physical
+// Climatology", table 4.2; Oke 1987, "Boundary Layer Climates", table 1.1)
+// overstate vegetation, whose broadband albedo is mostly near infrared.
 // - rock: weathered granite and scree, visible reflectance 0.2-0.35 in the
 //   USGS spectral library (Kokaly et al. 2017); basalt is far darker (~0.08).
+// - dark_rock: the andesite, welded tuff and hornfels of the Hotaka and
+//   Yarigatake massifs (Harayama et al. 2000, GSJ 1:50,000 geological sheet "Kamikochi"),
+//   grey to dark grey with lichen: visible reflectance 0.08-0.18 for andesites
+//   and lichen-covered rock in the USGS library (Kokaly et al. 2017); strongly
+//   varied (fresh faces, oxide stains, lichen), fractured relief.
+// - scree: talus of the same rock below the cliffs, fresher broken faces and
+//   no soil: a little lighter (0.15-0.22), granular relief of blocks of
+//   decimetres to a metre.
+// - meadow: alpine meadow in autumn (sedges and grasses turning straw and
+//   russet among Vaccinium): senescent leaves reflect more in the red than
+//   green ones (Asner 1998, Remote Sens. Environ. 64, 234-253): ~0.08-0.12.
+// - dwarf_pine: Pinus pumila scrub (haimatsu), a dense evergreen needle
+//   canopy: conifer canopies reflect 0.03-0.05 in the visible (Betts & Ball
+//   1997, J. Geophys. Res. 102(D24), 28901), the darkest green of the range;
+//   soft clumps of a few metres.
+// - forest: subalpine conifer forest (Abies mariesii, A. veitchii, Tsuga
+//   diversifolia) with Erman's birch turning yellow in October: conifer
+//   visible albedo 0.03-0.05 (Betts & Ball 1997), a little warmer for the
+//   birch; crowns of 3-5 m shade each other (very rough).
 // - sand: desert sand 0.25-0.40 (Hartmann), quartz sand tinted yellow by iron
 //   oxide coatings; luminance 0.38.
 // - mud: bare soil 0.10-0.25 dry, as low as 0.05 dark and wet (Oke); a dark
 //   soil (luminance 0.17) under a film of water, wetness 0.8, which darkens
 //   it to about 0.11 (render/bsdf.h, Lekner & Dorf 1988) and makes it shine.
-// - grass: broadband 0.16-0.26 (Oke), but most of that is near infrared; in
-//   the visible chlorophyll absorbs blue and red, leaving ~0.05-0.12 with a
-//   green peak (luminance 0.10). A canopy is very rough.
+// - grass: green grass in the visible, chlorophyll absorbing blue and red:
+//   ~0.05-0.12 with a green peak (luminance 0.10). A canopy is very rough.
 // - snow: fresh snow 0.75-0.95 (Hartmann), visible albedo of clean snow
 //   0.95-0.98 (Warren 1982, Rev. Geophys. 20(1)); a little blue. Half of its
 //   reflection through the forward-scattering lobe of render/bsdf.h.
+// Detail (render/ground_detail.h): albedo variation (relative standard
+// deviation), rms slope of the sub-cell relief and its largest wavelength.
 constexpr float kRough = 0.35f;
-const std::array<Preset, 5> kPresets = {{
-    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f}},
-    {"sand", {{0.45f, 0.37f, 0.26f}, 0.3f, 0.0f, 0.0f}},
-    {"mud", {{0.20f, 0.16f, 0.12f}, 0.1f, 0.8f, 0.0f}},
-    {"grass", {{0.07f, 0.12f, 0.04f}, 0.6f, 0.0f, 0.0f}},
-    {"snow", {{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f, 0.5f}},
+const std::array<Preset, 10> kPresets = {{
+    // name        albedo                  rough wet  fwd   variation bump scale
+    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f, {}}},
+    {"dark_rock", {{0.125f, 0.12f, 0.113f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f}}},
+    {"scree", {{0.18f, 0.17f, 0.155f}, 0.5f, 0.0f, 0.0f, {0.2f, 0.35f, 2.0f}}},
+    {"meadow", {{0.11f, 0.10f, 0.05f}, 0.7f, 0.0f, 0.0f, {0.3f, 0.2f, 3.0f}}},
+    {"dwarf_pine", {{0.028f, 0.042f, 0.022f}, 0.9f, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f}}},
+    {"forest", {{0.036f, 0.044f, 0.024f}, 1.0f, 0.0f, 0.0f, {0.35f, 0.6f, 4.5f}}},
+    {"sand", {{0.45f, 0.37f, 0.26f}, 0.3f, 0.0f, 0.0f, {}}},
+    {"mud", {{0.20f, 0.16f, 0.12f}, 0.1f, 0.8f, 0.0f, {}}},
+    {"grass", {{0.07f, 0.12f, 0.04f}, 0.6f, 0.0f, 0.0f, {}}},
+    {"snow", {{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f, 0.5f, {}}},
 }};
 
 }  // namespace
@@ -57,7 +84,7 @@ std::string material_preset_names() {
 }
 
 MaterialOverride full_override(const Material& m) {
-  return {m.albedo, m.roughness, m.wetness, m.forward_scattering};
+  return {m.albedo, m.roughness, m.wetness, m.forward_scattering, m.detail};
 }
 
 Material blend(const Material& under, const MaterialOverride& over, float t) {
@@ -67,6 +94,12 @@ Material blend(const Material& under, const MaterialOverride& over, float t) {
   if (over.wetness) out.wetness = under.wetness * (1 - t) + *over.wetness * t;
   if (over.forward_scattering) {
     out.forward_scattering = under.forward_scattering * (1 - t) + *over.forward_scattering * t;
+  }
+  if (over.detail) {
+    const GroundDetail& a = under.detail;
+    const GroundDetail& b = *over.detail;
+    out.detail = {a.variation * (1 - t) + b.variation * t, a.bump * (1 - t) + b.bump * t,
+                  a.scale * (1 - t) + b.scale * t};
   }
   return out;
 }
@@ -102,8 +135,9 @@ float SoftRange::weight(float x) const {
   return rise * fall;
 }
 
-float MaterialRule::weight(float altitude_m, float slope_deg) const {
-  return opacity * altitude.weight(altitude_m) * slope.weight(slope_deg);
+float MaterialRule::weight(float altitude_m, float slope_deg, float position_m) const {
+  return opacity * altitude.weight(altitude_m) * slope.weight(slope_deg) *
+         position.weight(position_m);
 }
 
 }  // namespace drift::render

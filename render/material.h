@@ -23,6 +23,14 @@ namespace drift::render {
 // Oren-Nayar sigma beyond which the model is not meant to be used (radians).
 constexpr float kMaxRoughness = 1.5f;
 
+// Relief and colour below the DEM's cell (render/ground_detail.h): procedural,
+// deterministic, filtered by the ray's footprint.
+struct GroundDetail {
+  float variation = 0.0f;  // relative standard deviation of the albedo (0.2: +-20 %)
+  float bump = 0.0f;       // rms slope of the sub-cell relief (tan of the facets' tilt)
+  float scale = 4.0f;      // metres: wavelength of the relief's largest features
+};
+
 struct Material {
   Eigen::Vector3f albedo{0.28f, 0.26f, 0.23f};
   float roughness = 0.0f;  // sigma of the facet slopes, radians; 0 is Lambert
@@ -30,15 +38,17 @@ struct Material {
   // Share of the reflection by a forward-scattering granular medium (snow:
   // single scattering by ice grains, render/bsdf.h); 0 plain rough diffuse.
   float forward_scattering = 0.0f;
+  GroundDetail detail{};  // none by default (objects, tests)
 };
 
 // Linear blend of every field: (1 - t) a + t b.
 Material mix(const Material& a, const Material& b, float t);
 
-// The named presets (rock, sand, mud, grass, snow), or nullopt for an unknown
+// The named presets (land classes: rock, dark_rock, scree, meadow, dwarf_pine,
+// forest; and sand, mud, grass, snow), or nullopt for an unknown
 // name. Values and their sources are in material.cpp.
 std::optional<Material> material_preset(std::string_view name);
-// "rock, sand, mud, grass, snow", for error messages.
+// The presets' names, comma-separated, for error messages.
 std::string material_preset_names();
 
 // The fields a rule or a layer sets; the others are left as they were beneath.
@@ -47,7 +57,10 @@ struct MaterialOverride {
   std::optional<float> roughness;
   std::optional<float> wetness;
   std::optional<float> forward_scattering;
-  bool empty() const { return !albedo && !roughness && !wetness && !forward_scattering; }
+  std::optional<GroundDetail> detail;
+  bool empty() const {
+    return !albedo && !roughness && !wetness && !forward_scattering && !detail;
+  }
 };
 // A preset as an override that sets every field.
 MaterialOverride full_override(const Material& m);
@@ -66,15 +79,19 @@ struct SoftRange {
 };
 
 // A material chosen by where the ground lies: weight = opacity x altitude
-// weight x slope weight. Altitude in metres above the DEM's datum (without
-// vertical exaggeration), slope in degrees of the unbumped terrain.
+// weight x slope weight x position weight. Altitude in metres above the DEM's
+// datum (without vertical exaggeration), slope in degrees of the unbumped
+// terrain, position the topographic position index in metres
+// (render/land_form.h: + on ridges, - in gullies).
 struct MaterialRule {
   std::string name = "rule";  // its coverage channel (render/coverage.h)
   MaterialOverride material;
   SoftRange altitude;
   SoftRange slope;
+  SoftRange position;
+  float altitude_jitter = 0.0f;  // metres: ragged altitude bounds (render/land_form.h)
   float opacity = 1.0f;
-  float weight(float altitude_m, float slope_deg) const;
+  float weight(float altitude_m, float slope_deg, float position_m = 0.0f) const;
 };
 
 // Kubelka-Munk reflectance of a layer over ground (Kubelka & Munk 1931; the

@@ -4,6 +4,8 @@
 #include <numbers>
 #include <string>
 
+#include "render/ground_detail.h"
+#include "render/land_form.h"
 #include "render/tonemap.h"
 #include "terrain/bilinear.h"
 #include "terrain/error.h"
@@ -88,9 +90,11 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
     ground = blend(ground, material, w);
     if (channels) cover(p.coverage, (channels->*entries)[i], w);
   };
+  const float position = surface.position ? sample_raster(*surface.position, x, y, 0.0f) : 0.0f;
   for (std::size_t i = 0; i < surface.rules.size(); ++i) {
     const MaterialRule& rule = surface.rules[i];
-    put_on_top(rule.material, rule.weight(relief.altitude, relief.slope_deg),
+    const float altitude = ragged_altitude(relief.altitude, rule.altitude_jitter, x, y, i);
+    put_on_top(rule.material, rule.weight(altitude, relief.slope_deg, position),
                &CoverageChannels::rules, i);
   }
   for (std::size_t i = 0; i < surface.layers.size(); ++i) {
@@ -136,6 +140,10 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
       p.normal = Eigen::Vector3f(base.x() - g.x(), base.y() - g.y(), 1.0f).normalized();
     }
   }
+  const DetailedGround detail = ground_detail(p.material, x, y, p.normal, footprint);
+  p.material.albedo = detail.albedo;
+  p.material.roughness = detail.roughness;
+  p.normal = detail.normal;
   return p;
 }
 

@@ -60,6 +60,9 @@ struct TerrainSurface {
   // or a land-cover colour map): linear R, G, B in [0, 1]; outside it the
   // ground material's colour.
   std::optional<std::array<terrain::HeightField, 3>> albedo_map;
+  // Topographic position index (render/land_form.h) for rules that use
+  // `position`, in the DEM's CRS; made from the DEM when the scene is loaded.
+  std::optional<terrain::HeightField> position;
 };
 
 // Reads a draped albedo image (GeoTIFF or any GDAL raster): 3 bands (or 1,

@@ -24,6 +24,9 @@ struct DisplayTransform {
   double exposure_ev = 0.0;  // multiply radiance by 2^exposure_ev before the curve
   ToneCurve curve = ToneCurve::Filmic;
   std::array<float, 3> white_balance{1.0f, 1.0f, 1.0f};  // R, G, B gains before the curve
+  // Meter each frame (render/auto_exposure.h) when it is written as PNG;
+  // exposure_ev is then added to the metered exposure as a compensation.
+  bool auto_exposure = false;
 };
 
 // Linear radiance -> display-linear value in [0, 1] (before the sRGB encoding).

@@ -14,10 +14,24 @@ using drift::terrain::HeightField;
 using drift::terrain::local_georeference;
 
 TEST(MaterialPresets, KnownNamesWithPlausibleAlbedos) {
-  EXPECT_EQ(material_preset_names(), "rock, sand, mud, grass, snow");
+  EXPECT_EQ(material_preset_names(),
+            "rock, dark_rock, scree, meadow, dwarf_pine, forest, sand, mud, grass, snow");
   auto lum = [](const Material& m) {
     return 0.2126f * m.albedo.x() + 0.7152f * m.albedo.y() + 0.0722f * m.albedo.z();
   };
+  // The land classes inside their measured visible ranges (material.cpp).
+  EXPECT_GT(lum(*material_preset("dark_rock")), 0.08f);
+  EXPECT_LT(lum(*material_preset("dark_rock")), 0.18f);
+  EXPECT_GT(lum(*material_preset("scree")), lum(*material_preset("dark_rock")));
+  EXPECT_LT(lum(*material_preset("dwarf_pine")), 0.05f);
+  EXPECT_LT(lum(*material_preset("forest")), 0.05f);
+  EXPECT_GT(material_preset("dwarf_pine")->albedo.y(), material_preset("dwarf_pine")->albedo.x());
+  EXPECT_GT(material_preset("meadow")->albedo.x(), material_preset("meadow")->albedo.z());
+  for (const char* name : {"dark_rock", "scree", "meadow", "dwarf_pine", "forest"}) {
+    EXPECT_GT(material_preset(name)->detail.variation, 0.0f) << name;
+    EXPECT_GT(material_preset(name)->detail.bump, 0.0f) << name;
+    EXPECT_LE(material_preset(name)->detail.scale, 10.0f) << name;  // below a 10 m cell
+  }
   EXPECT_GT(lum(*material_preset("snow")), 0.85f);
   EXPECT_GT(lum(*material_preset("sand")), lum(*material_preset("rock")));
   EXPECT_LT(lum(*material_preset("grass")), 0.15f);

@@ -1,0 +1,52 @@
+// Ground below the DEM's cell: per material (Material::detail), a relief of
+// procedural octaves bump-mapped onto the smooth DEM surface and a variation
+// of the albedo, both deterministic functions of the ground position and both
+// filtered by the ray's footprint (render/procedural_noise.h).
+//
+// | field     | meaning                                               | unit     |
+// |-----------|-------------------------------------------------------|----------|
+// | variation | relative standard deviation of the albedo             | fraction |
+// | bump      | rms slope of the relief when every octave is resolved | tan      |
+// | scale     | wavelength of the relief's largest octave (<= a cell) | metres   |
+//
+// What keeps the DEM's meaning: the relief's octaves are zero-mean value noise
+// of wavelengths from `scale` down to scale / 32, so its slope averaged over
+// a cell is ~0 and the mean surface is the DEM's (tested by averaging over
+// footprints); material rules and stage products see the unbumped slope.
+// Octaves smaller than the footprint are faded out rather than sampled (no
+// shimmer), and the slope variance they carried becomes Oren-Nayar roughness
+// (LEAN mapping, Olano & Baker 2010), so far ground keeps its matte, rough
+// look. The albedo varies over octaves of 128 m down to 0.5 m with more
+// weight on the large ones (Hurst exponent 0.3), so a far range shows
+// patches of lighter and darker rock and near ground a finer mottle; the
+// variation is a factor of mean 1, so a material's mean albedo is kept.
+#pragma once
+
+#include "render/material.h"
+
+namespace drift::render {
+
+// Albedo (variation) and shading normal (relief) of a point of ground.
+struct DetailedGround {
+  Eigen::Vector3f albedo;
+  Eigen::Vector3f normal;
+  float roughness;
+};
+
+// `material` at ground point (x, y) (CRS metres) with smooth unit normal
+// `normal` (z up), seen by a footprint `footprint` metres wide.
+DetailedGround ground_detail(const Material& material, double x, double y,
+                             const Eigen::Vector3f& normal, double footprint);
+
+// The relief's slope (dh/dx, dh/dy) and the slope variance the footprint
+// filtered away (for tests and the shading above).
+struct DetailSlope {
+  Eigen::Vector2f slope{0, 0};
+  float lost_variance = 0.0f;
+};
+DetailSlope detail_slope(const GroundDetail& detail, double x, double y, double footprint);
+
+// The albedo factor (mean 1) at (x, y) for a footprint.
+float albedo_factor(const GroundDetail& detail, double x, double y, double footprint);
+
+}  // namespace drift::render

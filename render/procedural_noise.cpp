@@ -1,0 +1,72 @@
+#include "render/procedural_noise.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "terrain/hash.h"
+
+namespace drift::render {
+
+namespace {
+
+// Lattice value in [-1, 1] of cell (i, j).
+float lattice(std::int64_t i, std::int64_t j, std::uint64_t seed) {
+  const std::uint64_t h = terrain::mix64(terrain::mix64(seed ^ static_cast<std::uint64_t>(i)) ^
+                                (static_cast<std::uint64_t>(j) * 0x9e3779b97f4a7c15ULL));
+  return static_cast<float>(h >> 40) * (2.0f / 16777216.0f) - 1.0f;
+}
+
+// Quintic fade 6t^5 - 15t^4 + 10t^3 and its derivative (Perlin 2002): the
+// gradient is continuous across cells.
+float fade(float t) { return t * t * t * (t * (6.0f * t - 15.0f) + 10.0f); }
+float fade_derivative(float t) { return 30.0f * t * t * (t - 1.0f) * (t - 1.0f); }
+
+}  // namespace
+
+NoiseSample value_noise(double x, double y, std::uint64_t seed) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const auto i = static_cast<std::int64_t>(fx), j = static_cast<std::int64_t>(fy);
+  const float tx = static_cast<float>(x - fx), ty = static_cast<float>(y - fy);
+  const float a = lattice(i, j, seed), b = lattice(i + 1, j, seed);
+  const float c = lattice(i, j + 1, seed), d = lattice(i + 1, j + 1, seed);
+  const float u = fade(tx), v = fade(ty);
+  const float k = a - b - c + d;
+  NoiseSample s;
+  s.value = a + (b - a) * u + (c - a) * v + k * u * v;
+  s.gradient = {fade_derivative(tx) * ((b - a) + k * v), fade_derivative(ty) * ((c - a) + k * u)};
+  return s;
+}
+
+int octave_count(const Octaves& o) {
+  int n = 1;
+  for (double w = o.largest * 0.5; w >= o.smallest * (1.0 - 1e-9); w *= 0.5) ++n;
+  return n;
+}
+
+FilteredNoise filtered_noise(double x, double y, const Octaves& o, float amplitude_at_largest,
+                             float hurst, double footprint) {
+  FilteredNoise out;
+  const int count = octave_count(o);
+  double wavelength = o.largest;
+  for (int i = 0; i < count; ++i, wavelength *= 0.5) {
+    const float amplitude =
+        amplitude_at_largest * static_cast<float>(std::pow(wavelength / o.largest, hurst));
+    // Kept whole above two footprints, gone below one (a mip-map's blend).
+    const float keep =
+        footprint > 0.0 ? static_cast<float>(std::clamp(wavelength / footprint - 1.0, 0.0, 1.0))
+                        : 1.0f;
+    const float slope_rms = amplitude * kNoiseGradientRms / static_cast<float>(wavelength);
+    // What the filter took of this octave: its share of the slope variance.
+    out.lost_slope_variance += (1.0f - keep * keep) * slope_rms * slope_rms;
+    if (keep <= 0.0f) continue;
+    // Each octave its own lattice (seed + i), shifted so lattices do not align.
+    const NoiseSample n =
+        value_noise(x / wavelength + 0.37 * i, y / wavelength + 0.71 * i, o.seed + 7919u * i);
+    out.value += keep * amplitude * n.value;
+    out.gradient += (keep * amplitude / static_cast<float>(wavelength)) * n.gradient;
+    ++out.octaves;
+  }
+  return out;
+}
+
+}  // namespace drift::render

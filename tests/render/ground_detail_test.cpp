@@ -1,0 +1,193 @@
+#include "render/ground_detail.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "render/bsdf.h"
+#include "render/color.h"
+#include "render/land_form.h"
+#include "terrain/error.h"
+#include "render/procedural_noise.h"
+
+namespace drift::render {
+namespace {
+
+GroundDetail rock_detail() { return material_preset("dark_rock")->detail; }
+
+TEST(ProceduralNoise, MomentsMatchTheConstants) {
+  // The constants that normalise the octaves are the noise's own moments.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-5e4, 5e4);
+  double s = 0, s2 = 0, g2 = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    const NoiseSample v = value_noise(u(rng), u(rng), 3);
+    s += v.value, s2 += v.value * v.value, g2 += v.gradient.squaredNorm();
+  }
+  EXPECT_NEAR(s / n, 0.0, 0.01);
+  EXPECT_NEAR(std::sqrt(s2 / n), kNoiseStd, 0.01);
+  EXPECT_NEAR(std::sqrt(g2 / n), kNoiseGradientRms, 0.02);
+}
+
+TEST(ProceduralNoise, GradientIsTheDerivative) {
+  for (const double x : {0.1, 3.7, -12.25}) {
+    const double y = 0.6 * x + 0.3, h = 1e-3;
+    const NoiseSample v = value_noise(x, y, 11);
+    const double dx = (value_noise(x + h, y, 11).value - value_noise(x - h, y, 11).value) / (2 * h);
+    const double dy = (value_noise(x, y + h, 11).value - value_noise(x, y - h, 11).value) / (2 * h);
+    EXPECT_NEAR(v.gradient.x(), dx, 5e-3);
+    EXPECT_NEAR(v.gradient.y(), dy, 5e-3);
+  }
+}
+
+void expect_cell_mean_kept(const GroundDetail& d);
+
+TEST(GroundDetail, CellScaleMeanSlopeIsKept) {
+  // The relief's slope averaged over a DEM cell (10 m) is ~0: the mean
+  // surface stays the DEM's. Point samples over 40 cells far from the origin.
+  for (const char* name : {"dark_rock", "scree", "meadow", "dwarf_pine", "forest"}) {
+    SCOPED_TRACE(name);
+    expect_cell_mean_kept(material_preset(name)->detail);
+  }
+}
+
+void expect_cell_mean_kept(const GroundDetail& d) {
+  double worst = 0.0, sum2 = 0.0;
+  for (int cell = 0; cell < 40; ++cell) {
+    const double x0 = 746000.0 + 37.0 * cell, y0 = 4030000.0 + 11.0 * cell;
+    Eigen::Vector2d mean(0, 0);
+    const int k = 48;
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; j < k; ++j)
+        mean += detail_slope(d, x0 + (i + 0.5) * 10.0 / k, y0 + (j + 0.5) * 10.0 / k, 0.0)
+                    .slope.cast<double>();
+    worst = std::max(worst, (mean / (k * k)).norm());
+    sum2 += (mean / (k * k)).squaredNorm();
+  }
+  // Against the relief's rms slope (0.6, 31 degrees): the cells' mean slopes
+  // are a twentieth of it in rms (1.7 degrees) and an eighth at worst.
+  const double rms = std::sqrt(sum2 / 40);
+  EXPECT_LT(rms, 0.05 * d.bump) << "rms cell-mean slope " << rms;
+  EXPECT_LT(worst, 0.125 * d.bump) << "largest cell-mean slope " << worst;
+}
+
+TEST(GroundDetail, FootprintFiltersToTheMeanAndKeepsTheVariance) {
+  const GroundDetail d = rock_detail();
+  // Up close every octave is there and nothing is lost.
+  const DetailSlope near = detail_slope(d, 746100.3, 4030200.7, 0.0);
+  EXPECT_EQ(near.lost_variance, 0.0f);
+  EXPECT_GT(near.slope.norm(), 0.0f);
+  // A footprint of a cell (10 m > the 6 m largest octave): the slope is the
+  // mean's (0) and its whole variance, bump^2, becomes roughness.
+  const DetailSlope far = detail_slope(d, 746100.3, 4030200.7, 10.0);
+  EXPECT_EQ(far.slope.norm(), 0.0f);
+  EXPECT_NEAR(far.lost_variance, d.bump * d.bump, 1e-4 * d.bump * d.bump);
+  // The point-sampled slopes' variance is the bump's.
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(0.0, 5000.0);
+  double g2 = 0;
+  for (int i = 0; i < 100000; ++i) g2 += detail_slope(d, u(rng), u(rng), 0.0).slope.squaredNorm();
+  EXPECT_NEAR(std::sqrt(g2 / 100000), d.bump, 0.05 * d.bump);
+}
+
+TEST(GroundDetail, AlbedoFactorKeepsTheMean) {
+  const GroundDetail d = rock_detail();
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(0.0, 20000.0);
+  double s = 0, s2 = 0;
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    const double f = albedo_factor(d, u(rng), u(rng), 0.0);
+    s += f, s2 += f * f;
+  }
+  EXPECT_NEAR(s / n, 1.0, 0.01);
+  EXPECT_NEAR(std::sqrt(s2 / n - (s / n) * (s / n)), d.variation, 0.15 * d.variation);
+}
+
+// A pixel seen from afar: a footprint F wide on flat ground of dark rock lit
+// by a sun 30 degrees up. Its true value is the mean over the footprint of
+// point-sampled shading (albedo x cos); 4 samples with the footprint filter
+// must be far closer to it than 4 point samples (which alias: shimmer).
+TEST(GroundDetail, FarDetailDoesNotAlias) {
+  const Material rock = *material_preset("dark_rock");
+  const Eigen::Vector3f sun = Eigen::Vector3f(0.8f, 0.2f, 0.5f).normalized();
+  const Eigen::Vector3f up(0, 0, 1);
+  const Eigen::Vector3f eye = Eigen::Vector3f(-0.9f, 0.1f, 0.35f).normalized();
+  // Radiance under a unit sun through the ground's BSDF: bumped normal and
+  // the material's roughness point-sampled, the flat normal and the
+  // filtered-away relief as roughness with the footprint.
+  auto shade = [&](double x, double y, double footprint) {
+    const DetailedGround g = ground_detail(rock, x, y, up, footprint);
+    Material m = rock;
+    m.albedo = g.albedo;
+    m.roughness = g.roughness;
+    const GroundBsdf bsdf(g.normal, eye, m);
+    return luminance(bsdf.eval(sun)) * std::max(0.0f, g.normal.dot(sun));
+  };
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double footprint = 3.0;  // metres: a pixel a few km away
+  double err_filtered = 0, err_point = 0, mean_reference = 0;
+  const int pixels = 120;
+  for (int p = 0; p < pixels; ++p) {
+    const double x0 = 746000.0 + 3.0 * p, y0 = 4030000.0;
+    double reference = 0, filtered = 0, point = 0;
+    for (int i = 0; i < 1024; ++i)
+      reference += shade(x0 + footprint * u(rng), y0 + footprint * u(rng), 0.0) / 1024;
+    for (int i = 0; i < 4; ++i) {
+      const double x = x0 + footprint * u(rng), y = y0 + footprint * u(rng);
+      filtered += shade(x, y, footprint) / 4;
+      point += shade(x, y, 0.0) / 4;
+    }
+    err_filtered += (filtered - reference) * (filtered - reference);
+    err_point += (point - reference) * (point - reference);
+    mean_reference += reference / pixels;
+  }
+  const double rms_filtered = std::sqrt(err_filtered / pixels) / mean_reference;
+  const double rms_point = std::sqrt(err_point / pixels) / mean_reference;
+  // Relative rms error against the 1024-sample mean: the filter removes the
+  // sub-pixel relief's noise (what remains is the albedo's and the relief's
+  // octaves above the footprint, which the 4 samples resolve).
+  EXPECT_LT(rms_filtered, 0.5 * rms_point) << rms_filtered << " vs " << rms_point;
+  std::printf("far detail, relative rms error against 1024 samples: filtered %.4f, point %.4f\n",
+              rms_filtered, rms_point);
+}
+
+TEST(LandForm, TopographicPositionOfPlaneAndValley) {
+  terrain::HeightField plane(41, 41, 0.0f, terrain::local_georeference(10.0));
+  terrain::HeightField valley = plane;
+  for (int r = 0; r < 41; ++r)
+    for (int c = 0; c < 41; ++c) {
+      plane(c, r) = 3.0f * c - 2.0f * r;
+      valley(c, r) = 5.0f * std::abs(c - 20);
+    }
+  const terrain::HeightField tp = topographic_position(plane, 50.0);
+  EXPECT_NEAR(tp(20, 20), 0.0f, 1e-3f);  // a plane has no ridges or gullies
+  const terrain::HeightField tv = topographic_position(valley, 50.0);
+  // The valley floor lies below its surroundings: mean of 5|dc| over dc in
+  // [-5, 5] is 5 x 30 / 11.
+  EXPECT_NEAR(tv(20, 20), -5.0f * 30.0f / 11.0f, 1e-3f);
+  EXPECT_GT(tv(8, 20), 0.0f - 1e-3f);
+  EXPECT_THROW(topographic_position(plane, 0.0), Error);
+}
+
+TEST(LandForm, RaggedAltitudeStaysNearTheBound) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 20000.0);
+  double s = 0, worst = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double d = ragged_altitude(2500.0f, 100.0f, u(rng), u(rng), 2) - 2500.0;
+    s += d, worst = std::max(worst, std::abs(d));
+  }
+  EXPECT_NEAR(s / 20000, 0.0, 5.0);
+  EXPECT_LT(worst, 200.0);
+  EXPECT_GT(worst, 40.0);
+  EXPECT_EQ(ragged_altitude(2500.0f, 0.0f, 1.0, 2.0, 0), 2500.0f);
+  EXPECT_EQ(ragged_altitude(2500.0f, 50.0f, 1.0, 2.0, 0), ragged_altitude(2500.0f, 50.0f, 1.0, 2.0, 0));
+}
+
+}  // namespace
+}  // namespace drift::render
