@@ -1,6 +1,7 @@
 // drift marks GROUND.tif --track TRACK.toml -o OUT.tif: marks that objects
 // moving along keyframes leave in soft ground (paper 000, terrain/marks/marks.h).
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -23,27 +24,34 @@ namespace fs = std::filesystem;
 struct MarksCommand {
   std::string ground, track, output, material, disturbed, frames, snow_depth, renderer = "cpu";
   double snow_min = 0.01;
+  bool add_snow = false;
   marks::MarksOptions options;
 };
 
-marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
-                                      const terrain::HeightField& ground) {
-  marks::Material base = track.material.value_or(*marks::material_preset("sand"));
-  if (!c.material.empty()) base = *marks::material_preset(c.material);
-  if (c.snow_depth.empty()) return marks::MaterialField{{base}, {}};
-  const terrain::HeightField depth = terrain::read_raster(c.snow_depth);
+// The snow-depth raster, of the ground's size.
+terrain::HeightField read_snow_depth(const MarksCommand& c, const terrain::HeightField& ground) {
+  terrain::HeightField depth = terrain::read_raster(c.snow_depth);
   if (depth.width() != ground.width() || depth.height() != ground.height()) {
     throw Error("snow depth '" + c.snow_depth + "' is " + std::to_string(depth.width()) + " x " +
                 std::to_string(depth.height()) + " cells but the ground is " +
                 std::to_string(ground.width()) + " x " + std::to_string(ground.height()) +
                 "; give the depth drift snow fall made on this ground");
   }
+  return depth;
+}
+
+marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
+                                      const terrain::HeightField& depth) {
+  marks::Material base = track.material.value_or(*marks::material_preset("sand"));
+  if (!c.material.empty()) base = *marks::material_preset(c.material);
+  if (depth.empty()) return marks::MaterialField{{base}, {}};
   const marks::Material snow =
       c.material.empty() ? *marks::material_preset("snow") : *marks::material_preset(c.material);
   return marks::materials_from_snow_depth(depth, c.snow_min, base, snow);
 }
 
 void run_marks(MarksCommand& c) {
+  if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
   // Frames are each complete when written (they come one by one); the marked
   // ground and the disturbed raster replace their files together at the end.
   OutputSet outputs({c.output, c.disturbed}, {c.ground, c.track, c.snow_depth});
@@ -55,9 +63,17 @@ void run_marks(MarksCommand& c) {
   o.track_disturbed = !c.disturbed.empty();
   if (!c.material.empty())
     for (marks::MarkObject& obj : track.objects) obj.material.reset();  // --material overrides all
-  const terrain::HeightField ground = terrain::read_raster(c.ground);
+  terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);
-  marks::MaterialField materials = ground_materials(c, track, ground);
+  terrain::HeightField depth;
+  if (!c.snow_depth.empty()) depth = read_snow_depth(c, ground);
+  if (c.add_snow) {  // mark the snow surface: ground + depth
+    for (std::size_t i = 0; i < ground.size(); ++i) {
+      const float d = depth.values()[i];
+      if (std::isfinite(d)) ground.values()[i] += d;
+    }
+  }
+  marks::MaterialField materials = ground_materials(c, track, depth);
   if (!c.frames.empty()) fs::create_directories(c.frames);
   marks::StepFn on_step;
   if (!c.frames.empty()) {
@@ -108,6 +124,9 @@ void add_marks_command(CLI::App& root) {
   sub->add_option("--snow-depth", c->snow_depth,
                   "snow depth GeoTIFF (drift snow fall): snow where it lies, the ground's material "
                   "elsewhere");
+  sub->add_flag("--add-snow", c->add_snow,
+                "mark the snow surface: GROUND + the --snow-depth raster (the output is that "
+                "surface with the marks)");
   sub->add_option("--snow-min", c->snow_min,
                   "snow shallower than this (m) leaves the ground's material")
       ->capture_default_str();
