@@ -1,7 +1,10 @@
 // drift render SCENE.toml: path-trace a scene file into EXR and/or PNG.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <regex>
 
@@ -53,6 +56,26 @@ void print_exposure(const render::Image& image, const render::DisplayTransform& 
   if (!display.auto_exposure || !whole_frame) return;
   const render::DisplayTransform fixed = render::resolve_exposure(image, display);
   std::printf("exposure: metered %+.2f EV (--exposure EV fixes it)\n", fixed.exposure_ev);
+}
+
+// Which scene and settings an image comes from, recorded in it so that drift
+// merge refuses tiles of different renders: FNV-1a of the scene file's bytes and
+// of every option that changes pixels (not --tile, not the outputs).
+std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
+  std::ifstream in(o.scene, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  for (const std::string& part :
+       {o.size, o.terrain, o.snow_cover, o.snow_depth, o.snow_objects, o.ripples, o.sun_time,
+        std::to_string(scene.settings.samples_per_pixel),
+        std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
+        std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)}) {
+    text.append("\n").append(part);
+  }
+  std::uint64_t hash = 14695981039346656037ull;
+  for (unsigned char c : text) hash = (hash ^ c) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
 }
 
 void run_render(const RenderOptions& o, const CLI::App& sub) {
@@ -131,12 +154,14 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The display settings ride along so that `drift merge` can write the PNG.
   image.attributes = {
-      {"exposure", scene.display.auto_exposure ? "auto" : std::to_string(scene.display.exposure_ev)},
+      {"exposure",
+       scene.display.auto_exposure ? "auto" : std::to_string(scene.display.exposure_ev)},
       {"exposure_compensation",
        std::to_string(scene.display.auto_exposure ? scene.display.exposure_ev : 0.0)},
       {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"},
       {"white_balance",
-       scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
+       scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"},
+      {"scene", scene_identity(o, scene)}};
   for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
   outputs.commit();
   if (scene.settings.noise_target > 0.0f) {
@@ -187,9 +212,10 @@ void add_render_command(CLI::App& root) {
                   "put the sun where it stands over the DEM at this local time, "
                   "\"YYYY-MM-DD HH:MM[:SS] [UTC offset]\" (e.g. \"2026-10-15 17:05 +09:00\"; "
                   "default offset UTC); overrides [sun] azimuth/elevation or date/time");
-  sub->add_option("--exposure", o->exposure_ev,
-                  "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
-                  "EXR stays linear)")
+  sub->add_option(
+         "--exposure", o->exposure_ev,
+         "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
+         "EXR stays linear)")
       ->check(CLI::Range(-20.0, 20.0));
   add_seed_option(*sub, o->seed);
 }

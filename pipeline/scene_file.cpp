@@ -42,16 +42,17 @@ void read_exposure(Section& out, const toml::table* table, render::DisplayTransf
   display.auto_exposure = !node || node->is_string();
   if (node && node->is_string()) {
     const std::string mode = *out.string("exposure");
-    if (mode != "auto") out.invalid("exposure", "is '" + mode + "'; use \"auto\" or a number of EV");
+    if (mode != "auto")
+      out.invalid("exposure", "is '" + mode + "'; use \"auto\" or a number of EV");
   } else if (node) {
     display.exposure_ev = out.number("exposure", 0.0, -20.0, 20.0);
   }
   const double compensation = out.number("exposure_compensation", 0.0, -20.0, 20.0);
   if (compensation != 0.0 && !display.auto_exposure)
-    out.invalid("exposure_compensation", "needs exposure = \"auto\"; with a fixed exposure set that instead");
+    out.invalid("exposure_compensation",
+                "needs exposure = \"auto\"; with a fixed exposure set that instead");
   if (display.auto_exposure) display.exposure_ev = compensation;
 }
-
 
 // The detail keys of a material (render/ground_detail.h): `variation`,
 // `bump`, `bump_scale`, each over the preset's (or none).
@@ -168,6 +169,20 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
 
 }  // namespace
 
+// Lens values of 0 mean "not given"; given ones must be large enough that their
+// reciprocals stay finite.
+void check_lens(const render::Camera& c, const fs::path& path) {
+  auto refuse = [&](const char* key, double v, const char* least) {
+    throw Error(path.string() + ": 'camera." + key + "' is " + Section::fmt(v) +
+                "; give 0 (none) or at least " + least);
+  };
+  if (c.focal_length_mm && *c.focal_length_mm < 0.1)
+    refuse("focal_length", *c.focal_length_mm, "0.1 mm");
+  if (c.f_number > 0.0 && c.f_number < 0.5) refuse("f_number", c.f_number, "0.5");
+  if (c.focus_distance && *c.focus_distance < 1e-3)
+    refuse("focus_distance", *c.focus_distance, "1 mm");
+}
+
 SceneFile read_scene_file(const fs::path& path) {
   const toml::table root = parse_toml_file(path, "scene");
   static const std::set<std::string> sections = {"terrain", "snow",   "ripples", "sun",    "sky",
@@ -233,7 +248,8 @@ SceneFile read_scene_file(const fs::path& path) {
                   "drift dunes --model ripples)");
     scene.ripples = resolve(*ripple_raster);
     render::RippleLayer layer;
-    const double cell = rip.number("cell", 0.0, 0.0, 100.0);
+    // At least 0.1 mm: the bump map divides by it (1e-39 overflowed inside Embree).
+    const double cell = rip.number("cell", 0.0, 1e-4, 100.0);
     if (cell > 0.0) scene.ripple_texel_metres = cell;
     layer.rotation_deg = rip.number("rotation", 0.0, -360.0, 360.0);
     layer.strength = static_cast<float>(rip.number("strength", 1.0, 0.0, 100.0));
@@ -323,6 +339,14 @@ SceneFile read_scene_file(const fs::path& path) {
     if (const double d = cam.number("focus_distance", 0.0, 0.0, 1e8); d > 0.0)
       camera.focus_distance = d;
     cam.finish();
+    check_lens(camera, path);
+    for (const auto& [key, ll] :
+         {std::pair{"from_lonlat", from_lonlat}, {"to_lonlat", to_lonlat}}) {
+      if (ll && std::fabs((*ll)[1]) > 90.0) {
+        throw Error(path.string() + ": 'camera." + key + "' latitude " + Section::fmt((*ll)[1]) +
+                    " is off the globe; latitudes lie in [-90, 90]");
+      }
+    }
     if (camera.f_number > 0.0 && !camera.focal_length_mm)
       throw Error(path.string() + ": 'camera.f_number' needs 'camera.focal_length' (millimetres)");
     if (from && from_lonlat)
@@ -360,7 +384,8 @@ SceneFile read_scene_file(const fs::path& path) {
   rs.finish();
 
   Section out(subtable(root, "output", path), "output", path);
-  for (const std::string& f : out.strings("files")) scene.outputs.emplace_back(f);
+  // Relative to the scene file, like every path in it (docs/rendering.md).
+  for (const std::string& f : out.strings("files")) scene.outputs.emplace_back(resolve(f));
   read_exposure(out, subtable(root, "output", path), scene.display);
   const auto tone = out.string("tone");
   if (tone && *tone != "filmic" && *tone != "clamp") {

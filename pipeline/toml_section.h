@@ -170,12 +170,15 @@ class Section {
   [[noreturn]] void fail(const char* key, const toml::node& node, const std::string& what) const {
     throw Error(where(node) + ": '" + name_ + "." + key + "' " + what);
   }
+
+ public:
   static std::string fmt(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", v);
     return buf;
   }
 
+ private:
   const toml::table* table_;
   std::string name_;
   std::filesystem::path file_;

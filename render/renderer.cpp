@@ -22,6 +22,7 @@
 #include "render/sky_sampler.h"
 #include "terrain/direction.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::render {
 
@@ -164,6 +165,12 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   for (const std::string& name : scene.coverage_names()) channels.push_back("coverage." + name);
   channels.emplace_back("mask.sky");
   if (settings.noise_target > 0.0f) channels.emplace_back("samples");
+  // The image and the film's per-pixel sums (about as much again).
+  require_memory(
+      static_cast<std::uint64_t>(settings.width) * band * channels.size() * sizeof(float) * 2,
+      "a " + std::to_string(settings.width) + " x " + std::to_string(band) + " image of " +
+          std::to_string(channels.size()) + " channels",
+      "render a smaller --size, or the frame in --tile bands joined by drift merge");
   Image image(settings.width, band, channels);
 
   if (band != settings.height) image.frame = {0, row_begin, settings.width, settings.height};

@@ -14,6 +14,7 @@
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/memory.h"
 
 namespace drift::snow {
 
@@ -147,7 +148,8 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
   require(o.sun_range_deg >= 0.0 && o.sun_range_deg <= 90.0, "--sun-range must lie in [0, 90]");
   require(o.radius_m >= 0.0 && std::isfinite(o.radius_m), "--radius must be positive (metres)");
   require(o.radius_cells > 0.0, "--radius-cells must be positive");
-  require(o.band_m > 0.0, "--band must be positive (metres)");
+  require(o.band_m > 0.0 && std::isfinite(o.band_m), "--band must be positive (metres)");
+  require(!o.snow_line_m || std::isfinite(*o.snow_line_m), "--snow-line must be a finite height");
   require(dem.width() >= 3 && dem.height() >= 3, "the DEM must be at least 3 x 3 cells");
   require(dem.geo().north_up() && dem.geo().cell_size_x() > 0 && dem.geo().cell_size_y() > 0,
           "the DEM must be north-up with positive cell sizes; warp it with drift import");
@@ -158,6 +160,11 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
   require(nodata == 0, "the DEM has " + std::to_string(nodata) +
                            " nodata cells; drift import fills them (run it first)");
 
+  // The smoothed field, the TSA, the descriptor and two working grids.
+  require_memory(dem.size() * sizeof(float) * 6,
+                 "the snow cover of a " + std::to_string(dem.width()) + " x " +
+                     std::to_string(dem.height()) + " DEM",
+                 "crop or resample the DEM first (drift import --crop, --resample)");
   CoverResult result;
   bool southern = false;
   if (o.hemisphere == Hemisphere::South) southern = true;

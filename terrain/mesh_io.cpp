@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -18,8 +19,33 @@ namespace drift::terrain {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// tinyobjloader reads "v nan 0 0" (or "v 1e999 ...") as a finite vertex without
+// a word: every vertex line is checked here first, naming the line.
+void require_finite_obj_vertices(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
+    std::istringstream words(line.substr(2));
+    std::string word;
+    for (int k = 0; k < 3 && words >> word; ++k) {
+      char* end = nullptr;
+      const double v = std::strtod(word.c_str(), &end);
+      if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
+        throw Error("mesh '" + path.string() + "', line " + std::to_string(number) +
+                    ": vertex coordinate '" + word + "' is not a finite number");
+      }
+    }
+  }
+}
+
+}  // namespace
+
 Mesh read_obj(const fs::path& path, bool y_up) {
   check_input_file(path, "mesh");
+  require_finite_obj_vertices(path);
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
@@ -193,8 +219,16 @@ Mesh read_ply(const fs::path& path) {
     }
   }
   if (line != "end_header") throw bad("no end_header");
-  if (vertices > (std::size_t{1} << 31) || faces > (std::size_t{1} << 31)) {
-    throw bad("implausible element counts");
+  // What the header declares must be in the file, before anything is allocated.
+  const std::streampos body = f.tellg();
+  f.seekg(0, std::ios::end);
+  const auto left = static_cast<std::uintmax_t>(f.tellg() - body);
+  f.seekg(body);
+  const std::uintmax_t needed = static_cast<std::uintmax_t>(vertices) * properties.size() * 4 +
+                                static_cast<std::uintmax_t>(faces) * 13;
+  if (vertices > (std::size_t{1} << 31) || faces > (std::size_t{1} << 31) || needed > left) {
+    throw bad("the header declares " + std::to_string(vertices) + " vertices and " +
+              std::to_string(faces) + " faces, more than the file holds (truncated?)");
   }
   std::vector<float> row(properties.size());
   std::vector<std::vector<float>> columns(properties.size(), std::vector<float>(vertices));
@@ -213,7 +247,12 @@ Mesh read_ply(const fs::path& path) {
   const auto *x = column("x"), *y = column("y"), *z = column("z");
   if (!x || !y || !z) throw bad("no x, y, z vertex properties");
   mesh.positions.resize(vertices);
-  for (std::size_t v = 0; v < vertices; ++v) mesh.positions[v] = {(*x)[v], (*y)[v], (*z)[v]};
+  for (std::size_t v = 0; v < vertices; ++v) {
+    mesh.positions[v] = {(*x)[v], (*y)[v], (*z)[v]};
+    if (!mesh.positions[v].allFinite()) {
+      throw bad("vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
   const auto *nx = column("nx"), *ny = column("ny"), *nz = column("nz");
   if (nx && ny && nz) {
     mesh.normals.resize(vertices);

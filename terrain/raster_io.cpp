@@ -71,6 +71,39 @@ GeoReference georeference_of(GDALDataset& ds, GDALRasterBand& band) {
   return geo;
 }
 
+// A cell size of 0, NaN or infinity (or a NaN origin) makes every slope, area and
+// position computed later meaningless.
+void require_usable_georeference(const GeoReference& geo, const fs::path& path) {
+  const auto& gt = geo.geotransform;
+  bool finite = true;
+  for (double v : gt) finite = finite && std::isfinite(v);
+  const double dx = std::hypot(gt[1], gt[4]), dy = std::hypot(gt[2], gt[5]);
+  if (!finite || !(dx > 0) || !(dy > 0) || !std::isfinite(1.0 / dx) || !std::isfinite(1.0 / dy)) {
+    char text[200];
+    std::snprintf(text, sizeof text, "%g, %g, %g, %g, %g, %g", gt[0], gt[1], gt[2], gt[3], gt[4],
+                  gt[5]);
+    throw Error("raster '" + path.string() + "' has an unusable georeference (geotransform " +
+                text +
+                "): cell sizes must be finite and non-zero; fix it with gdal_edit.py -a_ullr");
+  }
+}
+
+// Infinite heights are refused rather than guessed at; NaN is nodata (filled by
+// drift import, refused or handled by each stage).
+void require_finite_cells(const HeightField& grid, const fs::path& path) {
+  const float nd = grid.geo().nodata ? static_cast<float>(*grid.geo().nodata) : 0.0f;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const float v = grid.values()[i];
+    if (std::isinf(v) && !(grid.geo().nodata && v == nd)) {
+      const std::size_t col = i % static_cast<std::size_t>(grid.width());
+      const std::size_t row = i / static_cast<std::size_t>(grid.width());
+      throw Error("raster '" + path.string() + "' holds an infinite height (" +
+                  (v > 0 ? "+inf" : "-inf") + ") at column " + std::to_string(col) + ", row " +
+                  std::to_string(row) + "; declare it nodata or fix the cell");
+    }
+  }
+}
+
 }  // namespace
 
 void ensure_gdal() {
@@ -127,6 +160,7 @@ HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadO
                  "crop it (drift import --crop) or resample it to a coarser cell size first");
 
   GeoReference geo = georeference_of(*ds, *band);
+  require_usable_georeference(geo, path);
   // Shift the geotransform to the window's origin.
   auto& gt = geo.geotransform;
   gt[0] += win.x_off * gt[1] + win.y_off * gt[2];
@@ -141,6 +175,7 @@ HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadO
                 (g_last_gdal_message.empty() ? std::string("read failed") : g_last_gdal_message) +
                 " (the file may be truncated or corrupt)");
   }
+  require_finite_cells(grid, path);
   // Invalid cells become NaN in memory, whatever the file called them.
   if (geo.nodata) {
     const float nd = static_cast<float>(*geo.nodata);
