@@ -58,42 +58,25 @@ void print_exposure(const render::Image& image, const render::DisplayTransform& 
   std::printf("exposure: metered %+.2f EV (--exposure EV fixes it)\n", fixed.exposure_ev);
 }
 
-// Which scene and settings an image comes from, recorded in it so that drift
-// merge refuses tiles of different renders: FNV-1a of the scene file's bytes and
-// of every option that changes pixels (not --tile, not the outputs).
-std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
-  std::ifstream in(o.scene, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), {});
-  for (const std::string& part :
-       {o.size, o.terrain, o.snow_cover, o.snow_depth, o.snow_objects, o.ripples, o.sun_time,
-        std::to_string(scene.settings.samples_per_pixel),
-        std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
-        std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)}) {
-    text.append("\n").append(part);
+// --size WIDTHxHEIGHT into the settings.
+void apply_size(const std::string& size, render::RenderSettings& settings) {
+  std::smatch m;
+  if (!std::regex_match(size, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
+    usage_error("--size '" + size + "' must be WIDTHxHEIGHT, e.g. 1280x720");
   }
-  std::uint64_t hash = 14695981039346656037ull;
-  for (unsigned char c : text) hash = (hash ^ c) * 1099511628211ull;
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
+  settings.width = std::stoi(m[1]);
+  settings.height = std::stoi(m[2]);
+  if (settings.width < 1 || settings.height < 1 || settings.width > 16384 ||
+      settings.height > 16384) {
+    usage_error("--size '" + size + "': each side must be 1..16384");
+  }
 }
 
-void run_render(const RenderOptions& o, const CLI::App& sub) {
-  SceneFile scene = read_scene_file(o.scene);
+// The command line's overrides of the scene file.
+void apply_overrides(const RenderOptions& o, const CLI::App& sub, SceneFile& scene) {
   if (o.spp > 0) scene.settings.samples_per_pixel = o.spp;
   if (o.noise_target >= 0.0) scene.settings.noise_target = static_cast<float>(o.noise_target);
-  if (!o.size.empty()) {
-    std::smatch m;
-    if (!std::regex_match(o.size, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
-      usage_error("--size '" + o.size + "' must be WIDTHxHEIGHT, e.g. 1280x720");
-    }
-    scene.settings.width = std::stoi(m[1]);
-    scene.settings.height = std::stoi(m[2]);
-    if (scene.settings.width < 1 || scene.settings.height < 1 || scene.settings.width > 16384 ||
-        scene.settings.height > 16384) {
-      usage_error("--size '" + o.size + "': each side must be 1..16384");
-    }
-  }
+  if (!o.size.empty()) apply_size(o.size, scene.settings);
   if (sub.count("--seed")) scene.settings.seed = o.seed;
   // Placed over the DEM when the terrain is loaded, replacing [sun]'s direction.
   if (!o.sun_time.empty()) scene.sun_time = parse_sun_time(o.sun_time);
@@ -116,6 +99,10 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     scene.outputs.clear();
     for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
   }
+}
+
+// Outputs are PNG or EXR, a tile (--tile i/n) only EXR.
+void check_outputs(const RenderOptions& o, SceneFile& scene) {
   if (scene.outputs.empty()) {
     throw Error("nothing to write: give -o NAME.png|NAME.exr or [output] files in '" + o.scene +
                 "'");
@@ -127,18 +114,65 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       throw Error("cannot write '" + f.string() + "': use a .png or .exr file name");
     }
   }
-  if (!o.tile.empty()) {
-    const auto [index, count] = render::parse_tile(o.tile);
-    const render::RowRange rows = render::tile_rows(scene.settings.height, index, count);
-    scene.settings.row_begin = rows.begin;
-    scene.settings.row_end = rows.end;
-    for (const auto& f : scene.outputs) {
-      if (f.extension() != ".exr") {
-        throw Error("a tile is written as EXR (it keeps its place in the frame); '" + f.string() +
-                    "' is not: give -o TILE.exr and join the tiles with drift merge");
-      }
+  if (o.tile.empty()) return;
+  std::pair<int, int> tile;
+  try {
+    tile = render::parse_tile(o.tile);
+  } catch (const Error& e) {
+    usage_error(std::string("--") + e.what());
+  }
+  const auto [index, count] = tile;
+  const render::RowRange rows = render::tile_rows(scene.settings.height, index, count);
+  scene.settings.row_begin = rows.begin;
+  scene.settings.row_end = rows.end;
+  for (const auto& f : scene.outputs) {
+    if (f.extension() != ".exr") {
+      throw Error("a tile is written as EXR (it keeps its place in the frame); '" + f.string() +
+                  "' is not: give -o TILE.exr and join the tiles with drift merge");
     }
   }
+}
+
+// Which scene and settings an image comes from, recorded in it so that drift
+// merge refuses tiles of different renders: FNV-1a of the scene file's bytes and
+// of every option that changes pixels (not --tile, not the outputs).
+std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
+  std::ifstream in(o.scene, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  for (const std::string& part :
+       {o.size, o.terrain, o.snow_cover, o.snow_depth, o.snow_objects, o.ripples, o.sun_time,
+        std::to_string(scene.settings.samples_per_pixel),
+        std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
+        std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)}) {
+    text.append("\n").append(part);
+  }
+  std::uint64_t hash = 14695981039346656037ull;
+  for (unsigned char c : text) hash = (hash ^ c) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
+
+void print_summary(const SceneFile& scene, const render::Image& image,
+                   const render::RenderStats& stats, double seconds) {
+  if (scene.settings.noise_target > 0.0f) {
+    const double mean_spp =
+        static_cast<double>(stats.camera_rays) / (static_cast<double>(image.width) * image.height);
+    std::printf("rendered %dx%d at %.1f spp on average (noise target %g, at most %d) in %.1f s -> ",
+                image.width, image.height, mean_spp, scene.settings.noise_target,
+                scene.settings.samples_per_pixel, seconds);
+  } else {
+    std::printf("rendered %dx%d at %d spp in %.1f s -> ", image.width, image.height,
+                scene.settings.samples_per_pixel, seconds);
+  }
+  for (const auto& f : scene.outputs) std::printf("%s ", f.c_str());
+  std::printf("\n");
+}
+
+void run_render(const RenderOptions& o, const CLI::App& sub) {
+  SceneFile scene = read_scene_file(o.scene);
+  apply_overrides(o, sub, scene);
+  check_outputs(o, scene);
   std::vector<std::filesystem::path> inputs = scene_inputs(scene);
   inputs.emplace_back(o.scene);
   OutputSet outputs(scene.outputs, inputs);
@@ -164,18 +198,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       {"scene", scene_identity(o, scene)}};
   for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
   outputs.commit();
-  if (scene.settings.noise_target > 0.0f) {
-    const double mean_spp =
-        static_cast<double>(stats.camera_rays) / (static_cast<double>(image.width) * image.height);
-    std::printf("rendered %dx%d at %.1f spp on average (noise target %g, at most %d) in %.1f s -> ",
-                image.width, image.height, mean_spp, scene.settings.noise_target,
-                scene.settings.samples_per_pixel, seconds);
-  } else {
-    std::printf("rendered %dx%d at %d spp in %.1f s -> ", image.width, image.height,
-                scene.settings.samples_per_pixel, seconds);
-  }
-  for (const auto& f : scene.outputs) std::printf("%s ", f.c_str());
-  std::printf("\n");
+  print_summary(scene, image, stats, seconds);
   print_exposure(image, scene.display, o.tile.empty());
 }
 
@@ -183,12 +206,8 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
 
 void add_render_command(CLI::App& root) {
   auto o = std::make_shared<RenderOptions>();
-  // The action needs its own App (to ask whether --seed was given), which exists
-  // only after add_subcommand returns: hand it over through a shared slot.
-  auto self = std::make_shared<CLI::App*>(nullptr);
   CLI::App* sub = add_subcommand(root, "render", "path-trace a scene file (TOML) to EXR and/or PNG",
-                                 [o, self] { run_render(*o, **self); });
-  *self = sub;
+                                 [o](const CLI::App& self) { run_render(*o, self); });
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
   sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, 1 << 20));

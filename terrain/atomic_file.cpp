@@ -19,6 +19,7 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
     return;
   }
   check_output_path(target_, OutputSet::open_inputs());
+  DeferSignals defer;  // a signal between creating and recording would leave the file
   temp_ = create_temp_beside(target_);
   try {
     slot_ = register_temp(temp_);
@@ -49,7 +50,7 @@ void AtomicFile::commit() {
     return;
   }
   match_permissions(temp_, target_);
-  DeferSignals defer;
+  DeferSignals defer(true);
   fs::rename(temp_, target_, ec);
   if (ec) {
     throw Error("cannot move finished output onto '" + target_.string() + "': " + ec.message());

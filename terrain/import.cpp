@@ -10,6 +10,7 @@
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
+#include "terrain/parameter.h"
 #include "terrain/raster_dataset.h"
 #include "terrain/raster_io.h"
 
@@ -17,80 +18,12 @@ namespace drift::terrain {
 
 namespace fs = std::filesystem;
 
-std::array<double, 2> metres_per_degree(double lat_deg);
-
 namespace {
 
 std::string fmt(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
-}
-
-// Crop boxes of positive, finite area; lon/lat boxes on the globe.
-void check_crop_boxes(const ImportOptions& o) {
-  if (o.crop) {
-    const auto& b = *o.crop;
-    for (double v : b) {
-      if (!std::isfinite(v)) throw Error("--crop values must be finite numbers, got " + fmt(v));
-    }
-    if (!(b[0] < b[2] && b[1] < b[3])) {
-      throw Error("--crop " + fmt(b[0]) + "," + fmt(b[1]) + "," + fmt(b[2]) + "," + fmt(b[3]) +
-                  " has no area: give xmin,ymin,xmax,ymax with xmin < xmax and ymin < ymax");
-    }
-  }
-  if (o.crop_lonlat) {
-    const auto& b = *o.crop_lonlat;
-    for (double v : b) {
-      if (!std::isfinite(v)) {
-        throw Error("--crop-lonlat values must be finite numbers, got " + fmt(v));
-      }
-    }
-    if (b[1] < -90 || b[3] > 90 || b[0] < -180 || b[2] > 180) {
-      throw Error("--crop-lonlat " + fmt(b[0]) + "," + fmt(b[1]) + "," + fmt(b[2]) + "," +
-                  fmt(b[3]) +
-                  " leaves the globe: longitudes lie in [-180, 180], latitudes in "
-                  "[-90, 90]");
-    }
-    if (!(b[0] < b[2] && b[1] < b[3])) throw Error("--crop-lonlat needs W < E and S < N");
-  }
-}
-
-// Metres per CRS unit along x of a raster kept in its CRS (1 for a local grid).
-double metres_per_unit(const RasterHeader& h) {
-  const double dx = std::fabs(h.geo.cell_size_x());
-  return dx > 0 ? cell_size_metres(h.geo, h.width, h.height)[0] / dx : 1.0;
-}
-
-// The warped grid covers the crop box (or the source) at `cell`: checks it fits
-// in memory three times over (GDAL's grid, ours, the nodata filling's copy)
-// before GDAL allocates it. `unit_m` converts `cell` to metres.
-void require_warp_memory(const RasterHeader& h, const ImportOptions& o, double unit_m, double cell,
-                         const fs::path& path) {
-  const auto metric = cell_size_metres(h.geo, h.width, h.height);
-  double width_m = h.width * metric[0], height_m = h.height * metric[1];
-  if (o.crop) {
-    const auto& b = *o.crop;
-    const double dx = std::fabs(h.geo.cell_size_x()), dy = std::fabs(h.geo.cell_size_y());
-    width_m = (b[2] - b[0]) * (dx > 0 ? metric[0] / dx : 1.0);
-    height_m = (b[3] - b[1]) * (dy > 0 ? metric[1] / dy : 1.0);
-  } else if (o.crop_lonlat) {
-    const auto& b = *o.crop_lonlat;
-    const auto m = metres_per_degree(0.5 * (b[1] + b[3]));
-    width_m = (b[2] - b[0]) * m[0];
-    height_m = (b[3] - b[1]) * m[1];
-  }
-  const double cell_m = cell * unit_m;
-  const double cells = std::ceil(width_m / cell_m) * std::ceil(height_m / cell_m);
-  const double bytes = cells * sizeof(float) * 3.0;
-  const std::string what = "importing '" + path.string() + "' at " + fmt(cell_m) +
-                           " m cells (about " + fmt(std::ceil(width_m / cell_m)) + " x " +
-                           fmt(std::ceil(height_m / cell_m)) + ")";
-  const std::string fix = "crop it (--crop, --crop-lonlat) or give a coarser --resample";
-  if (!(cells < 2.0e9) || !std::isfinite(bytes)) {
-    throw Error(what + " is too large a grid; " + fix);
-  }
-  require_memory(static_cast<std::uint64_t>(bytes), what, fix);
 }
 
 }  // namespace
@@ -157,64 +90,106 @@ std::size_t fill_nodata(HeightField& g, const std::string& what) {
   return filled;
 }
 
-ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
-  if (o.crop && o.crop_lonlat) throw Error("give --crop or --crop-lonlat, not both");
-  if (o.resample_m && !(*o.resample_m > 0 && std::isfinite(*o.resample_m))) {
-    throw Error("--resample must be a positive cell size in metres");
-  }
-  if (!(o.exaggeration > 0 && o.exaggeration <= 100)) {
-    throw Error("--exaggerate must lie in (0, 100], got " + fmt(o.exaggeration));
-  }
-  check_crop_boxes(o);
-  const RasterHeader header = read_raster_header(path);  // clear errors for bad files
-  ImportResult result;
-  result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
-                          std::to_string(header.width) + " x " + std::to_string(header.height));
+namespace {
 
+// gdalwarp's arguments for an import and what they amount to.
+struct WarpPlan {
+  std::vector<std::string> args;
+  double cell = 0.0;  // output cell size (metres, or degrees with keep_crs)
+  bool has_crs = false, reproject = false, geographic = false;
+};
+
+// The target CRS and cell size: a geographic DEM goes to the UTM zone of its
+// centre at about its finest metric spacing, unless keep_crs.
+void plan_grid(const RasterHeader& header, const ImportOptions& o, WarpPlan& plan,
+               std::vector<std::string>& report) {
   OGRSpatialReference srs;
-  const bool has_crs =
+  plan.has_crs =
       !header.geo.crs_wkt.empty() && srs.importFromWkt(header.geo.crs_wkt.c_str()) == OGRERR_NONE;
-  const bool geographic = has_crs && srs.IsGeographic();
-  const bool reproject = geographic && !o.keep_crs;
-
-  // Warped into memory: no temporary file at all.
-  std::vector<std::string> args = {"-of", "MEM",      "-ot",        "Float32",
-                                   "-r",  "bilinear", "-dstnodata", "nan"};
-  double cell = 0.0;
-  if (reproject) {
+  plan.geographic = plan.has_crs && srs.IsGeographic();
+  plan.reproject = plan.geographic && !o.keep_crs;
+  if (plan.reproject) {
     const auto lonlat = centre_lonlat(header.geo, header.width, header.height);
     const int epsg = utm_epsg(lonlat[0], lonlat[1]);
     // Square cells near the source's finest metric spacing.
     const auto metric = cell_size_metres(header.geo, header.width, header.height);
     const double cx = metric[0], cy = metric[1];
-    cell = std::round(std::min(cx, cy) * 100.0) / 100.0;
-    args.insert(args.end(), {"-t_srs", "EPSG:" + std::to_string(epsg)});
-    result.report.push_back("reprojected " + std::string(srs.GetName() ? srs.GetName() : "?") +
-                            " -> EPSG:" + std::to_string(epsg) + " (UTM zone " +
-                            std::to_string(epsg % 100) + (epsg < 32700 ? "N" : "S") +
-                            "), source cells " + fmt(std::round(cx * 100) / 100) + " x " +
-                            fmt(std::round(cy * 100) / 100) + " m");
+    plan.cell = std::round(std::min(cx, cy) * 100.0) / 100.0;
+    plan.args.insert(plan.args.end(), {"-t_srs", "EPSG:" + std::to_string(epsg)});
+    report.push_back("reprojected " + std::string(srs.GetName() ? srs.GetName() : "?") +
+                     " -> EPSG:" + std::to_string(epsg) + " (UTM zone " +
+                     std::to_string(epsg % 100) + (epsg < 32700 ? "N" : "S") + "), source cells " +
+                     fmt(std::round(cx * 100) / 100) + " x " + fmt(std::round(cy * 100) / 100) +
+                     " m");
   } else {
-    cell = std::fabs(header.geo.cell_size_x());
-    if (geographic)
-      result.report.push_back("kept the geographic CRS (--keep-crs): cells are degrees");
+    plan.cell = std::fabs(header.geo.cell_size_x());
+    if (plan.geographic)
+      report.push_back("kept the geographic CRS (--keep-crs): cells are degrees");
   }
-  if (o.resample_m) cell = *o.resample_m;
-  if (!(cell > 0)) throw Error("'" + path.string() + "' has no usable cell size");
-  args.insert(args.end(), {"-tr", fmt(cell), fmt(cell)});
+}
+
+// The whole warp: CRS, cell size and crop box.
+WarpPlan plan_warp(const fs::path& path, const RasterHeader& header, const ImportOptions& o,
+                   std::vector<std::string>& report) {
+  WarpPlan plan;
+  // Warped into memory (GDAL's MEM driver): no temporary file at all.
+  plan.args = {"-of", "MEM", "-ot", "Float32", "-r", "bilinear", "-dstnodata", "nan"};
+  plan_grid(header, o, plan, report);
+  if (o.resample_m) plan.cell = *o.resample_m;
+  if (!(plan.cell > 0)) throw Error("'" + path.string() + "' has no usable cell size");
+  plan.args.insert(plan.args.end(), {"-tr", fmt(plan.cell), fmt(plan.cell)});
   if (o.crop) {
     const auto& b = *o.crop;
-    args.insert(args.end(), {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3])});
-    if (has_crs) args.insert(args.end(), {"-te_srs", header.geo.crs_wkt});
+    plan.args.insert(plan.args.end(), {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3])});
+    if (plan.has_crs) plan.args.insert(plan.args.end(), {"-te_srs", header.geo.crs_wkt});
   } else if (o.crop_lonlat) {
     const auto& b = *o.crop_lonlat;
-    if (!(b[0] < b[2] && b[1] < b[3])) throw Error("--crop-lonlat needs W < E and S < N");
-    args.insert(args.end(),
-                {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3]), "-te_srs", "EPSG:4326"});
+    plan.args.insert(plan.args.end(),
+                     {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3]), "-te_srs", "EPSG:4326"});
   }
-  require_warp_memory(header, o, reproject ? 1.0 : metres_per_unit(header), cell, path);
+  return plan;
+}
 
+// Metres per CRS unit along x of a raster kept in its CRS (1 for a local grid).
+double metres_per_unit(const RasterHeader& h) {
+  const double dx = std::fabs(h.geo.cell_size_x());
+  return dx > 0 ? cell_size_metres(h.geo, h.width, h.height)[0] / dx : 1.0;
+}
+
+// The warped grid covers the crop box (or the source) at the plan's cell: checks
+// it fits in memory three times over (GDAL's grid, ours, the nodata filling's
+// copy) before GDAL allocates it.
+void require_warp_memory(const RasterHeader& h, const ImportOptions& o, const WarpPlan& plan,
+                         const fs::path& path) {
+  const auto metric = cell_size_metres(h.geo, h.width, h.height);
+  double width_m = h.width * metric[0], height_m = h.height * metric[1];
+  if (o.crop) {
+    const auto& b = *o.crop;
+    const double dx = std::fabs(h.geo.cell_size_x()), dy = std::fabs(h.geo.cell_size_y());
+    width_m = (b[2] - b[0]) * (dx > 0 ? metric[0] / dx : 1.0);
+    height_m = (b[3] - b[1]) * (dy > 0 ? metric[1] / dy : 1.0);
+  } else if (o.crop_lonlat) {
+    const auto& b = *o.crop_lonlat;
+    const auto m = metres_per_degree(0.5 * (b[1] + b[3]));
+    width_m = (b[2] - b[0]) * m[0];
+    height_m = (b[3] - b[1]) * m[1];
+  }
+  const double cell_m = plan.cell * (plan.reproject ? 1.0 : metres_per_unit(h));
+  const double columns = std::ceil(width_m / cell_m), rows = std::ceil(height_m / cell_m);
+  const double bytes = columns * rows * sizeof(float) * 3.0;
+  const std::string what = "importing '" + path.string() + "' at " + fmt(cell_m) +
+                           " m cells (about " + fmt(columns) + " x " + fmt(rows) + ")";
+  const std::string fix = "crop it (--crop, --crop-lonlat) or give a coarser --resample";
+  if (!(columns * rows < 2.0e9) || !std::isfinite(bytes)) {
+    throw Error(what + " is too large a grid; " + fix);
+  }
+  require_memory(static_cast<std::uint64_t>(bytes), what, fix);
+}
+
+// Runs the warp into memory and reads the grid from it.
+HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const ImportOptions& o) {
   ensure_gdal();
+  std::vector<std::string> args = plan.args;
   std::vector<char*> argv;
   argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
@@ -231,16 +206,60 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
     throw Error("cannot warp '" + path.string() + "': " + last_gdal_message() +
                 (o.crop || o.crop_lonlat ? " (does the crop box overlap the DEM?)" : ""));
   }
+  HeightField grid;
   try {
-    result.grid = read_dataset(*GDALDataset::FromHandle(dst), path);
+    grid = read_dataset(*GDALDataset::FromHandle(dst), path);
   } catch (...) {
     GDALClose(dst);
     throw;
   }
   GDALClose(dst);
+  return grid;
+}
+
+}  // namespace
+
+void ImportOptions::validate() const {
+  if (crop && crop_lonlat)
+    throw ParameterError("crop_lonlat", "and crop are both given; give one, not both");
+  if (resample_m) {
+    require_field(*resample_m > 0 && std::isfinite(*resample_m), "resample_m", *resample_m,
+                  "(0, inf) m, a cell size");
+  }
+  require_field(exaggeration > 0 && exaggeration <= 100, "exaggeration", exaggeration, "(0, 100]");
+  if (crop) {
+    const auto& b = *crop;
+    if (!(std::isfinite(b[0]) && std::isfinite(b[1]) && std::isfinite(b[2]) &&
+          std::isfinite(b[3]) && b[0] < b[2] && b[1] < b[3])) {
+      throw ParameterError("crop",
+                           "has no area: give xmin,ymin,xmax,ymax with finite numbers, "
+                           "xmin < xmax and ymin < ymax");
+    }
+  }
+  if (crop_lonlat) {
+    const auto& b = *crop_lonlat;
+    if (!(b[1] >= -90 && b[3] <= 90 && b[0] >= -180 && b[2] <= 180)) {
+      throw ParameterError("crop_lonlat",
+                           "leaves the globe: longitudes lie in [-180, 180], "
+                           "latitudes in [-90, 90]");
+    }
+    if (!(b[0] < b[2] && b[1] < b[3]))
+      throw ParameterError("crop_lonlat", "needs west < east and south < north");
+  }
+}
+
+ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
+  o.validate();
+  const RasterHeader header = read_raster_header(path);  // clear errors for bad files
+  ImportResult result;
+  result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
+                          std::to_string(header.width) + " x " + std::to_string(header.height));
+  const WarpPlan plan = plan_warp(path, header, o, result.report);
+  require_warp_memory(header, o, plan, path);
+  result.grid = warp_to_grid(path, plan, o);
   result.report.push_back("grid " + std::to_string(result.grid.width()) + " x " +
-                          std::to_string(result.grid.height()) + " cells of " + fmt(cell) +
-                          (reproject || !geographic ? " m" : " deg"));
+                          std::to_string(result.grid.height()) + " cells of " + fmt(plan.cell) +
+                          (plan.reproject || !plan.geographic ? " m" : " deg"));
 
   result.filled_cells = fill_nodata(result.grid, path.string());
   if (result.filled_cells > 0) {

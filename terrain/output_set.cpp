@@ -65,6 +65,7 @@ void OutputSet::stage(const fs::path& target) {
     }
   }
   check_output_path(target, inputs_);
+  DeferSignals defer;  // a signal between creating and recording would leave the file
   Staged s{target, create_temp_beside(target)};
   try {
     s.slot = register_temp(s.temp);
@@ -98,7 +99,7 @@ void OutputSet::commit() {
     if (!s.written) throw Error("internal: output '" + s.target.string() + "' was not written");
   }
   for (const Staged& s : outputs_) match_permissions(s.temp, s.target);
-  DeferSignals defer;
+  DeferSignals defer(true);
   std::vector<fs::path> old(outputs_.size());
   for (std::size_t i = 0; i < outputs_.size(); ++i) {
     old[i] = keep_old(outputs_[i].target, outputs_[i].temp);

@@ -102,12 +102,14 @@ void stop_here_for_tests() {
   if (wanted && writes.fetch_add(1) + 1 == std::atoi(wanted)) raise(SIGSTOP);
 }
 
-DeferSignals::DeferSignals() { g_deferring.fetch_add(1); }
+DeferSignals::DeferSignals(bool renaming) : renaming_(renaming) { g_deferring.fetch_add(1); }
 
 DeferSignals::~DeferSignals() {
   if (g_deferring.fetch_sub(1) == 1) {
     if (const int sig = g_pending.exchange(0)) {
-      clean_up_and_exit(sig, " while the outputs were moved into place; they are all complete\n");
+      clean_up_and_exit(
+          sig, renaming_ ? " while the outputs were moved into place; they are all complete\n"
+                         : "; temporary files removed, existing outputs left as they were\n");
     }
   }
 }

@@ -31,10 +31,14 @@ void stop_here_for_tests();
 // the signals would not do: any of TBB's threads may receive them.)
 class DeferSignals {
  public:
-  DeferSignals();
+  // `renaming`: outputs are being moved into place (says so if a signal came).
+  explicit DeferSignals(bool renaming = false);
   ~DeferSignals();
   DeferSignals(const DeferSignals&) = delete;
   DeferSignals& operator=(const DeferSignals&) = delete;
+
+ private:
+  bool renaming_;
 };
 
 }  // namespace drift

@@ -114,7 +114,7 @@ TEST(RefusalsCli, ImportRefusesEmptyCropsLatitudesOffTheGlobeAndHugeGrids) {
   const std::string base = "import " + in.string() + " -o " + out.string();
   EXPECT_REFUSED(drift(base + " --crop 10,0,10,50", d), 1, "no area");
   EXPECT_REFUSED(drift(base + " --crop-lonlat 137,30,138,95", d), 1, "[-90, 90]");
-  EXPECT_REFUSED(drift(base + " --crop-lonlat 137,36,137,37", d), 1, "W < E");
+  EXPECT_REFUSED(drift(base + " --crop-lonlat 137,36,137,37", d), 1, "west < east");
   // 160 m x 160 m at 1 mm cells: 2.56e10 cells, refused before GDAL allocates.
   EXPECT_REFUSED(drift(base + " --resample 0.001", d), 1, "too large a grid");
   EXPECT_REFUSED(drift(base + " --resample 0.01", d, "DRIFT_MEMORY_LIMIT=64M"), 1, "is available");
