@@ -3,11 +3,32 @@
 #include <tbb/global_control.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdlib>
 #include <memory>
 
 #include "terrain/parameter.h"
 
 namespace drift::pipeline {
+
+namespace {
+
+// CLI11's range checks compare with < and >, which NaN passes: every number a
+// user gives must be finite, whatever its option's own range (exit 2).
+void require_finite_numbers(const CLI::App& sub) {
+  for (const CLI::Option* option : sub.get_options()) {
+    if (option->get_type_name().find("FLOAT") == std::string::npos) continue;
+    for (const std::string& given : option->results()) {
+      char* end = nullptr;
+      const double v = std::strtod(given.c_str(), &end);
+      if (end != given.c_str() && !std::isfinite(v)) {
+        usage_error(option->get_name() + " " + given + ": not a finite number; give a number");
+      }
+    }
+  }
+}
+
+}  // namespace
 
 CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
                          std::function<void()> run) {
@@ -16,7 +37,8 @@ CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::s
   sub->add_option("--threads", *threads,
                   "worker threads (0 = all cores); results do not depend on it")
       ->check(CLI::Range(0, 4096));
-  sub->callback([threads, run = std::move(run)] {
+  sub->callback([sub, threads, run = std::move(run)] {
+    require_finite_numbers(*sub);
     std::unique_ptr<tbb::global_control> limit;
     if (*threads > 0) {
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,

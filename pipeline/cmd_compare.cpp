@@ -10,6 +10,7 @@
 #include "pipeline/cli.h"
 #include "render/image_compare.h"
 #include "render/image_io.h"
+#include "terrain/output_set.h"
 
 namespace drift::pipeline {
 
@@ -38,6 +39,7 @@ void run_compare(const CompareCommandOptions& o) {
       if (c.empty()) usage_error("--channels '" + o.channels + "' has an empty channel name");
     }
   }
+  OutputSet outputs({o.diff}, {o.a, o.b});
   const render::Image a = render::read_image(o.a);
   const render::Image b = render::read_image(o.b);
   const render::ComparisonResult r = render::compare_images(a, b, options);
@@ -45,6 +47,7 @@ void run_compare(const CompareCommandOptions& o) {
     render::write_image(render::difference_image(r), o.diff,
                         render::DisplayTransform{0.0, render::ToneCurve::Clamp});
   }
+  outputs.commit();
   std::string channels;
   for (const auto& c : r.channels) channels += (channels.empty() ? "" : ",") + c;
   std::printf("compare:   %s against reference %s (%dx%d, channels %s)\n", o.a.c_str(), o.b.c_str(),

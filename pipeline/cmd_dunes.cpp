@@ -12,6 +12,7 @@
 #include "dunes/wind_frame.h"
 #include "pipeline/cli.h"
 #include "pipeline/progress_bar.h"
+#include "terrain/output_set.h"
 #include "terrain/parameter.h"
 #include "terrain/raster_io.h"
 
@@ -64,6 +65,9 @@ void run_dunes(const DunesCommand& c, const CLI::App& sub) {
                  o.wind_from_deg, simulated_from, o.size);
   }
   const std::filesystem::path out = c.output;
+  // Snapshots are each complete when written (they come one by one); the field
+  // itself is replaced only at the end.
+  OutputSet outputs({out});
   const std::string description = c.model + " height (m)";
   auto snapshot = [&](int step, const terrain::HeightField& field) {
     terrain::write_geotiff(dunes::to_ground(field, o), snapshot_path(out, step),
@@ -72,6 +76,7 @@ void run_dunes(const DunesCommand& c, const CLI::App& sub) {
   const terrain::HeightField model_field =
       dunes::run(o, terminal_progress(c.model), c.snapshot_every, snapshot);
   terrain::write_geotiff(dunes::to_ground(model_field, o), out, {description, "m"});
+  outputs.commit();
   std::printf("%s: %d x %d cells of %g m, %d steps, wind from %g deg -> %s\n", c.model.c_str(),
               o.size, o.size, o.cell_m, o.steps, o.wind_from_deg, c.output.c_str());
 }

@@ -7,6 +7,7 @@
 
 #include "pipeline/cli.h"
 #include "terrain/import.h"
+#include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -34,8 +35,10 @@ void run_import(const ImportCommand& c) {
                   {"resample_m", "--resample"},
                   {"exaggeration", "--exaggerate"}},
                  false);
+  OutputSet outputs({c.output}, {c.input});
   const terrain::ImportResult r = terrain::import_dem(c.input, o);
   terrain::write_geotiff(r.grid, c.output, {"height (m)", "m"});
+  outputs.commit();
   for (const auto& line : r.report) std::printf("import: %s\n", line.c_str());
   std::printf("import: wrote %s\n", c.output.c_str());
 }

@@ -12,6 +12,7 @@
 #include "pipeline/track_file.h"
 #include "terrain/error.h"
 #include "terrain/marks/marks.h"
+#include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -26,19 +27,6 @@ struct MarksCommand {
   bool add_snow = false;
   marks::MarksOptions options;
 };
-
-// Outputs must not be the run's inputs (a failed run must leave inputs alone).
-void refuse_input_as_output(const MarksCommand& c) {
-  std::error_code ec;
-  for (const std::string* out : {&c.output, &c.disturbed}) {
-    if (out->empty()) continue;
-    for (const std::string* in : {&c.ground, &c.track, &c.snow_depth})
-      if (!in->empty() && fs::equivalent(*out, *in, ec))
-        usage_error("output '" + *out + "' is also an input; write it elsewhere");
-  }
-  if (!c.disturbed.empty() && c.disturbed == c.output)
-    usage_error("--disturbed and -o name the same file");
-}
 
 // The snow-depth raster, of the ground's size.
 terrain::HeightField read_snow_depth(const MarksCommand& c, const terrain::HeightField& ground) {
@@ -63,8 +51,10 @@ marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& tr
 }
 
 void run_marks(MarksCommand& c) {
-  refuse_input_as_output(c);
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
+  // Frames are each complete when written (they come one by one); the marked
+  // ground and the disturbed raster replace their files together at the end.
+  OutputSet outputs({c.output, c.disturbed}, {c.ground, c.track, c.snow_depth});
   TrackFile track = read_track_file(c.track);
   marks::MarksOptions o = c.options;
   o.step = track.step;
@@ -98,12 +88,13 @@ void run_marks(MarksCommand& c) {
   const marks::MarksResult r = marks::simulate_marks(ground, track.objects, std::move(materials), o,
                                                      on_step, terminal_progress("marks"));
   terrain::write_geotiff(r.heights, c.output, {"ground height with marks (m)", "m"});
-  std::printf("marks: wrote %s\n", c.output.c_str());
   if (!c.disturbed.empty()) {
     terrain::write_geotiff(r.disturbed, c.disturbed,
                            {"ground disturbed by marks (m compressed, displaced or slid)", "m"});
-    std::printf("marks: wrote %s\n", c.disturbed.c_str());
   }
+  outputs.commit();
+  std::printf("marks: wrote %s\n", c.output.c_str());
+  if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
   std::printf("marks: %d steps; %.6g m3 under objects: %.6g displaced, %.6g compressed away\n",
               r.report.steps, r.report.collided, r.report.displaced, r.report.compressed);
 }

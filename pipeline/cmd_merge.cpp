@@ -1,13 +1,16 @@
 // drift merge TILE.exr... -o FRAME.exr|png: join the bands of `drift render
 // --tile i/n` into the frame a single run gives, bit for bit.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 
 #include "pipeline/cli.h"
 #include "render/image_io.h"
 #include "render/tiles.h"
 #include "terrain/error.h"
+#include "terrain/output_set.h"
 
 namespace drift::pipeline {
 
@@ -19,6 +22,19 @@ struct MergeOptions {
   double exposure = 0.0;
 };
 
+// An exposure the tiles recorded, in EV; a tile edited by hand or damaged gets a
+// clear error rather than std::stod's.
+double recorded_ev(const render::Image& frame, const char* name) {
+  const std::string& text = *frame.attribute(name);
+  char* end = nullptr;
+  const double ev = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || !std::isfinite(ev) || std::fabs(ev) > 64) {
+    throw Error("the tiles record an " + std::string(name) + " of '" + text +
+                "', not a number in [-64, 64] EV; give --exposure EV");
+  }
+  return ev;
+}
+
 // The display settings the tiles were rendered with, unless overridden.
 render::DisplayTransform display_of(const render::Image& frame, const CLI::App& sub,
                                     double exposure) {
@@ -26,10 +42,10 @@ render::DisplayTransform display_of(const render::Image& frame, const CLI::App& 
   if (const std::string* e = frame.attribute("exposure")) {
     // "auto": the merged frame is metered (render/auto_exposure.h).
     d.auto_exposure = *e == "auto";
-    d.exposure_ev = d.auto_exposure ? 0.0 : std::stod(*e);
+    d.exposure_ev = d.auto_exposure ? 0.0 : recorded_ev(frame, "exposure");
   }
   if (const std::string* c = frame.attribute("exposure_compensation"); c && d.auto_exposure)
-    d.exposure_ev = std::stod(*c);
+    d.exposure_ev = recorded_ev(frame, "exposure_compensation");
   if (const std::string* t = frame.attribute("tone"); t && *t == "clamp")
     d.curve = render::ToneCurve::Clamp;
   if (const std::string* w = frame.attribute("white_balance"); w && *w == "daylight")
@@ -39,16 +55,15 @@ render::DisplayTransform display_of(const render::Image& frame, const CLI::App& 
 }
 
 void run_merge(const MergeOptions& o, const CLI::App& sub) {
+  std::vector<std::filesystem::path> names(o.tiles.begin(), o.tiles.end());
+  OutputSet outputs({o.outputs.begin(), o.outputs.end()}, names);
   std::vector<render::Image> tiles;
-  std::vector<std::filesystem::path> names;
-  for (const auto& t : o.tiles) {
-    names.emplace_back(t);
-    tiles.push_back(render::read_image(t));
-  }
+  for (const auto& t : names) tiles.push_back(render::read_image(t));
   const render::Image frame = render::merge_tiles(tiles, names);
   tiles.clear();
   const render::DisplayTransform display = display_of(frame, sub, o.exposure);
   for (const auto& f : o.outputs) render::write_image(frame, f, display);
+  outputs.commit();
   std::printf("merged %zu tiles into %dx%d -> ", names.size(), frame.width, frame.height);
   for (const auto& f : o.outputs) std::printf("%s ", f.c_str());
   std::printf("\n");

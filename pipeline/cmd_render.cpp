@@ -1,7 +1,10 @@
 // drift render SCENE.toml: path-trace a scene file into EXR and/or PNG.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <regex>
 
@@ -12,6 +15,7 @@
 #include "render/renderer.h"
 #include "render/tiles.h"
 #include "terrain/error.h"
+#include "terrain/output_set.h"
 
 namespace drift::pipeline {
 
@@ -129,6 +133,26 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
   }
 }
 
+// Which scene and settings an image comes from, recorded in it so that drift
+// merge refuses tiles of different renders: FNV-1a of the scene file's bytes and
+// of every option that changes pixels (not --tile, not the outputs).
+std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
+  std::ifstream in(o.scene, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  for (const std::string& part :
+       {o.size, o.terrain, o.snow_cover, o.snow_depth, o.snow_objects, o.ripples, o.sun_time,
+        std::to_string(scene.settings.samples_per_pixel),
+        std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
+        std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)}) {
+    text.append("\n").append(part);
+  }
+  std::uint64_t hash = 14695981039346656037ull;
+  for (unsigned char c : text) hash = (hash ^ c) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
+
 void print_summary(const SceneFile& scene, const render::Image& image,
                    const render::RenderStats& stats, double seconds) {
   if (scene.settings.noise_target > 0.0f) {
@@ -149,6 +173,9 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   SceneFile scene = read_scene_file(o.scene);
   apply_overrides(o, sub, scene);
   check_outputs(o, scene);
+  std::vector<std::filesystem::path> inputs = scene_inputs(scene);
+  inputs.emplace_back(o.scene);
+  OutputSet outputs(scene.outputs, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
   const render::TerrainScene embree_scene(scene.input);
@@ -167,8 +194,10 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
        std::to_string(scene.display.auto_exposure ? scene.display.exposure_ev : 0.0)},
       {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"},
       {"white_balance",
-       scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
+       scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"},
+      {"scene", scene_identity(o, scene)}};
   for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
+  outputs.commit();
   print_summary(scene, image, stats, seconds);
   print_exposure(image, scene.display, o.tile.empty());
 }

@@ -6,6 +6,7 @@
 #include "pipeline/progress_bar.h"
 #include "render/contact_sheet.h"
 #include "render/image_io.h"
+#include "terrain/output_set.h"
 
 namespace drift::pipeline {
 
@@ -42,10 +43,14 @@ void run_sheet(const SheetCommandOptions& o) {
     usage_error("--columns " + std::to_string(o.columns) + " is more than the " +
                 std::to_string(o.images.size()) + " images");
   }
+  std::vector<std::filesystem::path> inputs(o.images.begin(), o.images.end());
+  inputs.emplace_back(o.font);
+  OutputSet outputs({o.output}, inputs);
   std::vector<render::Image> images;
   for (const auto& path : o.images) images.push_back(render::read_image(path));
   const render::Image sheet = render::contact_sheet(images, options, terminal_progress("sheet"));
   render::write_image(sheet, o.output, render::DisplayTransform{0.0, render::ToneCurve::Clamp});
+  outputs.commit();
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "pipeline/progress_bar.h"
 #include "snow/snow_cover.h"
 #include "terrain/error.h"
+#include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -44,6 +45,7 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
                                           {"radius_m", "--radius"},
                                           {"radius_cells", "--radius-cells"},
                                           {"band_m", "--band"}});
+  OutputSet outputs({c.output, c.descriptor, c.accessibility}, {c.dem});
   const terrain::HeightField dem = terrain::read_raster(c.dem);
   snow::CoverResult r;
   try {
@@ -59,6 +61,7 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
     terrain::write_geotiff(r.descriptor, c.descriptor, {"snow descriptor t (0 snow, 1 rock)", ""});
   if (!c.accessibility.empty())
     terrain::write_geotiff(r.accessibility, c.accessibility, {"tangent sphere accessibility", "m"});
+  outputs.commit();
   double mean = 0;
   for (float v : cover.values()) mean += v;
   const double cell = dem.geo().cell_size_x();

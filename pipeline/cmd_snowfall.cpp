@@ -11,6 +11,7 @@
 #include "snow/snowfall.h"
 #include "terrain/error.h"
 #include "terrain/mesh_io.h"
+#include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -59,6 +60,7 @@ void run_snowfall(SnowfallCommand& c) {
                                           {"coverage.adhesion", "--adhesion"},
                                           {"max_iterations", "--max-iterations"}});
 
+  OutputSet outputs({c.output, c.cover, c.surface, c.mesh_out}, {c.ground, c.objects});
   const terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);
   const std::vector<terrain::PlacedMesh> objects =
@@ -67,18 +69,16 @@ void run_snowfall(SnowfallCommand& c) {
       snow::simulate_snowfall(ground, objects, o, terminal_progress("snow fall"));
 
   terrain::write_geotiff(r.depth, c.output, {"snow depth (m)", "m"});
-  std::printf("snow fall: wrote %s\n", c.output.c_str());
-  if (!c.cover.empty()) {
-    terrain::write_geotiff(r.coverage, c.cover, {"snow coverage (0..1)", ""});
-    std::printf("snow fall: wrote %s\n", c.cover.c_str());
-  }
-  if (!c.surface.empty()) {
+  if (!c.cover.empty()) terrain::write_geotiff(r.coverage, c.cover, {"snow coverage (0..1)", ""});
+  if (!c.surface.empty())
     terrain::write_geotiff(snow_surface(ground, r.depth), c.surface,
                            {"snow surface height, ground + depth (m)", "m"});
-    std::printf("snow fall: wrote %s\n", c.surface.c_str());
-  }
+  if (!c.mesh_out.empty()) terrain::write_ply(r.objects, c.mesh_out);
+  outputs.commit();
+  std::printf("snow fall: wrote %s\n", c.output.c_str());
+  if (!c.cover.empty()) std::printf("snow fall: wrote %s\n", c.cover.c_str());
+  if (!c.surface.empty()) std::printf("snow fall: wrote %s\n", c.surface.c_str());
   if (!c.mesh_out.empty()) {
-    terrain::write_ply(r.objects, c.mesh_out);
     std::printf("snow fall: wrote %s (%zu triangles; place it at position = [%.0f, %.0f, 0])\n",
                 c.mesh_out.c_str(), r.objects.triangle_count(), r.mesh_origin.x(),
                 r.mesh_origin.y());

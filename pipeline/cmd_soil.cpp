@@ -11,6 +11,7 @@
 #include "pipeline/soil_scenario_file.h"
 #include "terrain/error.h"
 #include "terrain/mesh_io.h"
+#include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 #include "terrain/soil/surface.h"
 #include "terrain/soil/top_surface.h"
@@ -67,6 +68,9 @@ void run_soil(SoilCommand& c) {
   if (!c.frames.empty() && !fs::is_directory(c.frames))
     throw Error("--frames directory '" + c.frames + "' does not exist; create it first");
 
+  // Frames are each complete when written; the products replace their files
+  // together at the end (docs/outputs.md).
+  OutputSet outputs({c.output, c.collision, c.vdb, c.surface, c.ground}, {c.scenario, c.terrain});
   soil::SoilSimulation sim = soil::make_simulation(sc);  // checks sizes and memory first
   const soil::SurfaceOptions surface{
       c.no_ridge_fix ? soil::RidgeFix::Off : soil::RidgeFix::StraightSlopes, 3, 0.0};
@@ -117,6 +121,7 @@ void run_soil(SoilCommand& c) {
                            c.ground, {"ground under the soil (m)", "m"});
     std::printf("soil: wrote %s\n", c.ground.c_str());
   }
+  outputs.commit();
   const double mass1 = sim.state().mass();
   std::printf(
       "soil: %d steps of %dx%dx%d voxels (%.3g m) in %.2f s (%.1f steps/s); soil %.6g -> "

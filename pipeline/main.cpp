@@ -7,8 +7,11 @@
 
 #include "pipeline/cli.h"
 #include "terrain/error.h"
+#include "terrain/temp_registry.h"
 
 int main(int argc, char** argv) try {
+  // SIGINT, SIGTERM, SIGHUP: remove temporary files, exit 130, 143, 129.
+  drift::install_signal_cleanup();
   CLI::App app{"Driftscape: natural ground from real elevation data, rendered.", "drift"};
   app.set_version_flag("--version", "drift 0.1.0");
   app.require_subcommand(1);

@@ -251,7 +251,8 @@ void read_ripples(const toml::table& root, const fs::path& path, SceneFile& scen
     rip.invalid_table("needs 'raster' (a tileable height field from drift dunes --model ripples)");
   scene.ripples = resolve(path, *ripple_raster);
   render::RippleLayer layer;
-  const double cell = rip.number("cell", 0.0, 0.0, 100.0);
+  // At least 0.1 mm: the bump map divides by it (1e-39 overflowed inside Embree).
+  const double cell = rip.number("cell", 0.0, 1e-4, 100.0);
   if (cell > 0.0) scene.ripple_texel_metres = cell;
   layer.rotation_deg = rip.number("rotation", 0.0, -360.0, 360.0);
   layer.strength = static_cast<float>(rip.number("strength", 1.0, 0.0, 100.0));
@@ -340,6 +341,13 @@ void read_lens(Section& cam, render::Camera& camera) {
     camera.focus_distance = d;
   if (camera.f_number > 0.0 && !camera.focal_length_mm)
     cam.invalid("f_number", "needs 'camera.focal_length' (millimetres)");
+  // Given values must keep their reciprocals finite (0 means not given).
+  if (camera.focal_length_mm && *camera.focal_length_mm < 0.1)
+    cam.invalid("focal_length", "must be 0 (none) or at least 0.1 mm");
+  if (camera.f_number > 0.0 && camera.f_number < 0.5)
+    cam.invalid("f_number", "must be 0 (a pinhole) or at least 0.5");
+  if (camera.focus_distance && *camera.focus_distance < 1e-3)
+    cam.invalid("focus_distance", "must be 0 (automatic) or at least 0.001 m");
 }
 
 // [camera]: where it stands and looks (CRS points, or lon/lat placed on the
@@ -357,6 +365,10 @@ void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene
   const double to_height = cam.number("to_height", 0.0, -1e4, 1e6);
   read_lens(cam, camera);
   cam.finish();
+  if (from_lonlat && std::fabs((*from_lonlat)[1]) > 90.0)
+    cam.invalid("from_lonlat", "has a latitude off the globe; latitudes lie in [-90, 90]");
+  if (to_lonlat && std::fabs((*to_lonlat)[1]) > 90.0)
+    cam.invalid("to_lonlat", "has a latitude off the globe; latitudes lie in [-90, 90]");
   if (from && from_lonlat) cam.invalid_table("has both 'from' and 'from_lonlat'; give one");
   if (to && to_lonlat) cam.invalid_table("has both 'to' and 'to_lonlat'; give one");
   if (!(from || from_lonlat) || !(to || to_lonlat)) {
@@ -390,7 +402,8 @@ void read_render(const toml::table& root, const fs::path& path, render::RenderSe
 // [output]: files and the PNG's display transform.
 void read_output(const toml::table& root, const fs::path& path, SceneFile& scene) {
   Section out(subtable(root, "output", path), "output", path);
-  for (const std::string& f : out.strings("files")) scene.outputs.emplace_back(f);
+  // Relative to the scene file, like every path in it (docs/rendering.md).
+  for (const std::string& f : out.strings("files")) scene.outputs.emplace_back(resolve(path, f));
   read_exposure(out, subtable(root, "output", path), scene.display);
   const auto tone = out.string("tone");
   if (tone && *tone != "filmic" && *tone != "clamp")
@@ -548,6 +561,14 @@ void load_scene_terrain(SceneFile& scene) {
       throw Error("ripple raster '" + scene.ripples.string() + "': " + e.what());
     }
   }
+}
+
+std::vector<fs::path> scene_inputs(const SceneFile& scene) {
+  std::vector<fs::path> inputs = {scene.terrain_raster, scene.snow_cover, scene.snow_depth,
+                                  scene.ripples,        scene.albedo_map, scene.snow_objects};
+  inputs.insert(inputs.end(), scene.layer_masks.begin(), scene.layer_masks.end());
+  std::erase_if(inputs, [](const fs::path& p) { return p.empty(); });
+  return inputs;
 }
 
 }  // namespace drift::pipeline

@@ -49,6 +49,10 @@ struct SceneFile {
 // Parses and validates; meshes are loaded, the terrain raster is not.
 SceneFile read_scene_file(const std::filesystem::path& path);
 
+// Every file the scene reads (rasters, masks, snowy objects), for refusing
+// them as outputs.
+std::vector<std::filesystem::path> scene_inputs(const SceneFile& scene);
+
 // Reads the scene's terrain raster and layer rasters; a geographic (degree)
 // raster is an error telling the user to run `drift import` first.
 void load_scene_terrain(SceneFile& scene);

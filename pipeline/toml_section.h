@@ -19,15 +19,14 @@
 #include <vector>
 
 #include "terrain/error.h"
+#include "terrain/input_path.h"
 
 namespace drift::pipeline {
 
 // Parses a TOML file; a missing file or a syntax error is a drift::Error
 // naming `what`, the file and the line.
 inline toml::table parse_toml_file(const std::filesystem::path& path, const char* what) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw Error(std::string("cannot read ") + what + " '" + path.string() + "': no such file");
+  check_input_file(path, what);
   try {
     return toml::parse_file(path.string());
   } catch (const toml::parse_error& e) {

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::render {
 
@@ -28,6 +29,29 @@ void draw_text(Image& sheet, const std::filesystem::path& font, int x, int y,
     throw Error("cannot draw the label '" + text + "' with font " + font.string() + ": " +
                 buf.geterror() + " (install fonts-dejavu-core or pass another .ttf font)");
   }
+}
+
+// OpenImageIO rasterises a text whole before compositing it: a very long text
+// needs gigabytes (and once crashed with SIGFPE when that failed). A text is
+// refused if it is wider than the largest sheet (65535 pixels) or its raster
+// does not fit in memory; narrower ones are drawn and cut at the sheet's edge.
+void require_text_fits(const std::string& text, const std::string& what,
+                       const std::filesystem::path& font, int size) {
+  constexpr long long kWidest = 65535;
+  if (text.empty()) return;
+  const auto too_wide = [&](long long pixels) {
+    return Error(what + " is about " + std::to_string(pixels) + " pixels wide, more than the " +
+                 std::to_string(kWidest) + " of the largest sheet; shorten it");
+  };
+  // A cheap bound before measuring: few glyphs are wider than twice their size.
+  if (static_cast<long long>(text.size()) * size > 2 * kWidest * 16) {
+    throw too_wide(static_cast<long long>(text.size()) * size / 2);
+  }
+  const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, size, font.string());
+  if (!box.defined()) return;
+  if (box.width() > kWidest) throw too_wide(box.width());
+  require_memory(static_cast<std::uint64_t>(box.width()) * box.height() * 4 * sizeof(float),
+                 "the text of " + what, "shorten it or use a smaller --font-size");
 }
 
 // Checks the options against the images; returns the font for the labels
@@ -133,6 +157,14 @@ Image contact_sheet(const std::vector<Image>& images, const ContactSheetOptions&
   const std::filesystem::path font = check_sheet(images, o, has_labels);
   if (progress && !progress(0.0, "contact sheet")) throw Cancelled();
   const SheetLayout l = sheet_layout(images, o, has_labels);
+  require_memory(
+      static_cast<std::uint64_t>(l.width) * l.height * 3 * sizeof(float),
+      "a contact sheet of " + std::to_string(l.width) + "x" + std::to_string(l.height) + " pixels",
+      "use fewer or smaller images");
+  if (!o.title.empty()) require_text_fits(o.title, "the title", font, l.title_size);
+  for (std::size_t i = 0; i < o.labels.size(); ++i) {
+    require_text_fits(o.labels[i], "label " + std::to_string(i + 1), font, o.font_size);
+  }
   Image sheet(static_cast<int>(l.width), static_cast<int>(l.height), {"R", "G", "B"}, kBackground);
   if (!o.title.empty())
     draw_text(sheet, font, static_cast<int>(l.width / 2), l.pad, o.title, l.title_size);

@@ -14,6 +14,7 @@
 #include "render/auto_exposure.h"
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::render {
 
@@ -111,6 +112,12 @@ Image read_image(const std::filesystem::path& path) {
                 std::to_string(spec.nchannels) + " channels)");
   }
   const int nc = spec.nchannels;
+  // Decoded as float and then copied: twice the declared size (a small PNG can
+  // declare 60000^2 pixels).
+  require_memory(static_cast<std::uint64_t>(spec.width) * spec.height * nc * sizeof(float) * 2,
+                 "image " + path.string() + " (" + std::to_string(spec.width) + "x" +
+                     std::to_string(spec.height) + ", " + std::to_string(nc) + " channels)",
+                 "use a smaller image");
   std::vector<float> raw(static_cast<std::size_t>(spec.width) * spec.height * nc);
   const bool ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, raw.data());
   const std::string read_error = ok ? std::string() : in->geterror();

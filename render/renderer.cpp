@@ -17,6 +17,7 @@
 #include "render/path_tracer.h"
 #include "render/random.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::render {
 
@@ -210,7 +211,14 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const int band = row_end - row_begin;
   const bool adaptive = settings.noise_target > 0.0f;
   const int coverage_count = static_cast<int>(scene.coverage_names().size());
-  Image image(settings.width, band, image_channels(scene, adaptive));
+  const std::vector<std::string> channels = image_channels(scene, adaptive);
+  // The image and the film's per-pixel sums (about as much again).
+  require_memory(
+      static_cast<std::uint64_t>(settings.width) * band * channels.size() * sizeof(float) * 2,
+      "a " + std::to_string(settings.width) + " x " + std::to_string(band) + " image of " +
+          std::to_string(channels.size()) + " channels",
+      "render a smaller --size, or the frame in --tile bands joined by drift merge");
+  Image image(settings.width, band, channels);
   if (band != settings.height) image.frame = {0, row_begin, settings.width, settings.height};
 
   const CameraRays camera_rays = make_camera_rays(scene, camera, settings.width, settings.height);

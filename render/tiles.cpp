@@ -5,6 +5,7 @@
 #include <regex>
 
 #include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::render {
 
@@ -25,6 +26,23 @@ std::pair<int, int> parse_tile(const std::string& text) {
   }
   return {std::stoi(m[1]), std::stoi(m[2])};
 }
+
+namespace {
+
+// drift render records which scene and settings a tile comes from ("scene");
+// tiles of different renders of the same size would otherwise merge silently.
+void require_same_scene(const Image& first, const Image& tile, const std::filesystem::path& a,
+                        const std::filesystem::path& b) {
+  const std::string* x = first.attribute("scene");
+  const std::string* y = tile.attribute("scene");
+  if ((x == nullptr) != (y == nullptr) || (x && *x != *y)) {
+    throw Error(b.string() + " was rendered from another scene or with other settings than " +
+                a.string() + " (scene " + (y ? *y : std::string("unknown")) + " against " +
+                (x ? *x : std::string("unknown")) + "): merge tiles of one render only");
+  }
+}
+
+}  // namespace
 
 Image merge_tiles(const std::vector<Image>& tiles,
                   const std::vector<std::filesystem::path>& names) {
@@ -51,7 +69,11 @@ Image merge_tiles(const std::vector<Image>& tiles,
     if (t.frame.x != 0 || t.width != width || t.frame.y < 0 || t.frame.y + t.height > height) {
       throw Error(name + " does not lie inside its frame as a band of whole rows");
     }
+    require_same_scene(first, t, names[0], names.at(i));
   }
+  require_memory(static_cast<std::uint64_t>(width) * height * first.channels.size() * sizeof(float),
+                 "the merged " + std::to_string(width) + "x" + std::to_string(height) + " frame",
+                 "merge fewer channels or a smaller frame");
   Image out(width, height, first.channels);
   out.attributes = first.attributes;
   std::vector<int> owner(static_cast<std::size_t>(height), -1);

@@ -14,6 +14,7 @@
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/memory.h"
 #include "terrain/parameter.h"
 
 namespace drift::snow {
@@ -174,6 +175,11 @@ void validate(const HeightField& dem, const CoverOptions& o) {
   for (float v : dem.values()) nodata += std::isnan(v) ? 1 : 0;
   require(nodata == 0, "the DEM has " + std::to_string(nodata) +
                            " nodata cells; drift import fills them (run it first)");
+  // The smoothed field, the TSA, the descriptor and two working grids.
+  require_memory(dem.size() * sizeof(float) * 6,
+                 "the snow cover of a " + std::to_string(dem.width()) + " x " +
+                     std::to_string(dem.height()) + " DEM",
+                 "crop or resample the DEM first (drift import --crop, --resample)");
 }
 
 bool in_southern_hemisphere(const HeightField& dem, Hemisphere hemisphere) {

@@ -1,6 +1,12 @@
 #include "snow/snowfall_mesh_refine.h"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
 #include <unordered_map>
+
+#include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::snow {
 
@@ -9,6 +15,31 @@ std::uint64_t edge_key(int a, int b) {
   if (a > b) std::swap(a, b);
   return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
 }
+// Splitting until no edge is longer than max_edge leaves a triangle whose
+// longest edge is L about 2 (L / max_edge)^2 triangles: check that fits before
+// splitting (one large triangle once grew past 8 GB).
+void require_refine_memory(const terrain::Mesh& mesh, double max_edge) {
+  double triangles = 0.0;
+  for (const auto& t : mesh.triangles) {
+    double longest = 0.0;
+    for (int e = 0; e < 3; ++e) {
+      longest = std::max(
+          longest,
+          static_cast<double>((mesh.positions[t[e]] - mesh.positions[t[(e + 1) % 3]]).norm()));
+    }
+    triangles += 2.0 * std::pow(std::ceil(longest / max_edge), 2.0);
+  }
+  // A triangle, its share of vertices and the pass's working copies: ~64 bytes.
+  const double bytes = triangles * 64.0;
+  const std::string what =
+      "splitting the objects' " + std::to_string(mesh.triangles.size()) +
+      " triangles into edges of at most " + std::to_string(max_edge) + " m (about " +
+      std::to_string(static_cast<long long>(std::min(triangles, 9e18))) + " triangles)";
+  const std::string fix = "raise --mesh-edge or give 0 to keep the meshes as they are";
+  if (!(bytes < 1e18)) throw Error(what + " is far too many; " + fix);
+  require_memory(static_cast<std::uint64_t>(bytes), what, fix);
+}
+
 using Midpoints = std::unordered_map<std::uint64_t, int>;
 
 // The longest edge of every triangle with an edge longer than sqrt(max2),
@@ -82,6 +113,7 @@ terrain::Mesh refine_mesh(const terrain::Mesh& mesh, double max_edge) {
     return out;
   }
   const double max2 = max_edge * max_edge;
+  require_refine_memory(mesh, max_edge);
   for (int pass = 0; pass < 64; ++pass) {
     const Midpoints mid = split_longest_edges(out, max2);
     if (mid.empty()) break;

@@ -1,6 +1,9 @@
-// Writes an output through a temporary file in the same directory and renames it
+// Writes one output through a private temporary file beside it and renames it
 // into place on commit(), so a failed or interrupted run never leaves a
-// half-written file and never replaces a good one with a bad one.
+// half-written file and never replaces a good one with a bad one. The target
+// must pass check_output_path (terrain/output_path.h). When the target belongs
+// to the run's open OutputSet (terrain/output_set.h), the set's temporary file
+// is used and the set renames all its outputs together.
 #pragma once
 
 #include <filesystem>
@@ -9,8 +12,8 @@ namespace drift {
 
 class AtomicFile {
  public:
-  // Checks that the target's directory exists and is writable; throws drift::Error
-  // naming the path otherwise.
+  // Checks the target and creates the temporary file; throws drift::Error naming
+  // the path if it cannot be an output.
   explicit AtomicFile(std::filesystem::path target);
   ~AtomicFile();  // removes the temporary file unless commit() succeeded
   AtomicFile(const AtomicFile&) = delete;
@@ -21,12 +24,15 @@ class AtomicFile {
   const std::filesystem::path& temp_path() const { return temp_; }
   const std::filesystem::path& target() const { return target_; }
 
-  // Renames the temporary file onto the target (atomic on POSIX).
+  // Renames the temporary file onto the target (atomic on POSIX), keeping an
+  // existing target's permissions; within an OutputSet, marks it complete.
   void commit();
 
  private:
   std::filesystem::path target_;
   std::filesystem::path temp_;
+  int slot_ = -1;        // in the signal handler's table of temporary files
+  bool staged_ = false;  // the temporary file belongs to an OutputSet
   bool committed_ = false;
 };
 

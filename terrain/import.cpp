@@ -3,7 +3,6 @@
 #include <gdal_priv.h>
 #include <gdal_utils.h>
 #include <ogr_spatialref.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <memory>
@@ -12,6 +11,7 @@
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
 #include "terrain/parameter.h"
+#include "terrain/raster_dataset.h"
 #include "terrain/raster_io.h"
 
 namespace drift::terrain {
@@ -132,8 +132,8 @@ void plan_grid(const RasterHeader& header, const ImportOptions& o, WarpPlan& pla
 WarpPlan plan_warp(const fs::path& path, const RasterHeader& header, const ImportOptions& o,
                    std::vector<std::string>& report) {
   WarpPlan plan;
-  plan.args = {"-of",      "GTiff",      "-ot", "Float32",   "-r",
-               "bilinear", "-dstnodata", "nan", "-overwrite"};
+  // Warped into memory (GDAL's MEM driver): no temporary file at all.
+  plan.args = {"-of", "MEM", "-ot", "Float32", "-r", "bilinear", "-dstnodata", "nan"};
   plan_grid(header, o, plan, report);
   if (o.resample_m) plan.cell = *o.resample_m;
   if (!(plan.cell > 0)) throw Error("'" + path.string() + "' has no usable cell size");
@@ -150,7 +150,43 @@ WarpPlan plan_warp(const fs::path& path, const RasterHeader& header, const Impor
   return plan;
 }
 
-// Runs the warp into a temporary GeoTIFF and reads it back.
+// Metres per CRS unit along x of a raster kept in its CRS (1 for a local grid).
+double metres_per_unit(const RasterHeader& h) {
+  const double dx = std::fabs(h.geo.cell_size_x());
+  return dx > 0 ? cell_size_metres(h.geo, h.width, h.height)[0] / dx : 1.0;
+}
+
+// The warped grid covers the crop box (or the source) at the plan's cell: checks
+// it fits in memory three times over (GDAL's grid, ours, the nodata filling's
+// copy) before GDAL allocates it.
+void require_warp_memory(const RasterHeader& h, const ImportOptions& o, const WarpPlan& plan,
+                         const fs::path& path) {
+  const auto metric = cell_size_metres(h.geo, h.width, h.height);
+  double width_m = h.width * metric[0], height_m = h.height * metric[1];
+  if (o.crop) {
+    const auto& b = *o.crop;
+    const double dx = std::fabs(h.geo.cell_size_x()), dy = std::fabs(h.geo.cell_size_y());
+    width_m = (b[2] - b[0]) * (dx > 0 ? metric[0] / dx : 1.0);
+    height_m = (b[3] - b[1]) * (dy > 0 ? metric[1] / dy : 1.0);
+  } else if (o.crop_lonlat) {
+    const auto& b = *o.crop_lonlat;
+    const auto m = metres_per_degree(0.5 * (b[1] + b[3]));
+    width_m = (b[2] - b[0]) * m[0];
+    height_m = (b[3] - b[1]) * m[1];
+  }
+  const double cell_m = plan.cell * (plan.reproject ? 1.0 : metres_per_unit(h));
+  const double columns = std::ceil(width_m / cell_m), rows = std::ceil(height_m / cell_m);
+  const double bytes = columns * rows * sizeof(float) * 3.0;
+  const std::string what = "importing '" + path.string() + "' at " + fmt(cell_m) +
+                           " m cells (about " + fmt(columns) + " x " + fmt(rows) + ")";
+  const std::string fix = "crop it (--crop, --crop-lonlat) or give a coarser --resample";
+  if (!(columns * rows < 2.0e9) || !std::isfinite(bytes)) {
+    throw Error(what + " is too large a grid; " + fix);
+  }
+  require_memory(static_cast<std::uint64_t>(bytes), what, fix);
+}
+
+// Runs the warp into memory and reads the grid from it.
 HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const ImportOptions& o) {
   ensure_gdal();
   std::vector<std::string> args = plan.args;
@@ -163,28 +199,21 @@ HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const Impor
   if (!wopts) throw Error("internal: bad warp options for '" + path.string() + "'");
   GDALDatasetH src = GDALOpen(path.c_str(), GA_ReadOnly);
   if (!src) throw Error("cannot open '" + path.string() + "': " + last_gdal_message());
-  const fs::path temp =
-      fs::temp_directory_path() / ("drift-import-" + std::to_string(getpid()) + ".tif");
   int usage_error = 0;
-  GDALDatasetH dst = GDALWarp(temp.c_str(), nullptr, 1, &src, wopts.get(), &usage_error);
+  GDALDatasetH dst = GDALWarp("", nullptr, 1, &src, wopts.get(), &usage_error);
   GDALClose(src);
   if (!dst) {
-    std::error_code ec;
-    fs::remove(temp, ec);
     throw Error("cannot warp '" + path.string() + "': " + last_gdal_message() +
                 (o.crop || o.crop_lonlat ? " (does the crop box overlap the DEM?)" : ""));
   }
-  GDALClose(dst);
   HeightField grid;
   try {
-    grid = read_raster(temp);
+    grid = read_dataset(*GDALDataset::FromHandle(dst), path);
   } catch (...) {
-    std::error_code ec;
-    fs::remove(temp, ec);
+    GDALClose(dst);
     throw;
   }
-  std::error_code ec;
-  fs::remove(temp, ec);
+  GDALClose(dst);
   return grid;
 }
 
@@ -198,8 +227,22 @@ void ImportOptions::validate() const {
                   "(0, inf) m, a cell size");
   }
   require_field(exaggeration > 0 && exaggeration <= 100, "exaggeration", exaggeration, "(0, 100]");
+  if (crop) {
+    const auto& b = *crop;
+    if (!(std::isfinite(b[0]) && std::isfinite(b[1]) && std::isfinite(b[2]) &&
+          std::isfinite(b[3]) && b[0] < b[2] && b[1] < b[3])) {
+      throw ParameterError("crop",
+                           "has no area: give xmin,ymin,xmax,ymax with finite numbers, "
+                           "xmin < xmax and ymin < ymax");
+    }
+  }
   if (crop_lonlat) {
     const auto& b = *crop_lonlat;
+    if (!(b[1] >= -90 && b[3] <= 90 && b[0] >= -180 && b[2] <= 180)) {
+      throw ParameterError("crop_lonlat",
+                           "leaves the globe: longitudes lie in [-180, 180], "
+                           "latitudes in [-90, 90]");
+    }
     if (!(b[0] < b[2] && b[1] < b[3]))
       throw ParameterError("crop_lonlat", "needs west < east and south < north");
   }
@@ -212,10 +255,7 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
                           std::to_string(header.width) + " x " + std::to_string(header.height));
   const WarpPlan plan = plan_warp(path, header, o, result.report);
-  // The warped grid covers at most about the source's area at `cell`: check it fits.
-  const double src_area_cells = static_cast<double>(header.width) * header.height;
-  require_memory(static_cast<std::uint64_t>(src_area_cells * 4.0 * 6.0),
-                 "importing '" + path.string() + "'", "crop it first (a lon/lat crop box)");
+  require_warp_memory(header, o, plan, path);
   result.grid = warp_to_grid(path, plan, o);
   result.report.push_back("grid " + std::to_string(result.grid.width()) + " x " +
                           std::to_string(result.grid.height()) + " cells of " + fmt(plan.cell) +

@@ -1,6 +1,9 @@
 #include "terrain/memory.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -40,7 +43,24 @@ std::uint64_t cgroup_limit() {
 
 }  // namespace
 
-std::uint64_t available_memory_bytes() { return std::min(meminfo_available(), cgroup_limit()); }
+// DRIFT_MEMORY_LIMIT caps what a run may use (bytes, or with K, M, G suffix),
+// e.g. for batch jobs sharing a machine, and for the fuzz targets.
+std::uint64_t user_limit() {
+  const char* text = std::getenv("DRIFT_MEMORY_LIMIT");
+  if (!text || !*text) return std::numeric_limits<std::uint64_t>::max();
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  const double scale = *end == 'K' || *end == 'k'   ? 1024.0
+                       : *end == 'M' || *end == 'm' ? 1024.0 * 1024.0
+                       : *end == 'G' || *end == 'g' ? 1024.0 * 1024.0 * 1024.0
+                                                    : 1.0;
+  if (!(v > 0) || !std::isfinite(v * scale)) return std::numeric_limits<std::uint64_t>::max();
+  return static_cast<std::uint64_t>(std::min(v * scale, 1.8e19));
+}
+
+std::uint64_t available_memory_bytes() {
+  return std::min({meminfo_available(), cgroup_limit(), user_limit()});
+}
 
 std::string human_bytes(std::uint64_t bytes) {
   const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};

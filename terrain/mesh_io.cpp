@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -13,16 +14,39 @@
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
+#include "terrain/input_path.h"
 
 namespace drift::terrain {
 
 namespace fs = std::filesystem;
 
-Mesh read_obj(const fs::path& path, bool y_up) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    throw Error("cannot read mesh '" + path.string() + "': no such file");
+namespace {
+
+// tinyobjloader reads "v nan 0 0" (or "v 1e999 ...") as a finite vertex without
+// a word: every vertex line is checked here first, naming the line.
+void require_finite_obj_vertices(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  for (std::size_t number = 1; std::getline(in, line); ++number) {
+    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
+    std::istringstream words(line.substr(2));
+    std::string word;
+    for (int k = 0; k < 3 && words >> word; ++k) {
+      char* end = nullptr;
+      const double v = std::strtod(word.c_str(), &end);
+      if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
+        throw Error("mesh '" + path.string() + "', line " + std::to_string(number) +
+                    ": vertex coordinate '" + word + "' is not a finite number");
+      }
+    }
   }
+}
+
+}  // namespace
+
+Mesh read_obj(const fs::path& path, bool y_up) {
+  check_input_file(path, "mesh");
+  require_finite_obj_vertices(path);
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
@@ -237,8 +261,16 @@ PlyHeader read_ply_header(std::istream& f, const PlyError& bad) {
   std::string element;
   while (std::getline(f, line) && line != "end_header") read_ply_header_line(line, element, h, bad);
   if (line != "end_header") throw bad("no end_header");
-  if (h.vertices > (std::size_t{1} << 31) || h.faces > (std::size_t{1} << 31)) {
-    throw bad("implausible element counts");
+  // What the header declares must be in the file, before anything is allocated.
+  const std::streampos body = f.tellg();
+  f.seekg(0, std::ios::end);
+  const auto left = static_cast<std::uintmax_t>(f.tellg() - body);
+  f.seekg(body);
+  const std::uintmax_t needed = static_cast<std::uintmax_t>(h.vertices) * h.properties.size() * 4 +
+                                static_cast<std::uintmax_t>(h.faces) * 13;
+  if (h.vertices > (std::size_t{1} << 31) || h.faces > (std::size_t{1} << 31) || needed > left) {
+    throw bad("the header declares " + std::to_string(h.vertices) + " vertices and " +
+              std::to_string(h.faces) + " faces, more than the file holds (truncated?)");
   }
   return h;
 }
@@ -263,7 +295,12 @@ void read_ply_vertices(std::istream& f, const PlyHeader& h, Mesh& mesh, const Pl
   const auto *x = column("x"), *y = column("y"), *z = column("z");
   if (!x || !y || !z) throw bad("no x, y, z vertex properties");
   mesh.positions.resize(vertices);
-  for (std::size_t v = 0; v < vertices; ++v) mesh.positions[v] = {(*x)[v], (*y)[v], (*z)[v]};
+  for (std::size_t v = 0; v < vertices; ++v) {
+    mesh.positions[v] = {(*x)[v], (*y)[v], (*z)[v]};
+    if (!mesh.positions[v].allFinite()) {
+      throw bad("vertex " + std::to_string(v) + " has a non-finite coordinate");
+    }
+  }
   const auto *nx = column("nx"), *ny = column("ny"), *nz = column("nz");
   if (nx && ny && nz) {
     mesh.normals.resize(vertices);
@@ -296,6 +333,7 @@ void read_ply_faces(std::istream& f, const PlyHeader& h, Mesh& mesh, const PlyEr
 }  // namespace
 
 Mesh read_ply(const fs::path& path) {
+  check_input_file(path, "mesh");
   std::ifstream f(path, std::ios::binary);
   if (!f) throw Error("cannot read mesh '" + path.string() + "': no such file");
   const PlyError bad = [&](const std::string& what) {

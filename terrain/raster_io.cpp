@@ -11,7 +11,9 @@
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
+#include "terrain/input_path.h"
 #include "terrain/memory.h"
+#include "terrain/raster_dataset.h"
 
 namespace drift::terrain {
 
@@ -34,13 +36,7 @@ using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
 
 DatasetPtr open_raster(const fs::path& path) {
   ensure_gdal();
-  std::error_code ec;
-  if (!fs::exists(path, ec)) {
-    throw Error("cannot read '" + path.string() + "': no such file");
-  }
-  if (fs::is_directory(path, ec)) {
-    throw Error("cannot read '" + path.string() + "': it is a directory, not a raster file");
-  }
+  check_input_file(path, "raster");
   g_last_gdal_message.clear();
   auto* ds = static_cast<GDALDataset*>(
       GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));
@@ -75,6 +71,39 @@ GeoReference georeference_of(GDALDataset& ds, GDALRasterBand& band) {
   return geo;
 }
 
+// A cell size of 0, NaN or infinity (or a NaN origin) makes every slope, area and
+// position computed later meaningless.
+void require_usable_georeference(const GeoReference& geo, const fs::path& path) {
+  const auto& gt = geo.geotransform;
+  bool finite = true;
+  for (double v : gt) finite = finite && std::isfinite(v);
+  const double dx = std::hypot(gt[1], gt[4]), dy = std::hypot(gt[2], gt[5]);
+  if (!finite || !(dx > 0) || !(dy > 0) || !std::isfinite(1.0 / dx) || !std::isfinite(1.0 / dy)) {
+    char text[200];
+    std::snprintf(text, sizeof text, "%g, %g, %g, %g, %g, %g", gt[0], gt[1], gt[2], gt[3], gt[4],
+                  gt[5]);
+    throw Error("raster '" + path.string() + "' has an unusable georeference (geotransform " +
+                text +
+                "): cell sizes must be finite and non-zero; fix it with gdal_edit.py -a_ullr");
+  }
+}
+
+// Infinite heights are refused rather than guessed at; NaN is nodata (filled by
+// drift import, refused or handled by each stage).
+void require_finite_cells(const HeightField& grid, const fs::path& path) {
+  const float nd = grid.geo().nodata ? static_cast<float>(*grid.geo().nodata) : 0.0f;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const float v = grid.values()[i];
+    if (std::isinf(v) && !(grid.geo().nodata && v == nd)) {
+      const std::size_t col = i % static_cast<std::size_t>(grid.width());
+      const std::size_t row = i / static_cast<std::size_t>(grid.width());
+      throw Error("raster '" + path.string() + "' holds an infinite height (" +
+                  (v > 0 ? "+inf" : "-inf") + ") at column " + std::to_string(col) + ", row " +
+                  std::to_string(row) + "; declare it nodata or fix the cell");
+    }
+  }
+}
+
 }  // namespace
 
 void ensure_gdal() {
@@ -102,6 +131,11 @@ RasterHeader read_raster_header(const fs::path& path) {
 
 HeightField read_raster(const fs::path& path, const ReadOptions& options) {
   DatasetPtr ds = open_raster(path);
+  return read_dataset(*ds, path, options);
+}
+
+HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadOptions& options) {
+  GDALDataset* ds = &dataset;
   if (options.band < 1 || options.band > ds->GetRasterCount()) {
     throw Error("cannot read band " + std::to_string(options.band) + " of '" + path.string() +
                 "': it has " + std::to_string(ds->GetRasterCount()) + " band(s)");
@@ -126,6 +160,7 @@ HeightField read_raster(const fs::path& path, const ReadOptions& options) {
                  "crop it (drift import --crop) or resample it to a coarser cell size first");
 
   GeoReference geo = georeference_of(*ds, *band);
+  require_usable_georeference(geo, path);
   // Shift the geotransform to the window's origin.
   auto& gt = geo.geotransform;
   gt[0] += win.x_off * gt[1] + win.y_off * gt[2];
@@ -140,6 +175,7 @@ HeightField read_raster(const fs::path& path, const ReadOptions& options) {
                 (g_last_gdal_message.empty() ? std::string("read failed") : g_last_gdal_message) +
                 " (the file may be truncated or corrupt)");
   }
+  require_finite_cells(grid, path);
   // Invalid cells become NaN in memory, whatever the file called them.
   if (geo.nodata) {
     const float nd = static_cast<float>(*geo.nodata);

@@ -100,10 +100,11 @@ TEST(MarksCli, BadTrackFilesExitOneNamingTheProblemAndWriteNothing) {
   }
 }
 
-TEST(MarksCli, AnOutputThatIsAnInputIsAUsageError) {
+// Refused like any output that is an input (docs/outputs.md): exit 1.
+TEST(MarksCli, AnOutputThatIsAnInputIsRefused) {
   const fs::path d = dir(), g = ground(d);
   std::ofstream(d / "track.toml") << track();
-  EXPECT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " + g.string(), d), 2)
+  EXPECT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " + g.string(), d), 1)
       << output(d);
 }
 

@@ -1,0 +1,372 @@
+// Every subcommand's outputs (docs/outputs.md): paths that cannot be outputs are
+// refused before any work with exit 1 and a message naming them; existing
+// outputs stay byte for byte as they were unless the run completes; temporary
+// files never stay behind, also after SIGINT, SIGTERM and SIGHUP (exit 130, 143,
+// 129) at several points of a run; permissions of a replaced file are kept.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "terrain/raster_io.h"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path test_dir() {
+  const fs::path d = fs::temp_directory_path() / "drift_outputs_cli" /
+                     ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+struct Result {
+  int status = -1;  // exit status, or 128 + signal
+  std::string log;  // stdout and stderr
+};
+
+std::vector<std::string> split(const std::string& args) {
+  std::istringstream in(args);
+  std::vector<std::string> v;
+  for (std::string w; in >> w;) v.push_back(w);
+  return v;
+}
+
+// Runs drift with `args` (split at spaces). With `stop_at` > 0 the run stops
+// itself as its stop_at-th output starts being written (DRIFT_TEST_STOP_AT_WRITE);
+// `at_stop` then runs, `sig` is sent and the run continued. With `after` > 0 ms
+// and no stop_at, `sig` is sent after that delay.
+Result drift(const std::string& args, const fs::path& dir, int stop_at = 0, int sig = 0,
+             int after_ms = 0, const std::function<void()>& at_stop = {}) {
+  std::vector<std::string> words = split(args);
+  words.insert(words.begin(), DRIFT_EXECUTABLE);
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_strings;
+  for (char** e = environ; *e; ++e) env_strings.emplace_back(*e);
+  if (stop_at > 0) env_strings.push_back("DRIFT_TEST_STOP_AT_WRITE=" + std::to_string(stop_at));
+  std::vector<char*> envp;
+  for (auto& e : env_strings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const fs::path log = dir.parent_path() / (dir.filename().string() + ".log");
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = 0;
+  EXPECT_EQ(posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), envp.data()), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  int status = 0;
+  bool ended = false;
+  if (stop_at > 0) {
+    waitpid(pid, &status, WUNTRACED);
+    ended = !WIFSTOPPED(status);
+    if (!ended) {
+      if (at_stop) at_stop();
+      if (sig) kill(pid, sig);
+      kill(pid, SIGCONT);
+    }
+  } else if (sig) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
+    kill(pid, sig);
+  }
+  if (!ended) waitpid(pid, &status, 0);
+  Result r;
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.log = slurp(log);
+  return r;
+}
+
+// Files in `dir` whose names start with '.' (the temporary files' names do).
+std::vector<std::string> hidden_files(const fs::path& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().filename().string()[0] == '.') found.push_back(e.path().string());
+  }
+  return found;
+}
+
+// A small metric DEM, a scene rendering it, two tiles and a PNG of it.
+struct Inputs {
+  fs::path dir, dem, scene, png, tile0, tile1, marks_ground, track;
+};
+
+// Made once per build of drift and shared by the test processes (CTest runs
+// them in parallel): a lock file serialises the making, a stamp records for
+// which drift binary they were made.
+Inputs make_inputs() {
+  static Inputs made;
+  if (!made.dir.empty()) return made;
+  made.dir = fs::path(DRIFT_BINARY_DIR) / "tests" / "outputs_cli_inputs";
+  made.dem = made.dir / "dem.tif";
+  made.scene = made.dir / "scene.toml";
+  made.png = made.dir / "frame.png";
+  made.tile0 = made.dir / "t0.exr";
+  made.tile1 = made.dir / "t1.exr";
+  made.marks_ground = made.dir / "marks_ground.tif";
+  made.track = made.dir / "track.toml";
+  fs::create_directories(made.dir);
+  const int lock = open((made.dir / "lock").c_str(), O_RDWR | O_CREAT, 0644);
+  flock(lock, LOCK_EX);
+  const std::string stamp =
+      std::to_string(fs::last_write_time(DRIFT_EXECUTABLE).time_since_epoch().count());
+  if (slurp(made.dir / "stamp") != stamp) {
+    drift::terrain::HeightField g(32, 32, 0.0f, drift::terrain::local_georeference(10.0));
+    for (int r = 0; r < 32; ++r)
+      for (int x = 0; x < 32; ++x) g(x, r) = 100.0f + 3.0f * static_cast<float>(x + (r % 7));
+    drift::terrain::write_geotiff(g, made.dem);
+    put(made.scene, "[terrain]\nraster = \"dem.tif\"\n[sun]\nazimuth = 120\nelevation = 35\n");
+    const std::string base = "render " + made.scene.string() + " --size 16x8 --spp 1 ";
+    EXPECT_EQ(drift(base + "-o " + made.png.string(), made.dir / "r0").status, 0);
+    EXPECT_EQ(drift(base + "--tile 0/2 -o " + made.tile0.string(), made.dir / "r1").status, 0);
+    EXPECT_EQ(drift(base + "--tile 1/2 -o " + made.tile1.string(), made.dir / "r2").status, 0);
+    // A ball pressed into 1 cm cells (as tests/marks/marks_cli_test.cpp).
+    drift::terrain::HeightField m(32, 32, 2000.0f, drift::terrain::local_georeference(0.01));
+    m.geo().geotransform[0] = 600000.0;
+    m.geo().geotransform[3] = 4000000.0;
+    drift::terrain::write_geotiff(m, made.marks_ground);
+    put(made.track,
+        "step = 0.1\n[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
+        "/data/objects/ball.obj\"\nscale = 0.2\n"
+        "[[objects.keyframes]]\ntime = 0.0\nposition = [600000.16, 3999999.84, 2000.04]\n"
+        "[[objects.keyframes]]\ntime = 0.2\nposition = [600000.16, 3999999.84, 2000.01]\n");
+    put(made.dir / "stamp", stamp);
+  }
+  flock(lock, LOCK_UN);
+  close(lock);
+  return made;
+}
+
+// One run of each subcommand that writes: its arguments with OUT where the
+// (first) output goes, the output's extension and the input it reads first.
+struct Command {
+  std::string name, args, ext;
+  fs::path input;
+};
+
+const std::vector<Command>& commands() {
+  const Inputs in = make_inputs();
+  const std::string dem = in.dem.string(), png = in.png.string();
+  static const std::vector<Command> all = {
+      {"import", "import " + dem + " -o OUT", ".tif", in.dem},
+      {"dunes", "dunes --size 16 --steps 2 -o OUT", ".tif", {}},
+      {"snow cover", "snow cover " + dem + " --radius-cells 3 -o OUT", ".tif", in.dem},
+      {"snow fall", "snow fall " + dem + " --maps 1 --spread 0 -o OUT", ".tif", in.dem},
+      {"render", "render " + in.scene.string() + " --size 16x8 --spp 1 -o OUT", ".png", in.scene},
+      {"merge", "merge " + in.tile0.string() + " " + in.tile1.string() + " -o OUT", ".exr",
+       in.tile0},
+      {"compare", "compare " + png + " " + png + " --diff OUT", ".png", in.png},
+      {"sheet", "sheet " + png + " -o OUT", ".png", in.png},
+      {"marks", "marks " + in.marks_ground.string() + " --track " + in.track.string() + " -o OUT",
+       ".tif", in.marks_ground},
+  };
+  return all;
+}
+
+const std::vector<std::string> kCommandNames = {
+    "import", "dunes", "snow cover", "snow fall", "render", "merge", "compare", "sheet", "marks"};
+
+// The tests below run once per subcommand that writes (named in the test's name).
+class EachCommand : public ::testing::TestWithParam<std::string> {
+ protected:
+  const Command& command() const {
+    for (const Command& c : commands()) {
+      if (c.name == GetParam()) return c;
+    }
+    throw std::runtime_error("no command " + GetParam());
+  }
+};
+
+std::string test_name(const ::testing::TestParamInfo<std::string>& info) {
+  std::string name = info.param;
+  for (char& ch : name) ch = ch == ' ' ? '_' : ch;
+  return name;
+}
+
+std::string with_output(const Command& c, const fs::path& out) {
+  std::string args = c.args;
+  args.replace(args.find("OUT"), 3, out.string());
+  return args;
+}
+
+TEST_P(EachCommand, WritesAndKeepsPermissions) {
+  {
+    const Command& c = command();
+    const fs::path d = test_dir(), out = d / ("out" + c.ext);
+    put(out, "old");
+    fs::permissions(out, fs::perms(0640));
+    const Result r = drift(with_output(c, out), d);
+    EXPECT_EQ(r.status, 0) << c.name << ": " << r.log;
+    EXPECT_NE(slurp(out), "old") << c.name;
+    EXPECT_EQ(fs::status(out).permissions() & fs::perms::all, fs::perms(0640)) << c.name;
+    EXPECT_TRUE(hidden_files(d).empty()) << c.name;
+  }
+}
+
+TEST_P(EachCommand, WritesNamesUpToTheFileSystemLimit) {
+  {
+    const Command& c = command();
+    const fs::path d = test_dir();
+    const fs::path out = d / (std::string(255 - c.ext.size(), 'n') + c.ext);  // 255 bytes
+    const Result r = drift(with_output(c, out), d);
+    EXPECT_EQ(r.status, 0) << c.name << ": " << r.log;
+    EXPECT_TRUE(fs::exists(out)) << c.name;
+    EXPECT_TRUE(hidden_files(d).empty()) << c.name;
+  }
+}
+
+// Every class of path that is not a possible output, for every subcommand:
+// exit 1, the message names the path, nothing is touched.
+TEST_P(EachCommand, RefusesPathsThatCannotBeOutputs) {
+  {
+    const Command& c = command();
+    const fs::path d = test_dir();
+    const fs::path target = d / ("real" + c.ext), link = d / ("link" + c.ext);
+    put(target, "keep me");
+    fs::create_symlink(target, link);
+    const fs::path fifo = d / ("fifo" + c.ext), folder = d / ("folder" + c.ext);
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+    fs::create_directory(folder);
+    std::map<std::string, fs::path> refused = {
+        {"device", "/dev/null"},
+        {"fifo", fifo},
+        {"directory", folder},
+        {"symlink", link},
+        {"missing folder", d / "no" / ("x" + c.ext)},
+        {"name too long", d / (std::string(256, 'n') + c.ext)}};
+    if (!c.input.empty()) refused["input"] = c.input;
+    const std::string input_before = c.input.empty() ? "" : slurp(c.input);
+    for (const auto& [what, out] : refused) {
+      const Result r = drift(with_output(c, out), d);
+      EXPECT_EQ(r.status, 1) << c.name << ", " << what << ": " << r.log;
+      const std::string shown = out.filename().string().substr(0, 40);
+      EXPECT_NE(r.log.find(shown), std::string::npos) << c.name << ", " << what << ": " << r.log;
+    }
+    struct stat st {};
+    ASSERT_EQ(stat("/dev/null", &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << c.name << " replaced /dev/null";
+    EXPECT_TRUE(fs::is_symlink(link)) << c.name;
+    EXPECT_EQ(slurp(target), "keep me") << c.name;
+    EXPECT_TRUE(fs::is_fifo(fifo) && fs::is_directory(folder)) << c.name;
+    if (!c.input.empty()) {
+      EXPECT_EQ(slurp(c.input), input_before) << c.name;
+    }
+    EXPECT_TRUE(hidden_files(d).empty()) << c.name;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(OutputsCli, EachCommand, ::testing::ValuesIn(kCommandNames), test_name);
+
+// The inputs of a run are refused as its outputs however they are spelled.
+TEST(OutputsCli, InputsAreRefusedAsOutputsUnderAnyName) {
+  const Inputs in = make_inputs();
+  const fs::path d = test_dir();
+  const std::string before = slurp(in.tile1);
+  fs::create_hard_link(in.tile1, d / "hard.exr");
+  const std::string merge = "merge " + in.tile0.string() + " " + in.tile1.string() + " -o ";
+  for (const fs::path& out : {in.dir / "." / "t1.exr", d / "hard.exr"}) {
+    const Result r = drift(merge + out.string(), d);
+    EXPECT_EQ(r.status, 1) << out << ": " << r.log;
+    EXPECT_NE(r.log.find("input"), std::string::npos) << r.log;
+  }
+  EXPECT_EQ(slurp(in.tile1), before);
+  // The scene's own rasters are inputs of a render too.
+  const Result r = drift("render " + in.scene.string() + " --size 16x8 --spp 1 -o " +
+                             (d / "a.png").string() + " -o " + in.dem.string(),
+                         d);
+  EXPECT_EQ(r.status, 1) << r.log;
+  EXPECT_TRUE(fs::exists(in.dem) && !fs::exists(d / "a.png"));
+}
+
+// Commands with several outputs: a path named twice or a bad second output is
+// found before any work; a failure while writing the second output leaves the
+// first as it was.
+TEST(OutputsCli, SeveralOutputsAreAllOrNothing) {
+  const Inputs in = make_inputs();
+  const fs::path d = test_dir(), a = d / "a.png", b = d / "b.exr";
+  put(a, "old a");
+  put(b, "old b");
+  const std::string render = "render " + in.scene.string() + " --size 16x8 --spp 1 -o ";
+  Result r = drift(render + a.string() + " -o " + (d / "no" / "b.exr").string(), d);
+  EXPECT_EQ(r.status, 1) << r.log;
+  EXPECT_NE(r.log.find("does not exist"), std::string::npos) << r.log;
+  r = drift(render + a.string() + " -o " + (d / "." / "a.png").string(), d);
+  EXPECT_EQ(r.status, 1) << r.log;
+  EXPECT_NE(r.log.find("twice"), std::string::npos) << r.log;
+  // The second write fails: its temporary file has become a directory.
+  auto sabotage = [&] {
+    for (const std::string& t : hidden_files(d)) {
+      if (t.find(".b.tmp-") != std::string::npos) {
+        fs::remove(t);
+        fs::create_directory(t);
+      }
+    }
+  };
+  r = drift(render + a.string() + " -o " + b.string(), d, 2, 0, 0, sabotage);
+  EXPECT_EQ(r.status, 1) << r.log;
+  EXPECT_EQ(slurp(a), "old a");
+  EXPECT_EQ(slurp(b), "old b");
+  for (const std::string& t : hidden_files(d)) fs::remove_all(t);  // the sabotage's directory
+  // snow cover's three outputs: the third in a missing folder fails before work.
+  r = drift("snow cover " + in.dem.string() + " -o " + a.string() + " --descriptor " + b.string() +
+                " --accessibility " + (d / "no" / "c.tif").string(),
+            d);
+  EXPECT_EQ(r.status, 1) << r.log;
+  EXPECT_EQ(slurp(a), "old a");
+  EXPECT_TRUE(hidden_files(d).empty());
+}
+
+// SIGINT, SIGTERM and SIGHUP during the computation, as the first output is
+// being written and as the second is: exit 128 + signal with one line, no
+// temporary file left, the existing outputs untouched.
+TEST(OutputsCli, SignalsRemoveTemporaryFilesAndKeepOutputs) {
+  const Inputs in = make_inputs();
+  const std::string render = "render " + in.scene.string() + " --size 16x8 --spp 1 --threads 2 -o ";
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    for (int at : {1, 2}) {
+      const fs::path d = test_dir(), a = d / "a.png", b = d / "b.exr";
+      put(a, "old a");
+      put(b, "old b");
+      const Result r = drift(render + a.string() + " -o " + b.string(), d, at, sig);
+      EXPECT_EQ(r.status, 128 + sig) << "signal " << sig << " at write " << at << ": " << r.log;
+      EXPECT_NE(r.log.find("interrupted by SIG"), std::string::npos) << r.log;
+      EXPECT_EQ(slurp(a), "old a");
+      EXPECT_EQ(slurp(b), "old b");
+      EXPECT_TRUE(hidden_files(d).empty()) << "signal " << sig << " at write " << at;
+    }
+    // During the computation (a long dune run), with snapshots already written.
+    const fs::path d = test_dir(), out = d / "dunes.tif";
+    put(out, "old");
+    const Result r = drift("dunes --size 256 --steps 100000 --snapshot-every 1 -o " + out.string(),
+                           d, 0, sig, 1500);
+    EXPECT_EQ(r.status, 128 + sig) << r.log;
+    EXPECT_EQ(slurp(out), "old");
+    EXPECT_TRUE(hidden_files(d).empty()) << "signal " << sig << " during the computation";
+  }
+}
+
+}  // namespace

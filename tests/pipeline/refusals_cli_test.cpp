@@ -1,0 +1,234 @@
+// The number, size and input classes of docs/outputs.md, per subcommand: NaN
+// and infinity are usage errors (exit 2) naming the flag; values whose use would
+// overflow, crops of no area and latitudes off the globe are errors naming the
+// value; sizes are checked against memory before anything is allocated (the
+// message says how much is needed and how much there is); FIFOs as inputs fail
+// at once rather than hang. Existing outputs are untouched in every case.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "terrain/raster_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path test_dir() {
+  const fs::path d = fs::temp_directory_path() / "drift_refusals_cli" /
+                     ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+struct Result {
+  int status;
+  std::string log;
+};
+
+// Runs drift (at most 60 s: a hang fails the test rather than the suite) with
+// the environment assignments in `env` and returns its status and output.
+Result drift(const std::string& args, const fs::path& d, const std::string& env = "") {
+  const fs::path log = d / "log.txt";
+  const std::string cmd =
+      env + " timeout 60 " + DRIFT_EXECUTABLE + " " + args + " > " + log.string() + " 2>&1";
+  const int raw = std::system(cmd.c_str());
+  return {WEXITSTATUS(raw), slurp(log)};
+}
+
+// A small metric DEM, `value` at cell (3, 2).
+fs::path dem(const fs::path& d, float value = 1.0f, double cell = 10.0) {
+  drift::terrain::HeightField g(16, 16, 100.0f, drift::terrain::local_georeference(cell));
+  g(3, 2) = value;
+  const fs::path p = d / "dem.tif";
+  drift::terrain::write_geotiff(g, p);
+  return p;
+}
+
+#define EXPECT_REFUSED(result, code, needle)                        \
+  do {                                                              \
+    const Result r_ = (result);                                     \
+    EXPECT_EQ(r_.status, code) << r_.log;                           \
+    EXPECT_NE(r_.log.find(needle), std::string::npos) << r_.log;    \
+    EXPECT_NE(r_.log.find("drift: "), std::string::npos) << r_.log; \
+  } while (0)
+
+TEST(RefusalsCli, NonFiniteNumbersAreUsageErrorsInEverySubcommand) {
+  const fs::path d = test_dir(), in = dem(d), out = d / "out.tif";
+  put(out, "old");
+  const std::string i = in.string(), o = " -o " + out.string();
+  const std::string png = (d / "a.png").string();
+  put(d / "scene.toml", "[terrain]\nraster = \"dem.tif\"\n");
+  const std::string scene = (d / "scene.toml").string();
+  for (const std::string& args : {
+           "import " + i + o + " --resample nan",
+           "import " + i + o + " --exaggerate inf",
+           "import " + i + o + " --crop 0,0,nan,10",
+           "dunes --size 16 --cell nan" + o,
+           "snow cover " + i + o + " --snow-line nan",
+           "snow cover " + i + o + " --radius inf",
+           "snow fall " + i + o + " --rate nan",
+           "snow fall " + i + o + " --direction 0,nan",
+           "render " + scene + " -o " + png + " --exposure nan",
+           "render " + scene + " -o " + png + " --noise-target nan",
+           "merge " + png + " -o " + png + " --exposure -inf",
+           "compare " + png + " " + png + " --pixel-threshold nan",
+           "compare " + png + " " + png + " --threshold inf",
+           "sheet " + png + " -o " + png + " --exposure nan",
+       }) {
+    const Result r = drift(args, d);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.log;
+    // (An option's own range check may refuse inf first, with its own words.)
+    if (args.find("nan") != std::string::npos) {
+      EXPECT_NE(r.log.find("not a finite number"), std::string::npos) << args << "\n" << r.log;
+    }
+  }
+  EXPECT_EQ(slurp(out), "old");
+}
+
+TEST(RefusalsCli, FifosAsInputsFailAtOnce) {
+  const fs::path d = test_dir(), fifo = d / "pipe.tif";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  const std::string f = fifo.string(), o = " -o " + (d / "o.tif").string();
+  for (const std::string& args :
+       {"info " + f, "import " + f + o, "snow cover " + f + o, "render " + f + " -o x.png",
+        "compare " + f + " " + f, "snow fall " + dem(d).string() + " --objects " + f + o}) {
+    EXPECT_REFUSED(drift(args, d), 1, "pipe.tif");
+  }
+}
+
+TEST(RefusalsCli, ImportRefusesEmptyCropsLatitudesOffTheGlobeAndHugeGrids) {
+  const fs::path d = test_dir(), in = dem(d), out = d / "out.tif";
+  put(out, "old");
+  const std::string base = "import " + in.string() + " -o " + out.string();
+  EXPECT_REFUSED(drift(base + " --crop 10,0,10,50", d), 1, "no area");
+  EXPECT_REFUSED(drift(base + " --crop-lonlat 137,30,138,95", d), 1, "[-90, 90]");
+  EXPECT_REFUSED(drift(base + " --crop-lonlat 137,36,137,37", d), 1, "west < east");
+  // 160 m x 160 m at 1 mm cells: 2.56e10 cells, refused before GDAL allocates.
+  EXPECT_REFUSED(drift(base + " --resample 0.001", d), 1, "too large a grid");
+  EXPECT_REFUSED(drift(base + " --resample 0.01", d, "DRIFT_MEMORY_LIMIT=64M"), 1, "is available");
+  EXPECT_EQ(slurp(out), "old");
+}
+
+TEST(RefusalsCli, RastersWithInfiniteCellsOrCellSizesAreRefused) {
+  const fs::path d = test_dir(), out = d / "out.tif";
+  const std::string o = " -o " + out.string();
+  const std::string inf_dem = dem(d, std::numeric_limits<float>::infinity()).string();
+  EXPECT_REFUSED(drift("info " + inf_dem, d), 1, "infinite height");
+  EXPECT_REFUSED(drift("snow cover " + inf_dem + o, d), 1, "column 3, row 2");
+  drift::terrain::HeightField g(8, 8, 1.0f, drift::terrain::local_georeference(0.0));
+  drift::terrain::write_geotiff(g, d / "flat.tif");
+  EXPECT_REFUSED(drift("import " + (d / "flat.tif").string() + o, d), 1, "georeference");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(RefusalsCli, SceneValuesWhoseReciprocalsOverflowAndLatitudesOffTheGlobe) {
+  const fs::path d = test_dir();
+  dem(d);
+  drift::terrain::HeightField ripples(16, 16, 0.0f, drift::terrain::local_georeference(0.01));
+  drift::terrain::write_geotiff(ripples, d / "ripples.tif");
+  const std::string head = "[terrain]\nraster = \"dem.tif\"\n";
+  const std::string render =
+      "render " + (d / "scene.toml").string() + " --size 8x4 --spp 1 -o " + (d / "a.png").string();
+  put(d / "scene.toml", head + "[ripples]\nraster = \"ripples.tif\"\ncell = 1e-39\n");
+  EXPECT_REFUSED(drift(render, d), 1, "ripples.cell");
+  put(d / "scene.toml", head + "[camera]\nfrom_lonlat = [137.6, 95.0]\nto = [80, -80, 100]\n");
+  EXPECT_REFUSED(drift(render, d), 1, "[-90, 90]");
+  put(d / "scene.toml", head +
+                            "[camera]\nfrom = [0, 0, 500]\nto = [80, -80, 100]\n"
+                            "focal_length = 1e-30\n");
+  EXPECT_REFUSED(drift(render, d), 1, "focal_length");
+  EXPECT_FALSE(fs::exists(d / "a.png"));
+}
+
+TEST(RefusalsCli, SizesAreCheckedAgainstMemoryBeforeAllocating) {
+  const fs::path d = test_dir();
+  dem(d);
+  put(d / "scene.toml", "[terrain]\nraster = \"dem.tif\"\n");
+  // A render's image.
+  EXPECT_REFUSED(drift("render " + (d / "scene.toml").string() + " --size 16384x16384 -o " +
+                           (d / "a.exr").string(),
+                       d, "DRIFT_MEMORY_LIMIT=1G"),
+                 1, "needs");
+  // An image declaring 60000^2 pixels in 69 bytes, before decoding.
+  const std::string huge =
+      std::string(DRIFT_SOURCE_DIR) + "/tests/fuzz/regressions/image/declares_60000x60000.png";
+  EXPECT_REFUSED(drift("compare " + huge + " " + huge, d), 1, "60000x60000");
+  EXPECT_REFUSED(drift("sheet " + huge + " -o " + (d / "s.png").string(), d), 1, "60000x60000");
+  // A sheet title far wider than any sheet.
+  ASSERT_EQ(drift("render " + (d / "scene.toml").string() + " --size 8x4 --spp 1 -o " +
+                      (d / "small.png").string(),
+                  d)
+                .status,
+            0);
+  EXPECT_REFUSED(drift("sheet " + (d / "small.png").string() + " --font-size 128 --title " +
+                           std::string(20000, 'W') + " -o " + (d / "s.png").string(),
+                       d),
+                 1, "the title");
+  // One big triangle refined for snowfall.
+  put(d / "tri.obj", "v 0 0 0\nv 1000 0 0\nv 0 1000 0\nf 1 2 3\n");
+  put(d / "objects.toml", "[[objects]]\nmesh = \"tri.obj\"\nposition = [80, -80, 100]\n");
+  EXPECT_REFUSED(drift("snow fall " + (d / "dem.tif").string() + " --objects " +
+                           (d / "objects.toml").string() + " --mesh-edge 0.001 -o " +
+                           (d / "depth.tif").string(),
+                       d),
+                 1, "--mesh-edge");
+  EXPECT_FALSE(fs::exists(d / "depth.tif") || fs::exists(d / "s.png"));
+}
+
+TEST(RefusalsCli, NonFiniteMeshVerticesAreRefused) {
+  const fs::path d = test_dir();
+  put(d / "nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  put(d / "objects.toml", "[[objects]]\nmesh = \"nan.obj\"\nposition = [80, -80, 100]\n");
+  EXPECT_REFUSED(drift("snow fall " + dem(d).string() + " --objects " +
+                           (d / "objects.toml").string() + " -o " + (d / "depth.tif").string(),
+                       d),
+                 1, "nan.obj");
+}
+
+TEST(RefusalsCli, TilesOfDifferentScenesDoNotMerge) {
+  const fs::path d = test_dir();
+  dem(d);
+  put(d / "a.toml", "[terrain]\nraster = \"dem.tif\"\n[sun]\nelevation = 30\n");
+  put(d / "b.toml", "[terrain]\nraster = \"dem.tif\"\n[sun]\nelevation = 60\n");
+  for (const std::string tile : {"a 0", "b 1", "a 1"}) {
+    const std::string scene(1, tile[0]), index(1, tile[2]);
+    ASSERT_EQ(drift("render " + (d / (scene + ".toml")).string() + " --size 8x4 --spp 1 --tile " +
+                        index + "/2 -o " + (d / (scene + index + ".exr")).string(),
+                    d)
+                  .status,
+              0);
+  }
+  const std::string a0 = (d / "a0.exr").string();
+  EXPECT_REFUSED(
+      drift("merge " + a0 + " " + (d / "b1.exr").string() + " -o " + (d / "m.exr").string(), d), 1,
+      "another scene");
+  EXPECT_EQ(
+      drift("merge " + a0 + " " + (d / "a1.exr").string() + " -o " + (d / "m.exr").string(), d)
+          .status,
+      0);
+}
+
+TEST(RefusalsCli, SceneOutputFilesResolveAgainstTheSceneFile) {
+  const fs::path d = test_dir();
+  fs::create_directories(d / "scenes");
+  dem(d / "scenes");
+  put(d / "scenes" / "s.toml",
+      "[terrain]\nraster = \"dem.tif\"\n[render]\nwidth = 8\nheight = 4\nspp = 1\n"
+      "[output]\nfiles = [\"out.png\"]\n");
+  ASSERT_EQ(drift("render " + (d / "scenes" / "s.toml").string(), d).status, 0);
+  EXPECT_TRUE(fs::exists(d / "scenes" / "out.png"));
+}
+
+}  // namespace
