@@ -67,6 +67,17 @@ void read_detail(Section& s, render::MaterialOverride& m) {
   m.detail = d;
 }
 
+// [terrain] surround (rasters), surround_reach and surround_blend: the
+// ground beyond the DEM's edge (render/surround.h).
+template <class Resolve>
+void read_surround(Section& terrain, SceneFile& scene, const Resolve& resolve) {
+  for (const std::string& f : terrain.strings("surround"))
+    scene.surround_rasters.push_back(resolve(f));
+  render::SurroundOptions& o = scene.input.surround;
+  o.reach = terrain.number("surround_reach", o.reach, 0.0, 1e6);
+  o.blend = terrain.number("surround_blend", o.blend, 0.0, 1e5);
+}
+
 // The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
 // `material` names a preset (which sets every field), and `color`,
 // `roughness` and `wetness` set (or override) one field each. `preset` gets
@@ -193,6 +204,7 @@ SceneFile read_scene_file(const fs::path& path) {
   in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
   scene.terrain_repeat = terrain.integer("repeat", 1, 1, 9);
   scene.position_radius = terrain.number("position_radius", scene.position_radius, 1.0, 1e5);
+  read_surround(terrain, scene, resolve);
   if (const auto map = terrain.string("albedo_map")) scene.albedo_map = resolve(*map);
   // Objects standing on the terrain from an objects file (as `drift snow fall
   // --objects` reads), in addition to any [[objects]] here.
@@ -223,6 +235,8 @@ SceneFile read_scene_file(const fs::path& path) {
       snow.number("forward_scattering", in.surface.snow.forward_scattering, 0.0, 1.0));
   in.surface.snow_scattering =
       static_cast<float>(snow.number("scattering", in.surface.snow_scattering, 1.0, 1e5));
+  in.surface.snow_cover_outside = static_cast<float>(
+      snow.number("cover_outside", in.surface.snow_cover_outside, 0.0, 1.0));
   snow.finish();
 
   if (const toml::table* ripple_table = subtable(root, "ripples", path)) {
@@ -477,6 +491,8 @@ void load_scene_terrain(SceneFile& scene) {
   }
   for (std::size_t i = 0; i < scene.layer_masks.size(); ++i)
     surface.layers[i].mask = read_metric_raster(scene.layer_masks[i]);
+  for (const fs::path& f : scene.surround_rasters)
+    scene.input.surround.rasters.push_back(read_metric_raster(f));
   if (uses_position(surface))
     surface.position = render::topographic_position(scene.input.terrain, scene.position_radius);
   if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);

@@ -186,7 +186,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
     parameters.aerosol_scale = input.sky.haze;
     atmosphere = std::make_unique<Atmosphere>(parameters);
     const double camera_altitude = scene.origin().z() + camera_rays.eye.z();
-    const double reach = camera_rays.eye.head<2>().norm() + scene.extent().norm();
+    const double reach = camera_rays.eye.head<2>().norm() + scene.extent().norm() + scene.surround_reach();
     air = std::make_unique<PhysicalSky>(*atmosphere, camera_altitude, sun_dir.cast<double>(),
                                         static_cast<float>(sun.irradiance), reach);
   }
@@ -198,7 +198,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const bool shafts = air && input.sky.light_shafts && sun_up;
   const ShadowSlab shadow_slab{scene.bottom(), scene.top()};
   const auto in_shadow = [&](const Vector3f& p) { return scene.occluded(p, sun_dir, 1e30f); };
-  const float air_reach = camera_rays.eye.head<2>().norm() + scene.extent().norm();
+  const float air_reach = camera_rays.eye.head<2>().norm() + scene.extent().norm() + scene.surround_reach();
   auto shaft_loss = [&](const Vector3f& origin, const Vector3f& dir, float distance, float jitter,
                         std::uint64_t& rays) {
     rays += static_cast<std::uint64_t>(input.sky.shaft_steps);

@@ -41,6 +41,7 @@ struct TerrainScene::Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<RTCGrid> grids;
+  std::vector<RTCGrid> surround_grids;
   ~Embree() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -65,6 +66,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   embree_->scene = rtcNewScene(embree_->device);
   rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
   attach_terrain_grids();
+  attach_surround(input.surround);
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
   rtcCommitScene(embree_->scene);
   check_device(embree_->device, "build the scene");
@@ -153,6 +155,30 @@ void TerrainScene::attach_terrain_grids() {
   mesh_snow_triangles_.emplace_back();
 }
 
+void TerrainScene::attach_surround(const SurroundOptions& options) {
+  DemVertices dem{&vertices_, width_, height_, dx_, dy_, origin_, exaggeration_};
+  SurroundGrids ring = build_surround(dem, options);
+  if (ring.grids.empty()) return;
+  surround_vertices_ = std::move(ring.vertices);
+  std::vector<RTCGrid>& grids = embree_->surround_grids;
+  for (const SurroundGrids::Grid& g : ring.grids)
+    grids.push_back({g.start, g.stride, g.width, g.height});
+  RTCGeometry geometry = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_GRID);
+  rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                             surround_vertices_.data(), 0, sizeof(Eigen::Vector3f),
+                             surround_vertices_.size());
+  rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID, grids.data(), 0,
+                             sizeof(RTCGrid), grids.size());
+  rtcCommitGeometry(geometry);
+  surround_geometry_ = rtcAttachGeometry(embree_->scene, geometry);
+  rtcReleaseGeometry(geometry);
+  surround_reach_ = ring.reach;
+  // Keep the per-geometry tables indexed by id.
+  mesh_albedo_.resize(surround_geometry_ + 1, surface_.ground.albedo);
+  mesh_snow_.resize(surround_geometry_ + 1);
+  mesh_snow_triangles_.resize(surround_geometry_ + 1);
+}
+
 void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
   // Triangle geometry with its own (copied, shifted) buffers.
   RTCGeometry geom = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -223,13 +249,19 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;
   Eigen::Vector3f n;
-  if (rh.hit.geomID < terrain_geometries_) {
+  if (rh.hit.geomID == surround_geometry_) {
+    // Beyond the DEM: its facets' normal, facing up.
+    n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+    if (n.z() < 0.0f) n = -n;
+  } else if (rh.hit.geomID < terrain_geometries_) {
     // Smooth shading: bilinear vertex normals at the hit's cell position.
     const auto nw = vertices_.front();
     auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
     n = terrain::bilinear_clamped(vn, width_, height_, (hit.position.x() - nw.x()) / dx_,
                                   (nw.y() - hit.position.y()) / dy_)
             .normalized();
+  }
+  if (rh.hit.geomID < terrain_geometries_ || rh.hit.geomID == surround_geometry_) {
     const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
     // Material rules see the real relief: heights and slopes without the
     // vertical exaggeration (n ~ (-k Zx, -k Zy, 1)).

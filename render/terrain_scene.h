@@ -66,6 +66,8 @@ class TerrainScene {
   // The names of Hit::coverage's channels (render/coverage.h).
   const std::vector<std::string>& coverage_names() const { return coverage_.names; }
   float top() const { return top_; }
+  // Metres the ground reaches beyond the DEM's edge (render/surround.h).
+  float surround_reach() const { return surround_reach_; }
 
  private:
   // The constructor's steps: checks the raster's shape and takes its size;
@@ -95,6 +97,12 @@ class TerrainScene {
   std::vector<std::vector<float>> mesh_snow_;
   std::vector<std::vector<std::array<int, 3>>> mesh_snow_triangles_;
   unsigned terrain_geometries_ = 0;  // geometry ids [0, n) are terrain grids
+  // The ground beyond the DEM's edge (render/surround.h): its vertex buffer,
+  // grids and Embree geometry id (none: -1).
+  void attach_surround(const SurroundOptions& options);
+  std::vector<Eigen::Vector3f> surround_vertices_;
+  unsigned surround_geometry_ = ~0u;
+  float surround_reach_ = 0.0f;
   Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};
   float bottom_ = 0.0f, top_ = 0.0f;
   Eigen::Vector2f extent_{0, 0};
