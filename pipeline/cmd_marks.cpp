@@ -1,6 +1,7 @@
 // drift marks GROUND.tif --track TRACK.toml -o OUT.tif: marks that objects
 // moving along keyframes leave in soft ground (paper 000, terrain/marks/marks.h).
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -22,6 +23,7 @@ namespace fs = std::filesystem;
 struct MarksCommand {
   std::string ground, track, output, material, disturbed, frames, snow_depth, renderer = "cpu";
   double snow_min = 0.01;
+  bool add_snow = false;
   marks::MarksOptions options;
 };
 
@@ -38,18 +40,23 @@ void refuse_input_as_output(const MarksCommand& c) {
     usage_error("--disturbed and -o name the same file");
 }
 
-marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
-                                      const terrain::HeightField& ground) {
-  marks::Material base = track.material.value_or(*marks::material_preset("sand"));
-  if (!c.material.empty()) base = *marks::material_preset(c.material);
-  if (c.snow_depth.empty()) return marks::MaterialField{{base}, {}};
-  const terrain::HeightField depth = terrain::read_raster(c.snow_depth);
+// The snow-depth raster, of the ground's size.
+terrain::HeightField read_snow_depth(const MarksCommand& c, const terrain::HeightField& ground) {
+  terrain::HeightField depth = terrain::read_raster(c.snow_depth);
   if (depth.width() != ground.width() || depth.height() != ground.height()) {
     throw Error("snow depth '" + c.snow_depth + "' is " + std::to_string(depth.width()) + " x " +
                 std::to_string(depth.height()) + " cells but the ground is " +
                 std::to_string(ground.width()) + " x " + std::to_string(ground.height()) +
                 "; give the depth drift snow fall made on this ground");
   }
+  return depth;
+}
+
+marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
+                                      const terrain::HeightField& depth) {
+  marks::Material base = track.material.value_or(*marks::material_preset("sand"));
+  if (!c.material.empty()) base = *marks::material_preset(c.material);
+  if (depth.empty()) return marks::MaterialField{{base}, {}};
   const marks::Material snow =
       c.material.empty() ? *marks::material_preset("snow") : *marks::material_preset(c.material);
   return marks::materials_from_snow_depth(depth, c.snow_min, base, snow);
@@ -57,6 +64,7 @@ marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& tr
 
 void run_marks(MarksCommand& c) {
   refuse_input_as_output(c);
+  if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
   TrackFile track = read_track_file(c.track);
   marks::MarksOptions o = c.options;
   o.step = track.step;
@@ -65,9 +73,17 @@ void run_marks(MarksCommand& c) {
   o.track_disturbed = !c.disturbed.empty();
   if (!c.material.empty())
     for (marks::MarkObject& obj : track.objects) obj.material.reset();  // --material overrides all
-  const terrain::HeightField ground = terrain::read_raster(c.ground);
+  terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);
-  marks::MaterialField materials = ground_materials(c, track, ground);
+  terrain::HeightField depth;
+  if (!c.snow_depth.empty()) depth = read_snow_depth(c, ground);
+  if (c.add_snow) {  // mark the snow surface: ground + depth
+    for (std::size_t i = 0; i < ground.size(); ++i) {
+      const float d = depth.values()[i];
+      if (std::isfinite(d)) ground.values()[i] += d;
+    }
+  }
+  marks::MaterialField materials = ground_materials(c, track, depth);
   if (!c.frames.empty()) fs::create_directories(c.frames);
   marks::StepFn on_step;
   if (!c.frames.empty()) {
@@ -79,8 +95,8 @@ void run_marks(MarksCommand& c) {
       return true;
     };
   }
-  const marks::MarksResult r = marks::simulate_marks(ground, track.objects, std::move(materials),
-                                                     o, on_step, terminal_progress("marks"));
+  const marks::MarksResult r = marks::simulate_marks(ground, track.objects, std::move(materials), o,
+                                                     on_step, terminal_progress("marks"));
   terrain::write_geotiff(r.heights, c.output, {"ground height with marks (m)", "m"});
   std::printf("marks: wrote %s\n", c.output.c_str());
   if (!c.disturbed.empty()) {
@@ -101,25 +117,33 @@ void add_marks_command(CLI::App& root) {
       "marks of objects in soft ground: footprints, tyre tracks, dragged objects in sand, mud "
       "and snow (paper 000)",
       [c] { run_marks(*c); });
-  sub->add_option("ground", c->ground, "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
+  sub->add_option("ground", c->ground,
+                  "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
       ->required();
-  sub->add_option("--track", c->track, "TOML track file: step, material, [[objects]] with keyframes")
+  sub->add_option("--track", c->track,
+                  "TOML track file: step, material, [[objects]] with keyframes")
       ->required();
   sub->add_option("-o,--output", c->output, "ground with the marks, GeoTIFF (m)")->required();
   sub->add_option("--material", c->material, "overrides every material: sand, mud or snow")
       ->check(CLI::IsMember({"sand", "mud", "snow"}));
   sub->add_option("--disturbed", c->disturbed,
                   "GeoTIFF of how much each cell was compressed, displaced or slid (m)");
-  sub->add_option("--frames", c->frames, "directory for the field after every step (frame_NNNNN.tif)");
+  sub->add_option("--frames", c->frames,
+                  "directory for the field after every step (frame_NNNNN.tif)");
   sub->add_option("--snow-depth", c->snow_depth,
                   "snow depth GeoTIFF (drift snow fall): snow where it lies, the ground's material "
                   "elsewhere");
-  sub->add_option("--snow-min", c->snow_min, "snow shallower than this (m) leaves the ground's material")
+  sub->add_flag("--add-snow", c->add_snow,
+                "mark the snow surface: GROUND + the --snow-depth raster (the output is that "
+                "surface with the marks)");
+  sub->add_option("--snow-min", c->snow_min,
+                  "snow shallower than this (m) leaves the ground's material")
       ->capture_default_str();
   sub->add_option("--memory-steps", c->options.memory_steps,
                   "steps a cell that slid keeps relaxing (paper 000, 3.5)")
       ->capture_default_str();
-  sub->add_option("--erosion-passes", c->options.erosion_passes, "most relaxation passes per erosion")
+  sub->add_option("--erosion-passes", c->options.erosion_passes,
+                  "most relaxation passes per erosion")
       ->capture_default_str();
   sub->add_option("--margin", c->options.margin, "free cells kept around an object's footprint")
       ->capture_default_str();

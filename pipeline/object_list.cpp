@@ -28,7 +28,7 @@ terrain::Mesh mesh_file(const fs::path& path, bool y_up) {
 }  // namespace
 
 std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs::path& file,
-                                             const ObjectKeys& extra) {
+                                              const ObjectKeys& extra) {
   std::vector<terrain::PlacedMesh> out;
   if (const toml::node* objects = root.get("objects")) {
     const toml::array* list = objects->as_array();

@@ -14,7 +14,6 @@
 #include <vector>
 
 #include "pipeline/toml_section.h"
-
 #include "render/render_settings.h"
 #include "terrain/grid.h"
 
@@ -27,8 +26,8 @@ using ObjectKeys = std::function<void(Section& entry, std::size_t index)>;
 // errors name the file, the line and the key. `extra` reads further keys of
 // each entry; any key neither reads is an error.
 std::vector<terrain::PlacedMesh> read_objects(const toml::table& root,
-                                             const std::filesystem::path& file,
-                                             const ObjectKeys& extra = {});
+                                              const std::filesystem::path& file,
+                                              const ObjectKeys& extra = {});
 
 // A TOML file holding only [[objects]] entries.
 std::vector<terrain::PlacedMesh> read_objects_file(const std::filesystem::path& path);

@@ -49,7 +49,8 @@ int read_resolution(Section& s) {
   const toml::node* node = s.raw("resolution");
   if (!node) return 1;
   if (node->is_string() && *node->value<std::string>() == "auto") return 0;
-  const std::optional<std::int64_t> r = node->is_integer() ? node->value<std::int64_t>() : std::nullopt;
+  const std::optional<std::int64_t> r =
+      node->is_integer() ? node->value<std::int64_t>() : std::nullopt;
   if (!r || (*r != 1 && *r != 2 && *r != 4)) s.invalid("resolution", "must be 1, 2, 4 or \"auto\"");
   return static_cast<int>(*r);
 }
@@ -106,13 +107,16 @@ TrackFile read_track_file(const fs::path& path) {
   for (const auto& [k, node] : root) {
     const std::string key(k.str());
     if (key != "step" && key != "material" && key != "camera" && key != "objects")
-      throw Error(where(path, node) + ": unknown key '" + key +
-                  "' (a track file holds step, material, [camera] and [[objects]]; see docs/marks.md)");
+      throw Error(
+          where(path, node) + ": unknown key '" + key +
+          "' (a track file holds step, material, [camera] and [[objects]]; see docs/marks.md)");
   }
   Section top(&root, "track", path);
   out.step = top.number("step", std::nan(""), 1e-6, 3600.0);
-  if (std::isnan(out.step)) throw Error(path.string() + ": a track file needs 'step' (seconds per simulation step)");
-  if (const toml::node* m = root.get("material")) out.material = read_material_value(*m, path, "material");
+  if (std::isnan(out.step))
+    throw Error(path.string() + ": a track file needs 'step' (seconds per simulation step)");
+  if (const toml::node* m = root.get("material"))
+    out.material = read_material_value(*m, path, "material");
   read_camera(root, path, out);
   std::vector<marks::MarkObject> extra;
   const auto placed = read_objects(root, path, [&](Section& s, std::size_t i) {
@@ -123,11 +127,14 @@ TrackFile read_track_file(const fs::path& path) {
     o.motion = read_motion(s);
     o.resolution = read_resolution(s);
     o.follow_ground = s.boolean("follow_ground", false);
-    for (const toml::table* k : s.tables("keyframes")) o.trajectory.keys.push_back(read_keyframe(k, path));
-    if (o.trajectory.keys.empty()) s.invalid_table("needs keyframes ([[objects.keyframes]] with time and position)");
+    for (const toml::table* k : s.tables("keyframes"))
+      o.trajectory.keys.push_back(read_keyframe(k, path));
+    if (o.trajectory.keys.empty())
+      s.invalid_table("needs keyframes ([[objects.keyframes]] with time and position)");
     extra.push_back(std::move(o));
   });
-  if (placed.empty()) throw Error(path.string() + ": a track file needs at least one [[objects]] entry");
+  if (placed.empty())
+    throw Error(path.string() + ": a track file needs at least one [[objects]] entry");
   for (std::size_t i = 0; i < placed.size(); ++i) {
     marks::MarkObject& o = extra[i];
     o.mesh = placed[i].mesh;

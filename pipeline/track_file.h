@@ -21,11 +21,11 @@
 //   rotation = [yaw, pitch, roll]   # degrees (or quaternion = [w, x, y, z])
 #pragma once
 
+#include <toml++/toml.h>
+
 #include <filesystem>
 #include <optional>
 #include <vector>
-
-#include <toml++/toml.h>
 
 #include "terrain/marks/marks.h"
 

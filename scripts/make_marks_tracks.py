@@ -17,22 +17,28 @@ def keyframe(t, p, rotation=None):
     return s
 
 
-def walk(path, comment, material, x0, y, prints, stride, lift, sink, extra=""):
-    """Footprints alternating left and right along +x, each its own object
-    following the ground: down, held, lifted."""
+def walk(path, comment, material, start, heading, prints, spacing, lift, sink,
+         meshes=("foot_left.obj", "foot.obj"), pitch=0.0, extra=""):
+    """Footprints alternating left and right from `start` (CRS x, y) along
+    `heading` (degrees counter-clockwise from east), `spacing` metres apart,
+    each its own object following the ground: down, held, lifted; soles
+    pitched by `pitch` degrees (toe up) to lie on a slope."""
     out = [f"# {comment}\n# made by scripts/make_marks_tracks.py\nstep = 0.05\n{extra}"]
     if material:
         out.append(f'material = "{material}"\n')
+    h = math.radians(heading)
+    along, across = (math.cos(h), math.sin(h)), (-math.sin(h), math.cos(h))
     for k in range(prints):
         left = k % 2 == 0
-        x, side = x0 + k * stride / 2, (0.09 if left else -0.09)
+        side = 0.09 if left else -0.09
+        x = start[0] + k * spacing * along[0] + side * across[0]
+        y = start[1] + k * spacing * along[1] + side * across[1]
         t = 0.4 * k
         out.append("\n[[objects]]\nmesh = \"../objects/%s\"\nfollow_ground = true\n"
-                   % ("foot_left.obj" if left else "foot.obj"))
-        out.append(keyframe(t, (x, y + side, lift)))
-        out.append(keyframe(t + 0.15, (x, y + side, -sink)))
-        out.append(keyframe(t + 0.35, (x, y + side, -sink)))
-        out.append(keyframe(t + 0.5, (x, y + side, lift)))
+                   % (meshes[0] if left else meshes[1]))
+        turn = (heading, pitch, 0.0) if heading or pitch else None
+        for dt, z in ((0.0, lift), (0.15, -sink), (0.35, -sink), (0.5, lift)):
+            out.append(keyframe(t + dt, (x, y, z), turn))
     with open(os.path.join(OUT, path), "w") as f:
         f.write("".join(out))
     print(os.path.join(OUT, path))
@@ -57,7 +63,12 @@ def tyres(path):
 
 if __name__ == "__main__":
     walk("marks_walk_ripples.toml",
-         "Bare footprints across wind ripples (paper 000, fig. 13): six steps east,\n"
+         "Bare footprints across wind ripples (paper 000, fig. 13): five steps east,\n"
          "# across the crests of a ripple field from drift dunes (wind from the west).",
-         "sand", 0.6, -1.92, 6, 1.1, 0.05, 0.012)
+         "sand", (0.45, -1.54), 0.0, 5, 0.6, 0.05, 0.02)
+    walk("marks_walk_snow.toml",
+         "Shoe prints up a snow slope on Yarigatake: eight steps north (uphill) on\n"
+         "# 20 cm of snow from drift snow fall; material from the snow-depth raster.",
+         None, (746633.0, 4032748.5), 90.0, 8, 0.55, 0.05, 0.10,
+         meshes=("shoe.obj", "shoe.obj"), pitch=15.0)
     tyres("marks_tyres.toml")

@@ -187,9 +187,9 @@ double max_slope_excess(const Grid<double>& heights, const SlopeCells& cells,
       const int n = ny * w + nx;
       if (std::isfinite(bound(cells.ceiling, n, kInf))) continue;
       const double d = std::hypot(nb.dx * options.dx, nb.dy * options.dy);
-      worst = std::max(worst, heights.values()[static_cast<std::size_t>(index)] -
-                                  heights.values()[static_cast<std::size_t>(n)] -
-                                  rule.tan_repose * d);
+      worst =
+          std::max(worst, heights.values()[static_cast<std::size_t>(index)] -
+                              heights.values()[static_cast<std::size_t>(n)] - rule.tan_repose * d);
     }
   };
   if (only.empty()) {

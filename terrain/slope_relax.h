@@ -46,8 +46,8 @@ struct SlopeRelaxOptions {
 struct SlopeCells {
   std::span<const SlopeRule> rules;
   const Grid<std::uint8_t>* rule_of_cell = nullptr;  // index into rules
-  const Grid<double>* ceiling = nullptr;  // a cell never rises above it (+inf: none)
-  const Grid<double>* floor = nullptr;   // a cell never sinks below it (-inf: none)
+  const Grid<double>* ceiling = nullptr;             // a cell never rises above it (+inf: none)
+  const Grid<double>* floor = nullptr;               // a cell never sinks below it (-inf: none)
 };
 
 struct SlopeRelaxReport {

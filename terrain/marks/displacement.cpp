@@ -107,15 +107,15 @@ double along(const std::optional<Eigen::Vector2d>& drag, int k) {
 }
 
 // Contact cells, deepest first (pressing) or from the back (dragging).
-void displace_contact(Patch& p, terrain::Grid<double>& h, const std::optional<Eigen::Vector2d>& drag) {
+void displace_contact(Patch& p, terrain::Grid<double>& h,
+                      const std::optional<Eigen::Vector2d>& drag) {
   std::vector<int> order;
   for (int li = 0; li < static_cast<int>(p.contact.size()); ++li)
     if (p.contact[li]) order.push_back(li);
   if (!drag) {
     std::stable_sort(order.begin(), order.end(),
                      [&](int a, int b) { return p.inner[a] > p.inner[b]; });
-    for (int li : order)
-      hand_on(p, li, h, [&](int m, int) { return p.inner[m] < p.inner[li]; });
+    for (int li : order) hand_on(p, li, h, [&](int m, int) { return p.inner[m] < p.inner[li]; });
     return;
   }
   const double eps = 1e-9;

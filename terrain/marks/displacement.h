@@ -30,11 +30,11 @@
 namespace drift::marks {
 
 struct DisplacementReport {
-  double collided = 0.0;     // sum of h' over the contact (m of height, times cell area = m3)
-  double displaced = 0.0;    // sum of alpha h'
-  double compressed = 0.0;   // sum of (1 - alpha) h'
-  std::vector<int> contact;  // flat indices of the collided cells
-  std::vector<int> received; // flat indices of the free cells that took material
+  double collided = 0.0;      // sum of h' over the contact (m of height, times cell area = m3)
+  double displaced = 0.0;     // sum of alpha h'
+  double compressed = 0.0;    // sum of (1 - alpha) h'
+  std::vector<int> contact;   // flat indices of the collided cells
+  std::vector<int> received;  // flat indices of the free cells that took material
 };
 
 // heights: the whole field (m), updated in the bottom map's window.

@@ -25,6 +25,21 @@ std::optional<Eigen::Vector2d> drag_direction(const Eigen::Vector3d& d, const Gr
   return cells;
 }
 
+// How the object's lowest point moves from pose a to pose b: the motion of
+// the object where it meets the ground. A sliding object drags the ground
+// with it; a rolling wheel's lowest point barely moves, so it presses.
+Eigen::Vector3d contact_motion(const ObjectShape& shape, const Pose& a, const Pose& b) {
+  const Eigen::Matrix3d ra = a.rotation.toRotationMatrix(), rb = b.rotation.toRotationMatrix();
+  std::size_t lowest = 0;
+  double z = kInf;
+  for (std::size_t i = 0; i < shape.mesh.positions.size(); ++i) {
+    const double zi = (rb * shape.mesh.positions[i].cast<double>()).z();
+    if (zi < z) z = zi, lowest = i;
+  }
+  const Eigen::Vector3d p = shape.mesh.positions[lowest].cast<double>();
+  return (b.position + rb * p) - (a.position + ra * p);
+}
+
 }  // namespace
 
 void MarksOptions::validate() const {
@@ -37,17 +52,18 @@ void MarksOptions::validate() const {
   if (margin < 2 || margin > 1000) throw Error("marks: margin must lie in [2, 1000] cells");
   if (camera && (!camera->position.allFinite() || !(camera->fov_deg > 0 && camera->fov_deg < 180) ||
                  camera->width_px < 1))
-    throw Error("marks: the camera needs a finite position, a field of view in (0, 180) degrees "
-                "and a width of at least 1 pixel");
+    throw Error(
+        "marks: the camera needs a finite position, a field of view in (0, 180) degrees "
+        "and a width of at least 1 pixel");
 }
 
 struct MarksSimulation::Impl {
   MarksSimulation& sim;
   std::unique_ptr<BottomRasteriser> rasteriser;
-  terrain::Grid<double> ceiling;     // the objects' bottoms during erosion, +inf elsewhere
-  terrain::Grid<int> expiry;         // step until which a cell is remembered (3.5)
-  std::vector<int> remembered;       // the cells with expiry >= the current step
-  std::vector<BottomMap> last;       // each object's last bottom in this step
+  terrain::Grid<double> ceiling;  // the objects' bottoms during erosion, +inf elsewhere
+  terrain::Grid<int> expiry;      // step until which a cell is remembered (3.5)
+  std::vector<int> remembered;    // the cells with expiry >= the current step
+  std::vector<BottomMap> last;    // each object's last bottom in this step
   terrain::SlopeRelaxWorkspace workspace;
 
   explicit Impl(MarksSimulation& s) : sim(s) {}
@@ -73,7 +89,8 @@ struct MarksSimulation::Impl {
     for (const Material& m : sim.materials_.table) rules.push_back(m.slope_rule());
     terrain::SlopeCells cells{rules, sim.materials_.index.empty() ? nullptr : &sim.materials_.index,
                               &ceiling, nullptr};
-    terrain::SlopeRelaxOptions o{sim.frame_.dx, sim.frame_.dy, 1e-4 * std::min(sim.frame_.dx, sim.frame_.dy),
+    terrain::SlopeRelaxOptions o{sim.frame_.dx, sim.frame_.dy,
+                                 1e-4 * std::min(sim.frame_.dx, sim.frame_.dy),
                                  sim.options_.erosion_passes};
     std::vector<int> moved;
     terrain::relax_slopes(sim.heights_, std::move(seeds), cells, o, moved,
@@ -84,7 +101,8 @@ struct MarksSimulation::Impl {
     if (!object.material) return;
     MaterialField& m = sim.materials_;
     const std::uint8_t id = m.add(*object.material);
-    if (m.index.empty()) m.index = terrain::Grid<std::uint8_t>(sim.heights_.width(), sim.heights_.height(), 0);
+    if (m.index.empty())
+      m.index = terrain::Grid<std::uint8_t>(sim.heights_.width(), sim.heights_.height(), 0);
     for (int r = w.row0; r < w.row0 + w.height; ++r)
       for (int c = w.col0; c < w.col0 + w.width; ++c) m.index(c, r) = id;
   }
@@ -92,12 +110,14 @@ struct MarksSimulation::Impl {
   BottomMap deform(const CellTriangles& tris, const MarkObject& object,
                    const std::optional<Eigen::Vector2d>& drag, StepReport& report) {
     BottomMap bottom;
-    bottom.window = footprint_window(tris, sim.options_.margin, sim.heights_.width(), sim.heights_.height());
+    bottom.window =
+        footprint_window(tris, sim.options_.margin, sim.heights_.width(), sim.heights_.height());
     if (bottom.window.empty()) return bottom;
     rasteriser->render(tris, bottom);
     claim_material(bottom.window, object);
-    const DisplacementReport d = compress_and_displace(
-        sim.heights_, bottom, sim.materials_, drag, sim.options_.track_disturbed ? &sim.disturbed_ : nullptr);
+    const DisplacementReport d =
+        compress_and_displace(sim.heights_, bottom, sim.materials_, drag,
+                              sim.options_.track_disturbed ? &sim.disturbed_ : nullptr);
     const double area = sim.frame_.dx * sim.frame_.dy;
     report.collided += d.collided * area, report.displaced += d.displaced * area;
     report.compressed += d.compressed * area;
@@ -126,17 +146,21 @@ MarksSimulation::MarksSimulation(const terrain::HeightField& ground, MaterialFie
                  "crop the ground (drift import --crop) or coarsen it (drift import --resample)");
   if (!materials_.index.empty() &&
       (materials_.index.width() != ground.width() || materials_.index.height() != ground.height()))
-    throw Error("marks: the material raster is " + std::to_string(materials_.index.width()) + " x " +
-                std::to_string(materials_.index.height()) + " but the ground is " +
+    throw Error("marks: the material raster is " + std::to_string(materials_.index.width()) +
+                " x " + std::to_string(materials_.index.height()) + " but the ground is " +
                 std::to_string(ground.width()) + " x " + std::to_string(ground.height()));
   for (const Material& m : materials_.table) m.validate("marks");
   heights_ = terrain::Grid<double>(ground.width(), ground.height(), 0.0, ground.geo());
   for (std::size_t i = 0; i < ground.size(); ++i) {
     const float v = ground.values()[i];
-    if (!std::isfinite(v)) throw Error("marks: the ground has a cell that is not a finite number (nodata); fill it first (drift import)");
+    if (!std::isfinite(v))
+      throw Error(
+          "marks: the ground has a cell that is not a finite number (nodata); fill it first (drift "
+          "import)");
     heights_.values()[i] = v;
   }
-  if (options_.track_disturbed) disturbed_ = terrain::Grid<float>(ground.width(), ground.height(), 0.0f, ground.geo());
+  if (options_.track_disturbed)
+    disturbed_ = terrain::Grid<float>(ground.width(), ground.height(), 0.0f, ground.geo());
   impl_ = std::make_unique<Impl>(*this);
   impl_->rasteriser = make_bottom_rasteriser(options_.renderer);
   impl_->ceiling = terrain::Grid<double>(ground.width(), ground.height(), kInf);
@@ -166,7 +190,8 @@ StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& obj
   int n = 1;
   if (!first) {
     const double per = object.motion == Motion::SubSteps ? std::max(cells_moved, turned) : turned;
-    if (object.motion != Motion::Place) n = std::clamp(static_cast<int>(std::ceil(per - 1e-9)), 1, 10000);
+    if (object.motion != Motion::Place)
+      n = std::clamp(static_cast<int>(std::ceil(per - 1e-9)), 1, 10000);
   }
   const int level = resolution_for(object, to.position);
   BottomMap last;
@@ -175,13 +200,15 @@ StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& obj
     const Pose a{from.position + s0 * d, from.rotation.slerp(s0, to.rotation)};
     const Pose b{from.position + s1 * d, from.rotation.slerp(s1, to.rotation)};
     const bool sweep = !first && object.motion == Motion::Sweep;
-    const CellTriangles tris = sweep ? swept_triangles(shape, a.position, b, frame_)
-                                     : posed_triangles(shape, b, frame_);
-    const auto drag = first ? std::nullopt : drag_direction(b.position - a.position, frame_);
+    const CellTriangles tris =
+        sweep ? swept_triangles(shape, a.position, b, frame_) : posed_triangles(shape, b, frame_);
+    const auto drag = first ? std::nullopt : drag_direction(contact_motion(shape, a, b), frame_);
     if (level == 1) {
       last = impl_->deform(tris, object, drag, report);
     } else {
-      impl_->claim_material(footprint_window(tris, options_.margin * level, heights_.width(), heights_.height()), object);
+      impl_->claim_material(
+          footprint_window(tris, options_.margin * level, heights_.width(), heights_.height()),
+          object);
       CoarseResult c = deform_coarse(heights_, materials_, tris, level, frame_.dx, frame_.dy,
                                      options_.margin, options_.erosion_passes, *impl_->rasteriser,
                                      drag, options_.track_disturbed ? &disturbed_ : nullptr);
@@ -212,7 +239,8 @@ void MarksSimulation::end_step() {
 
 terrain::HeightField MarksSimulation::heights_as_float() const {
   terrain::HeightField out(heights_.width(), heights_.height(), 0.0f, heights_.geo());
-  for (std::size_t i = 0; i < out.size(); ++i) out.values()[i] = static_cast<float>(heights_.values()[i]);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out.values()[i] = static_cast<float>(heights_.values()[i]);
   return out;
 }
 

@@ -43,10 +43,10 @@ namespace drift::marks {
 enum class Motion { Sweep, SubSteps, Place };
 
 struct MarkObject {
-  std::string name;            // for messages
-  terrain::Mesh mesh;          // in its own frame (m), scaled and turned z-up
-  Trajectory trajectory;       // keyframes in the ground's CRS
-  bool follow_ground = false;  // keyframe z = height of the origin above the ground
+  std::string name;                  // for messages
+  terrain::Mesh mesh;                // in its own frame (m), scaled and turned z-up
+  Trajectory trajectory;             // keyframes in the ground's CRS
+  bool follow_ground = false;        // keyframe z = height of the origin above the ground
   std::optional<Material> material;  // the ground's material where it walks
   Motion motion = Motion::Sweep;
   int resolution = 1;  // 1 full, 2 half, 4 quarter; 0: chosen from the camera

@@ -27,7 +27,8 @@ struct Coarse {
 };
 
 // Block means of the heights (volume kept); each block takes its centre cell's material.
-Coarse coarsen(const terrain::Grid<double>& h, const MaterialField& m, const CellWindow& w, int level) {
+Coarse coarsen(const terrain::Grid<double>& h, const MaterialField& m, const CellWindow& w,
+               int level) {
   const int cw = w.width / level, ch = w.height / level;
   Coarse c{terrain::Grid<double>(cw, ch, 0.0), MaterialField{m.table, {}}};
   if (!m.index.empty()) c.materials.index = terrain::Grid<std::uint8_t>(cw, ch, 0);
@@ -38,7 +39,8 @@ Coarse coarsen(const terrain::Grid<double>& h, const MaterialField& m, const Cel
         for (int x = 0; x < level; ++x) sum += h(w.col0 + i * level + x, w.row0 + j * level + y);
       c.heights(i, j) = sum / (level * level);
       if (!m.index.empty())
-        c.materials.index(i, j) = m.index(w.col0 + i * level + level / 2, w.row0 + j * level + level / 2);
+        c.materials.index(i, j) =
+            m.index(w.col0 + i * level + level / 2, w.row0 + j * level + level / 2);
     }
   return c;
 }
@@ -49,17 +51,20 @@ void write_back(terrain::Grid<double>& h, const terrain::Grid<double>& delta, co
   int i0 = delta.width(), i1 = -1, j0 = delta.height(), j1 = -1;
   for (int j = 0; j < delta.height(); ++j)
     for (int i = 0; i < delta.width(); ++i)
-      if (delta(i, j) != 0.0) i0 = std::min(i0, i), i1 = std::max(i1, i), j0 = std::min(j0, j), j1 = std::max(j1, j);
+      if (delta(i, j) != 0.0)
+        i0 = std::min(i0, i), i1 = std::max(i1, i), j0 = std::min(j0, j), j1 = std::max(j1, j);
   if (i1 < 0) return;
-  const int x0 = w.col0 + std::max(i0 - 1, 0) * level, x1 = w.col0 + std::min(i1 + 2, delta.width()) * level;
-  const int y0 = w.row0 + std::max(j0 - 1, 0) * level, y1 = w.row0 + std::min(j1 + 2, delta.height()) * level;
+  const int x0 = w.col0 + std::max(i0 - 1, 0) * level,
+            x1 = w.col0 + std::min(i1 + 2, delta.width()) * level;
+  const int y0 = w.row0 + std::max(j0 - 1, 0) * level,
+            y1 = w.row0 + std::min(j1 + 2, delta.height()) * level;
   const double centre = 0.5 * (level - 1);  // fine offset of a block's centre
   const auto at = [&](int i, int j) { return delta(i, j); };
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) {
-      const double add = terrain::bilinear_clamped(at, delta.width(), delta.height(),
-                                                    (x - w.col0 - centre) / level,
-                                                    (y - w.row0 - centre) / level);
+      const double add =
+          terrain::bilinear_clamped(at, delta.width(), delta.height(),
+                                    (x - w.col0 - centre) / level, (y - w.row0 - centre) / level);
       if (add == 0.0) continue;
       h(x, y) += add;
       r.changed.push_back(y * h.width() + x);
@@ -81,7 +86,8 @@ CoarseResult deform_coarse(terrain::Grid<double>& heights, const MaterialField& 
   const double centre = 0.5 * (level - 1);
   CellTriangles coarse_tris(tris.size());
   for (std::size_t i = 0; i < tris.size(); ++i)
-    coarse_tris[i] = {(tris[i].x() - w.col0 - centre) / level, (tris[i].y() - w.row0 - centre) / level, tris[i].z()};
+    coarse_tris[i] = {(tris[i].x() - w.col0 - centre) / level,
+                      (tris[i].y() - w.row0 - centre) / level, tris[i].z()};
   BottomMap cb;
   cb.window = {0, 0, c.heights.width(), c.heights.height()};
   rasteriser.render(coarse_tris, cb);
@@ -94,20 +100,23 @@ CoarseResult deform_coarse(terrain::Grid<double>& heights, const MaterialField& 
     ceiling.values() = cb.z;
     std::vector<terrain::SlopeRule> rules;
     for (const Material& m : c.materials.table) rules.push_back(m.slope_rule());
-    terrain::SlopeCells cells{rules, c.materials.index.empty() ? nullptr : &c.materials.index, &ceiling, nullptr};
+    terrain::SlopeCells cells{rules, c.materials.index.empty() ? nullptr : &c.materials.index,
+                              &ceiling, nullptr};
     std::vector<int> seeds = d.received, moved;
     seeds.insert(seeds.end(), d.contact.begin(), d.contact.end());
     terrain::relax_slopes(c.heights, seeds, cells,
                           {dx * level, dy * level, 1e-4 * std::min(dx, dy), erosion_passes}, moved);
   }
   terrain::Grid<double> delta(c.heights.width(), c.heights.height());
-  for (std::size_t i = 0; i < delta.size(); ++i) delta.values()[i] = c.heights.values()[i] - before.values()[i];
+  for (std::size_t i = 0; i < delta.size(); ++i)
+    delta.values()[i] = c.heights.values()[i] - before.values()[i];
   write_back(heights, delta, w, level, r, disturbed);
   r.bottom.window = w;
   r.bottom.z.resize(static_cast<std::size_t>(w.width) * w.height);
   for (int y = 0; y < w.height; ++y)
     for (int x = 0; x < w.width; ++x)
-      r.bottom.z[static_cast<std::size_t>(y) * w.width + x] = cb.z[static_cast<std::size_t>(y / level) * cb.window.width + x / level];
+      r.bottom.z[static_cast<std::size_t>(y) * w.width + x] =
+          cb.z[static_cast<std::size_t>(y / level) * cb.window.width + x / level];
   return r;
 }
 

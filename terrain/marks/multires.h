@@ -18,7 +18,7 @@ namespace drift::marks {
 
 struct CoarseResult {
   double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m of coarse height, summed
-  int contact_cells = 0;                                      // coarse cells
+  int contact_cells = 0;                                     // coarse cells
   std::vector<int> changed;  // fine flat indices whose height changed
   BottomMap bottom;          // the coarse bottom over the fine cells (nearest)
 };

@@ -35,7 +35,8 @@ class CpuBottomRasteriser final : public BottomRasteriser {
   void render(const CellTriangles& tris, BottomMap& map) override {
     const CellWindow& w = map.window;
     map.z.assign(static_cast<std::size_t>(w.width) * w.height, BottomMap::kNone);
-    for (std::size_t t = 0; t + 2 < tris.size(); t += 3) draw(tris[t], tris[t + 1], tris[t + 2], map);
+    for (std::size_t t = 0; t + 2 < tris.size(); t += 3)
+      draw(tris[t], tris[t + 1], tris[t + 2], map);
   }
 
  private:
@@ -54,8 +55,10 @@ class CpuBottomRasteriser final : public BottomRasteriser {
                             static_cast<int>(std::floor(std::max({a.y(), b.y(), c.y()}))));
     if (x0 > x1 || y0 > y1) return;
     // Edge functions and the plane z = z_a + gx (x - a.x) + gy (y - a.y).
-    const double gx = ((b.z() - a.z()) * (c.y() - a.y()) - (c.z() - a.z()) * (b.y() - a.y())) / area;
-    const double gy = ((c.z() - a.z()) * (b.x() - a.x()) - (b.z() - a.z()) * (c.x() - a.x())) / area;
+    const double gx =
+        ((b.z() - a.z()) * (c.y() - a.y()) - (c.z() - a.z()) * (b.y() - a.y())) / area;
+    const double gy =
+        ((c.z() - a.z()) * (b.x() - a.x()) - (b.z() - a.z()) * (c.x() - a.x())) / area;
     auto edge = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q, double x, double y) {
       return (q.x() - p.x()) * (y - p.y()) - (q.y() - p.y()) * (x - p.x());
     };

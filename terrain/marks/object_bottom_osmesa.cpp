@@ -17,15 +17,16 @@ class OsmesaBottomRasteriser final : public BottomRasteriser {
     map.z.assign(static_cast<std::size_t>(w.width) * w.height, BottomMap::kNone);
     if (tris.empty() || w.empty()) return;
     double z_lo = 1e300, z_hi = -1e300;
-    for (const Eigen::Vector3d& p : tris) z_lo = std::min(z_lo, p.z()), z_hi = std::max(z_hi, p.z());
+    for (const Eigen::Vector3d& p : tris)
+      z_lo = std::min(z_lo, p.z()), z_hi = std::max(z_hi, p.z());
     // Looking up: the source is below, w = -z, so a = column and b = -y; the
     // mesh is given in (column, -row, z - z_lo) so that b runs with the rows.
     mesh_.positions.resize(tris.size());
     mesh_.triangles.resize(tris.size() / 3);
     for (std::size_t i = 0; i < tris.size(); ++i)
-      mesh_.positions[i] = Eigen::Vector3f(static_cast<float>(tris[i].x()),
-                                           static_cast<float>(-tris[i].y()),
-                                           static_cast<float>(tris[i].z() - z_lo));
+      mesh_.positions[i] =
+          Eigen::Vector3f(static_cast<float>(tris[i].x()), static_cast<float>(-tris[i].y()),
+                          static_cast<float>(tris[i].z() - z_lo));
     for (std::size_t t = 0; t < mesh_.triangles.size(); ++t)
       mesh_.triangles[t] = {static_cast<int>(3 * t), static_cast<int>(3 * t + 1),
                             static_cast<int>(3 * t + 2)};

@@ -55,9 +55,9 @@ Side classify(double s0, double s1, double s2, double eps) {
   const int pos = (s0 > eps) + (s1 > eps) + (s2 > eps);
   const int neg = (s0 < -eps) + (s1 < -eps) + (s2 < -eps);
   if (pos == 3) return Side::Current;
-  if (pos > 0 && neg > 0) return Side::Swept;  // (1) both signs
+  if (pos > 0 && neg > 0) return Side::Swept;    // (1) both signs
   if (pos == 0 && neg == 0) return Side::Swept;  // (2) all zero
-  if (neg == 0) return Side::Swept;  // (3) positive and zero
+  if (neg == 0) return Side::Swept;              // (3) positive and zero
   return Side::Previous;
 }
 
@@ -80,8 +80,8 @@ void push_prism(CellTriangles& out, const std::array<Eigen::Vector3d, 3>& p,
 
 }  // namespace
 
-CellTriangles swept_triangles(const ObjectShape& shape, const Eigen::Vector3d& from,
-                              const Pose& to, const GridFrame& frame) {
+CellTriangles swept_triangles(const ObjectShape& shape, const Eigen::Vector3d& from, const Pose& to,
+                              const GridFrame& frame) {
   const Eigen::Matrix3d r = to.rotation.toRotationMatrix();
   const Eigen::Vector3d d = to.position - from;
   const std::size_t n = shape.mesh.positions.size();

@@ -43,7 +43,7 @@ CellTriangles posed_triangles(const ObjectShape& shape, const Pose& pose, const 
 // position; one whose signs are mixed, all zero, or positive and zero is
 // extruded into a prism between the two positions; the rest stand at the
 // previous position. Rotation is left to sub-steps, as in the paper.
-CellTriangles swept_triangles(const ObjectShape& shape, const Eigen::Vector3d& from,
-                              const Pose& to, const GridFrame& frame);
+CellTriangles swept_triangles(const ObjectShape& shape, const Eigen::Vector3d& from, const Pose& to,
+                              const GridFrame& frame);
 
 }  // namespace drift::marks

@@ -19,21 +19,24 @@ double ground_under(const terrain::HeightField& g, const GridFrame& f, double x,
 void validate_objects(const std::vector<MarkObject>& objects) {
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const MarkObject& o = objects[i];
-    const std::string what = "object " + std::to_string(i + 1) + (o.name.empty() ? "" : " ('" + o.name + "')");
+    const std::string what =
+        "object " + std::to_string(i + 1) + (o.name.empty() ? "" : " ('" + o.name + "')");
     if (o.mesh.triangles.empty()) throw Error(what + ": the mesh has no triangles");
     for (const auto& p : o.mesh.positions)
       if (!p.allFinite()) throw Error(what + ": the mesh has a vertex that is not finite");
     o.trajectory.validate(what);
     if (o.material) o.material->validate(what);
     if (o.resolution != 0 && o.resolution != 1 && o.resolution != 2 && o.resolution != 4)
-      throw Error(what + ": resolution is " + std::to_string(o.resolution) + "; use 1, 2, 4 or 0 (auto)");
+      throw Error(what + ": resolution is " + std::to_string(o.resolution) +
+                  "; use 1, 2, 4 or 0 (auto)");
   }
 }
 
 }  // namespace
 
-MarksResult simulate_marks(const terrain::HeightField& ground, const std::vector<MarkObject>& objects,
-                           MaterialField materials, const MarksOptions& options, const StepFn& on_step,
+MarksResult simulate_marks(const terrain::HeightField& ground,
+                           const std::vector<MarkObject>& objects, MaterialField materials,
+                           const MarksOptions& options, const StepFn& on_step,
                            const ProgressFn& progress) {
   options.validate();
   validate_objects(objects);
@@ -42,13 +45,16 @@ MarksResult simulate_marks(const terrain::HeightField& ground, const std::vector
   std::vector<ObjectShape> shapes;
   for (const MarkObject& o : objects) shapes.push_back(ObjectShape::of(o.mesh));
   double t0 = 1e300, t1 = -1e300;
-  for (const MarkObject& o : objects) t0 = std::min(t0, o.trajectory.start()), t1 = std::max(t1, o.trajectory.end());
+  for (const MarkObject& o : objects)
+    t0 = std::min(t0, o.trajectory.start()), t1 = std::max(t1, o.trajectory.end());
   const double span = (t1 - t0) / options.step;
-  if (span > 1e7) throw Error("marks: the keyframes span " + std::to_string(span) + " steps; raise 'step'");
+  if (span > 1e7)
+    throw Error("marks: the keyframes span " + std::to_string(span) + " steps; raise 'step'");
   const int steps = static_cast<int>(std::ceil(span - 1e-9));
   auto pose_of = [&](const MarkObject& o, double t) {
     Pose p = o.trajectory.at(t);
-    if (o.follow_ground) p.position.z() += ground_under(ground, sim.frame(), p.position.x(), p.position.y());
+    if (o.follow_ground)
+      p.position.z() += ground_under(ground, sim.frame(), p.position.x(), p.position.y());
     return p;
   };
   MarksResult result;

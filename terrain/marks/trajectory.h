@@ -11,8 +11,8 @@
 namespace drift::marks {
 
 struct Keyframe {
-  double time = 0.0;                    // s
-  Eigen::Vector3d position{0, 0, 0};    // the object's origin (ground CRS metres)
+  double time = 0.0;                  // s
+  Eigen::Vector3d position{0, 0, 0};  // the object's origin (ground CRS metres)
   Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
 };
 

@@ -12,9 +12,9 @@
 #include <memory>
 #include <vector>
 
-#include "terrain/offscreen/depth_map.h"
 #include "terrain/grid.h"
 #include "terrain/mesh.h"
+#include "terrain/offscreen/depth_map.h"
 
 namespace drift::terrain {
 
@@ -35,8 +35,8 @@ class OsmesaDepthRenderer {
   // Fills map.top for the map's frame, corner, texel and size (set by the caller)
   // with the nearest surface among `meshes` (positions in the local frame) and
   // `ground` (may be null). [c_lo, c_hi] must enclose the geometry's depths.
-  void render(DepthMap& map, double c_lo, double c_hi,
-              const std::vector<const Mesh*>& meshes, const GroundGeometry* ground);
+  void render(DepthMap& map, double c_lo, double c_hi, const std::vector<const Mesh*>& meshes,
+              const GroundGeometry* ground);
 
  private:
   struct Impl;

@@ -55,8 +55,8 @@ void run_track(benchmark::State& state, const char* mesh, double z, int stride, 
     sim->end_step();
     from = to;
   }
-  state.counters["steps/s"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                                 benchmark::Counter::kIsRate);
+  state.counters["steps/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
 }
 
@@ -91,8 +91,8 @@ void BM_MarksBottom(benchmark::State& state) {
     benchmark::DoNotOptimize(b.z.data());
   }
   state.counters["cells"] = static_cast<double>(b.z.size());
-  state.counters["renders/s"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                                   benchmark::Counter::kIsRate);
+  state.counters["renders/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_MarksBottom)
     ->ArgNames({"radius", "opengl"})

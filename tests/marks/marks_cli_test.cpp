@@ -33,7 +33,8 @@ fs::path ground(const fs::path& d) {
 // A ball pressed 3 cm into the ground's middle and lifted again.
 std::string track(const std::string& keyframes_extra = "", const std::string& top = "") {
   return "step = 0.1\n" + top +
-         "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR "/data/objects/ball.obj\"\n"
+         "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
+         "/data/objects/ball.obj\"\n"
          "scale = 0.5\n"
          "[[objects.keyframes]]\ntime = 0.0\nposition = [600000.32, 3999999.68, 2000.08]\n"
          "[[objects.keyframes]]\ntime = 0.3\nposition = [600000.32, 3999999.68, 2000.02]\n"
@@ -42,8 +43,8 @@ std::string track(const std::string& keyframes_extra = "", const std::string& to
 }
 
 int run(const std::string& args, const fs::path& d) {
-  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " marks " + args + " > " +
-                          (d / "out.txt").string() + " 2>&1";
+  const std::string cmd =
+      std::string(DRIFT_EXECUTABLE) + " marks " + args + " > " + (d / "out.txt").string() + " 2>&1";
   return WEXITSTATUS(std::system(cmd.c_str()));
 }
 

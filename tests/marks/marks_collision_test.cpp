@@ -68,7 +68,8 @@ TEST(MarksCollision, SweptBallIsTheCapsuleBetweenItsPositions) {
 
 TEST(MarksTrajectory, LinearPositionSlerpRotation) {
   Trajectory t;
-  t.keys = {{0.0, {0, 0, 0}, rotation_from_ypr(0, 0, 0)}, {2.0, {4, 2, -2}, rotation_from_ypr(90, 0, 0)}};
+  t.keys = {{0.0, {0, 0, 0}, rotation_from_ypr(0, 0, 0)},
+            {2.0, {4, 2, -2}, rotation_from_ypr(90, 0, 0)}};
   t.validate("test");
   const Pose p = t.at(0.5);
   EXPECT_NEAR((p.position - Eigen::Vector3d(1, 0.5, -0.5)).norm(), 0.0, 1e-12);
@@ -93,8 +94,10 @@ MarksResult run_two_objects() {
   const GridFrame f = GridFrame::of(ground.geo());
   MarkObject press, dragged;
   press.mesh = dragged.mesh = sphere(0.05);
-  press.trajectory.keys = {{0.0, f.to_world(20, 20, 1.08), kId}, {0.3, f.to_world(20, 20, 1.035), kId}};
-  dragged.trajectory.keys = {{0.0, f.to_world(10, 60, 1.035), kId}, {0.5, f.to_world(80, 60, 1.035), kId}};
+  press.trajectory.keys = {{0.0, f.to_world(20, 20, 1.08), kId},
+                           {0.3, f.to_world(20, 20, 1.035), kId}};
+  dragged.trajectory.keys = {{0.0, f.to_world(10, 60, 1.035), kId},
+                             {0.5, f.to_world(80, 60, 1.035), kId}};
   dragged.material = material_preset("mud");
   MarksOptions o;
   o.step = 0.05;

@@ -76,7 +76,8 @@ TEST(MarksDrag, NothingIsSentBackwards) {
     EXPECT_LE(h(c, kRow), 1.0 - 0.99 * kDepth) << "trough floor, column " << c;
   // The material goes ahead: a mound in front of the ball's last position.
   double front = 0;
-  for (int c = kStart + kSteps * kStride; c < kWidth; ++c) front = std::max(front, h(c, kRow) - 1.0);
+  for (int c = kStart + kSteps * kStride; c < kWidth; ++c)
+    front = std::max(front, h(c, kRow) - 1.0);
   EXPECT_GT(front, 0.5 * kDepth);
 }
 

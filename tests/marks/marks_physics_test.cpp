@@ -152,7 +152,8 @@ TEST(MarksMaterials, PerRegionMaterialsFromASnowDepthRaster) {
     for (int c = 0; c < 48; ++c) snow_depth(c, r) = 0.3f;
   MaterialField m = materials_from_snow_depth(snow_depth, 0.01, *material_preset("sand"),
                                               *material_preset("snow"));
-  MarksSimulation sim(terrain::HeightField(96, 48, 1.0f, terrain::local_georeference(kCell)), m, {});
+  MarksSimulation sim(terrain::HeightField(96, 48, 1.0f, terrain::local_georeference(kCell)), m,
+                      {});
   const ObjectShape shape = ObjectShape::of(sphere(kRadius));
   MarkObject object;
   for (double col : {24.0, 72.0}) {
@@ -162,7 +163,8 @@ TEST(MarksMaterials, PerRegionMaterialsFromASnowDepthRaster) {
   settle(sim, 5);
   double snow_top = -1, sand_top = -1;
   for (int r = 0; r < 48; ++r)
-    for (int c = 0; c < 96; ++c) (c < 48 ? snow_top : sand_top) = std::max(c < 48 ? snow_top : sand_top, sim.heights()(c, r));
+    for (int c = 0; c < 96; ++c)
+      (c < 48 ? snow_top : sand_top) = std::max(c < 48 ? snow_top : sand_top, sim.heights()(c, r));
   EXPECT_LE(snow_top, 1.0) << "snow: compressed, no rim";
   EXPECT_GT(sand_top, 1.001) << "sand: displaced into a rim";
   EXPECT_LT(sim.heights()(24, 24), 1.0 - 0.9 * kDepth);

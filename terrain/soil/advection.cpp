@@ -1,0 +1,214 @@
+#include "terrain/soil/advection.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "terrain/soil/transport.h"
+
+namespace drift::soil {
+
+namespace {
+constexpr float kFull = 1.0f - 1e-6f;  // rho + psi at which a voxel counts as full (locked)
+}  // namespace
+
+void copy_back(SoilState& s, std::size_t i) {
+  s.rho[i] = s.back.rho[i];
+  s.ux[i] = s.back.ux[i];
+  s.uy[i] = s.back.uy[i];
+  s.uz[i] = s.back.uz[i];
+  s.fx[i] = s.back.fx[i];
+  s.fy[i] = s.back.fy[i];
+  s.fz[i] = s.back.fz[i];
+}
+
+detail::Ranges advect(SoilState& s, double dt) {
+  const terrain::Grid3Shape& g = s.shape;
+  const float scale = static_cast<float>(dt / g.voxel_size);  // m/s -> voxels per step
+  const float *ux = s.ux.data(), *uy = s.uy.data(), *uz = s.uz.data();
+  const float *rho = s.rho.data(), *psi = s.psi.data();
+  auto disp = [=](std::size_t i) {
+    return detail::D3{std::clamp(ux[i] * scale, -1.0f, 1.0f),
+                      std::clamp(uy[i] * scale, -1.0f, 1.0f),
+                      std::clamp(uz[i] * scale, -1.0f, 1.0f)};
+  };
+  // Eq. 24: a voxel full of soil and body is locked (rho is only read here).
+  auto unlocked = [=](std::size_t i) { return rho[i] + psi[i] < kFull; };
+  const detail::Carried carried{{ux, uy, uz}, {s.fx.data(), s.fy.data(), s.fz.data()}};
+  return detail::transport(
+      g, s.rho.data(), detail::sender_ranges(g, s.rho.data(), unlocked, disp), unlocked, disp,
+      carried, false,
+      [&](std::size_t i, const detail::Gathered& r) {
+        s.back.rho[i] = r.amount;
+        const float inv = r.amount > 0 ? 1.0f / r.amount : 0.0f;
+        s.back.ux[i] = r.u[0] * inv;
+        s.back.uy[i] = r.u[1] * inv;
+        s.back.uz[i] = r.u[2] * inv;
+        s.back.fx[i] = r.f[0] * inv;
+        s.back.fy[i] = r.f[1] * inv;
+        s.back.fz[i] = r.f[2] * inv;
+      },
+      true,
+      [&](std::size_t i, float self) {  // backflow came back with zero velocity (eq. 28)
+        s.ux[i] *= self;
+        s.uy[i] *= self;
+        s.uz[i] *= self;
+      },
+      [&](std::size_t i) { copy_back(s, i); });
+}
+
+namespace {
+
+float room(const SoilState& s, std::size_t i) { return std::max(0.0f, 1.0f - s.psi[i]); }
+
+// One Jacobi pass of "up one voxel", in place per column: the excess of
+// voxel z is computed from the values before the pass (z is read before it is
+// written, and the carry holds what z - 1 sent up).
+void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
+  const terrain::Grid3Shape& g = s.shape;
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) {
+      if (dirty && !(*dirty)[static_cast<std::size_t>(y) * g.nx + x]) continue;
+      const std::size_t c = g.column(x, y);
+      float carry = 0, cu[3] = {0, 0, 0};
+      for (int z = 0; z < g.nz; ++z) {
+        const std::size_t i = c + z;
+        const float r = s.rho[i];
+        const float ex = z + 1 < g.nz ? std::max(0.0f, r - room(s, i)) : 0.0f;
+        if (ex == 0 && carry == 0) continue;
+        const float u[3] = {s.ux[i], s.uy[i], s.uz[i]};
+        const float kept = r - ex, now = kept + carry;
+        const float inv = now > 0 ? 1.0f / now : 0.0f;
+        s.ux[i] = (kept * u[0] + carry * cu[0]) * inv;
+        s.uy[i] = (kept * u[1] + carry * cu[1]) * inv;
+        s.uz[i] = (kept * u[2] + carry * cu[2]) * inv;
+        s.rho[i] = now;
+        carry = ex;
+        std::copy(u, u + 3, cu);
+      }
+    }
+  });
+}
+
+// Weights of a heuristic over the 26 neighbours, indexed (ox+1) + 3 (oy+1) + 9 (oz+1).
+std::array<float, 27> heuristic_weights(OverflowHeuristic h) {
+  std::array<float, 27> w{};
+  for (int oz = -1; oz <= 1; ++oz)
+    for (int oy = -1; oy <= 1; ++oy)
+      for (int ox = -1; ox <= 1; ++ox) {
+        const int k = (ox + 1) + 3 * (oy + 1) + 9 * (oz + 1);
+        if (h == OverflowHeuristic::Spread) w[k] = (ox || oy || oz) ? 1.0f : 0.0f;
+        if (h == OverflowHeuristic::UpNine && oz == 1)
+          w[k] = (ox ? 0.25f : 0.5f) * (oy ? 0.25f : 0.5f);
+      }
+  return w;
+}
+
+// One Jacobi pass of a weighted heuristic: sources spread their excess over
+// their valid neighbours (normalised), every voxel gathers.
+void overflow_weighted_pass(SoilState& s, const std::array<float, 27>& w) {
+  const terrain::Grid3Shape& g = s.shape;
+  std::vector<float>& excess = s.back.moving;
+  std::vector<float>& norm = s.back.rho;  // 1 / sum of valid weights, 0 if none
+  auto valid = [&](int x, int y, int z) {
+    return g.contains(x, y, z) && s.psi[g.index(x, y, z)] < kFull;
+  };
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x)
+      for (int z = 0; z < g.nz; ++z) {
+        const std::size_t i = g.index(x, y, z);
+        const float ex = std::max(0.0f, s.rho[i] - room(s, i));
+        float sum = 0;
+        if (ex > 0)
+          for (int k = 0; k < 27; ++k)
+            if (w[k] > 0 && valid(x + k % 3 - 1, y + (k / 3) % 3 - 1, z + k / 9 - 1)) sum += w[k];
+        excess[i] = sum > 0 ? ex : 0.0f;
+        norm[i] = sum > 0 ? 1.0f / sum : 0.0f;
+      }
+  });
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x)
+      for (int z = 0; z < g.nz; ++z) {
+        const std::size_t i = g.index(x, y, z);
+        float in = 0, iu[3] = {0, 0, 0};
+        if (valid(x, y, z))
+          for (int k = 0; k < 27; ++k) {
+            if (w[k] <= 0) continue;
+            const int sx = x - (k % 3 - 1), sy = y - ((k / 3) % 3 - 1), sz = z - (k / 9 - 1);
+            if (!g.contains(sx, sy, sz)) continue;
+            const std::size_t j = g.index(sx, sy, sz);
+            if (excess[j] <= 0) continue;
+            const float q = excess[j] * w[k] * norm[j];
+            in += q;
+            iu[0] += q * s.ux[j];
+            iu[1] += q * s.uy[j];
+            iu[2] += q * s.uz[j];
+          }
+        const float kept = s.rho[i] - excess[i], now = kept + in;
+        const float inv = now > 0 ? 1.0f / now : 0.0f;
+        s.back.ux[i] = (kept * s.ux[i] + iu[0]) * inv;
+        s.back.uy[i] = (kept * s.uy[i] + iu[1]) * inv;
+        s.back.uz[i] = (kept * s.uz[i] + iu[2]) * inv;
+        s.back.fx[i] = now;  // the new density, until the swap below
+      }
+  });
+  s.rho.swap(s.back.fx);
+  s.ux.swap(s.back.ux);
+  s.uy.swap(s.back.uy);
+  s.uz.swap(s.back.uz);
+}
+
+}  // namespace
+
+void resolve_overflow(SoilState& s, OverflowHeuristic h, int passes, const ColumnMask* dirty) {
+  for (int p = 0; p < passes; ++p) {
+    if (h == OverflowHeuristic::Up)
+      overflow_up_pass(s, dirty);
+    else
+      overflow_weighted_pass(s, heuristic_weights(h));
+  }
+}
+
+void settle_overflow(SoilState& s, const ColumnMask* dirty) {
+  const terrain::Grid3Shape& g = s.shape;
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) {
+      if (dirty && !(*dirty)[static_cast<std::size_t>(y) * g.nx + x]) continue;
+      const std::size_t c = g.column(x, y);
+      float carry = 0;
+      for (int z = 0; z < g.nz; ++z) {
+        float& r = s.rho[c + z];
+        r += carry;
+        carry = std::max(0.0f, r - room(s, c + z));
+        r -= carry;
+      }
+      for (int z = g.nz - 1; z >= 0 && carry > 0; --z) {
+        float& r = s.rho[c + z];
+        const float take = std::min(carry, std::max(0.0f, room(s, c + z) - r));
+        r += take;
+        carry -= take;
+      }
+      if (carry > 0) s.rho[c + g.nz - 1] += carry;  // a column full to the top: keep the mass
+    }
+  });
+}
+
+void apply_gravity(SoilState& s, double gravity, double dt) {
+  const float dv = static_cast<float>(-gravity * dt);
+  const std::size_t n = s.size();
+  tbb::parallel_for(std::size_t{0}, n, std::size_t{1} << 16, [&](std::size_t begin) {
+    const std::size_t end = std::min(n, begin + (std::size_t{1} << 16));
+    for (std::size_t i = begin; i < end; ++i) {
+      if (s.rho[i] > 0) {
+        s.uz[i] += dv;
+      } else {
+        s.ux[i] = s.uy[i] = s.uz[i] = 0;
+        s.fx[i] = s.fy[i] = s.fz[i] = 0;
+      }
+    }
+  });
+}
+
+}  // namespace drift::soil

@@ -1,0 +1,34 @@
+// Contact motion (paper 004, sec. 3.2.4): soil that a moving rigid body
+// collides with is pushed through the grid along the body's motion.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "terrain/soil/primitives.h"
+#include "terrain/soil/soil_state.h"
+#include "terrain/soil/transport.h"
+
+namespace drift::soil {
+
+// A moving body's voxel box and velocity (m/s) this step.
+struct BodyMotion {
+  VoxelBox box;
+  Eigen::Vector3d velocity{0, 0, 0};
+};
+
+// Force application, eq. 33: in a collided voxel (rho + psi > 1) holding
+// rigid body, f = the body's direction of motion (the first of `bodies`
+// whose box holds the voxel; straight up for a body at rest, which can only
+// lift what it overlaps); a collided voxel with no body keeps f; elsewhere f = 0.
+void apply_forces(SoilState& state, const std::vector<BodyMotion>& bodies);
+
+// One force-propagation iteration, eqs. 34-35: the collided soil
+// rho + psi - 1 of every voxel moves by f scaled to a largest component of 1
+// (so it leaves its voxel entirely) into neighbours that are in the grid and
+// not solid body (psi < 1), with u; anything refused comes back. f becomes
+// the inflow-weighted mean of the arriving forces where the voxel is still
+// collided, 0 elsewhere. Returns per column the z-range that changed.
+detail::Ranges propagate_forces(SoilState& state);
+
+}  // namespace drift::soil

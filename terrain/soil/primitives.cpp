@@ -1,0 +1,214 @@
+#include "terrain/soil/primitives.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "terrain/error.h"
+
+namespace drift::soil {
+
+using Eigen::Vector3d;
+
+bool Primitive::inside(const Vector3d& p) const {
+  const Vector3d q = p - center;
+  switch (kind) {
+    case PrimitiveKind::Sphere:
+      return q.squaredNorm() <= size.x() * size.x();
+    case PrimitiveKind::Ellipsoid:
+      return q.cwiseQuotient(size).squaredNorm() <= 1.0;
+    case PrimitiveKind::Cuboid:
+      return (q.cwiseAbs().array() <= size.array()).all();
+    case PrimitiveKind::Cylinder:
+      return std::abs(q.z()) <= size.z() && q.x() * q.x() + q.y() * q.y() <= size.x() * size.x();
+    case PrimitiveKind::Cone: {
+      if (q.z() < 0 || q.z() > size.z()) return false;
+      const double r = size.x() * (1.0 - q.z() / size.z());
+      return q.x() * q.x() + q.y() * q.y() <= r * r;
+    }
+  }
+  return false;
+}
+
+Vector3d Primitive::lower() const {
+  switch (kind) {
+    case PrimitiveKind::Sphere:
+      return center - Vector3d::Constant(size.x());
+    case PrimitiveKind::Cylinder:
+      return center - Vector3d(size.x(), size.x(), size.z());
+    case PrimitiveKind::Cone:
+      return center - Vector3d(size.x(), size.x(), 0.0);
+    default:
+      return center - size;
+  }
+}
+
+Vector3d Primitive::upper() const {
+  switch (kind) {
+    case PrimitiveKind::Sphere:
+      return center + Vector3d::Constant(size.x());
+    case PrimitiveKind::Cylinder:
+      return center + Vector3d(size.x(), size.x(), size.z());
+    case PrimitiveKind::Cone:
+      return center + Vector3d(size.x(), size.x(), size.z());
+    default:
+      return center + size;
+  }
+}
+
+namespace {
+
+const char* kind_name(PrimitiveKind k) {
+  switch (k) {
+    case PrimitiveKind::Sphere:
+      return "sphere";
+    case PrimitiveKind::Ellipsoid:
+      return "ellipsoid";
+    case PrimitiveKind::Cuboid:
+      return "cuboid";
+    case PrimitiveKind::Cylinder:
+      return "cylinder";
+    case PrimitiveKind::Cone:
+      return "cone";
+  }
+  return "?";
+}
+
+// Which components of `size` a kind uses.
+bool uses(PrimitiveKind k, int axis) {
+  if (k == PrimitiveKind::Sphere) return axis == 0;
+  if (k == PrimitiveKind::Cylinder || k == PrimitiveKind::Cone) return axis != 1;
+  return true;
+}
+
+double overlap(double lo, double hi, double a, double b) {
+  return std::max(0.0, std::min(hi, b) - std::max(lo, a)) / (hi - lo);
+}
+
+bool holds_box(const Primitive& p, const Vector3d& lo, const Vector3d& hi) {
+  for (int c = 0; c < 8; ++c) {
+    const Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
+                          (c & 4) ? hi.z() : lo.z());
+    if (!p.inside(corner)) return false;
+  }
+  return true;
+}
+
+bool box_touches(const Primitive& p, const Vector3d& lo, const Vector3d& hi) {
+  return (p.lower().array() < hi.array()).all() && (p.upper().array() > lo.array()).all();
+}
+
+}  // namespace
+
+Vector3d RigidObject::position(double t) const {
+  if (path.empty()) return Vector3d::Zero();
+  if (t <= path.front().time) return path.front().position;
+  if (t >= path.back().time) return path.back().position;
+  auto it = std::upper_bound(path.begin(), path.end(), t,
+                             [](double v, const Keyframe& k) { return v < k.time; });
+  const Keyframe& b = *it;
+  const Keyframe& a = *(it - 1);
+  const double s = (t - a.time) / (b.time - a.time);
+  return a.position + s * (b.position - a.position);
+}
+
+Vector3d RigidObject::velocity(double t) const {
+  if (path.size() < 2 || t < path.front().time || t >= path.back().time) return Vector3d::Zero();
+  auto it = std::upper_bound(path.begin(), path.end(), t,
+                             [](double v, const Keyframe& k) { return v < k.time; });
+  const Keyframe& b = *it;
+  const Keyframe& a = *(it - 1);
+  return (b.position - a.position) / (b.time - a.time);
+}
+
+void validate(const RigidObject& o, const std::string& what) {
+  if (o.primitives.empty()) throw Error(what + " '" + o.name + "' has no primitives");
+  for (std::size_t i = 0; i < o.primitives.size(); ++i) {
+    const Primitive& p = o.primitives[i];
+    const std::string where = what + " '" + o.name + "' primitive " + std::to_string(i + 1) + " (" +
+                              kind_name(p.kind) + ")";
+    if (!p.center.allFinite()) throw Error(where + " has a non-finite centre");
+    for (int a = 0; a < 3; ++a)
+      if (uses(p.kind, a) && !(std::isfinite(p.size[a]) && p.size[a] > 0))
+        throw Error(where + " has size " + std::to_string(p.size[a]) +
+                    "; sizes must be positive finite metres");
+  }
+  for (std::size_t i = 0; i < o.path.size(); ++i) {
+    if (!o.path[i].position.allFinite() || !std::isfinite(o.path[i].time))
+      throw Error(what + " '" + o.name + "' keyframe " + std::to_string(i + 1) + " is not finite");
+    if (i > 0 && !(o.path[i].time > o.path[i - 1].time))
+      throw Error(what + " '" + o.name + "' keyframe " + std::to_string(i + 1) +
+                  " is not later than the one before; keyframe times must increase");
+  }
+}
+
+double coverage(const std::vector<Primitive>& prims, const Vector3d& pos, const Vector3d& lo,
+                const Vector3d& hi) {
+  const Vector3d llo = lo - pos, lhi = hi - pos;
+  const Primitive* only = nullptr;
+  int touching = 0;
+  for (const Primitive& p : prims) {
+    if (!box_touches(p, llo, lhi)) continue;
+    if (holds_box(p, llo, lhi)) return 1.0;
+    only = &p;
+    ++touching;
+  }
+  if (touching == 0) return 0.0;
+  if (touching == 1 && only->kind == PrimitiveKind::Cuboid) {
+    const Vector3d a = only->lower(), b = only->upper();
+    return overlap(llo.x(), lhi.x(), a.x(), b.x()) * overlap(llo.y(), lhi.y(), a.y(), b.y()) *
+           overlap(llo.z(), lhi.z(), a.z(), b.z());
+  }
+  constexpr int n = 4;
+  int in = 0;
+  const Vector3d step = (lhi - llo) / n;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const Vector3d q = llo + step.cwiseProduct(Vector3d(i + 0.5, j + 0.5, k + 0.5));
+        for (const Primitive& p : prims)
+          if (p.inside(q)) {
+            ++in;
+            break;
+          }
+      }
+  return static_cast<double>(in) / (n * n * n);
+}
+
+VoxelBox voxel_box(const std::vector<Primitive>& prims, const Vector3d& pos,
+                   const terrain::Grid3Shape& shape) {
+  Vector3d lo = Vector3d::Constant(1e300), hi = Vector3d::Constant(-1e300);
+  for (const Primitive& p : prims) {
+    lo = lo.cwiseMin(p.lower() + pos);
+    hi = hi.cwiseMax(p.upper() + pos);
+  }
+  VoxelBox box;
+  const Eigen::Vector3i n(shape.nx, shape.ny, shape.nz);
+  for (int a = 0; a < 3; ++a) {
+    const double l = std::floor((lo[a] - shape.origin[a]) / shape.voxel_size);
+    const double h = std::ceil((hi[a] - shape.origin[a]) / shape.voxel_size);
+    box.lo[a] = static_cast<int>(std::clamp(l, 0.0, static_cast<double>(n[a])));
+    box.hi[a] = static_cast<int>(std::clamp(h, 0.0, static_cast<double>(n[a])));
+  }
+  return box;
+}
+
+void add_coverage(const std::vector<Primitive>& prims, const Vector3d& pos,
+                  const terrain::Grid3Shape& shape, std::vector<float>& field) {
+  const VoxelBox box = voxel_box(prims, pos, shape);
+  if (box.empty()) return;
+  const double h = shape.voxel_size;
+  tbb::parallel_for(box.lo.y(), box.hi.y(), [&](int y) {
+    for (int x = box.lo.x(); x < box.hi.x(); ++x)
+      for (int z = box.lo.z(); z < box.hi.z(); ++z) {
+        const Vector3d lo = shape.origin + h * Vector3d(x, y, z);
+        const double c = coverage(prims, pos, lo, lo + Vector3d::Constant(h));
+        if (c <= 0.0) continue;
+        float& v = field[shape.index(x, y, z)];
+        v = std::min(1.0f, v + static_cast<float>(c));
+      }
+  });
+}
+
+}  // namespace drift::soil

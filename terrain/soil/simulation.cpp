@@ -1,0 +1,107 @@
+#include "terrain/soil/simulation.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "terrain/error.h"
+#include "terrain/soil/deformation.h"
+
+namespace drift::soil {
+
+namespace {
+
+// Marks the columns of a body's voxel box, widened by one, as dirty.
+void mark_box(const VoxelBox& box, ColumnMask& dirty, const terrain::Grid3Shape& g) {
+  for (int y = std::max(0, box.lo.y() - 1); y < std::min(g.ny, box.hi.y() + 1); ++y)
+    for (int x = std::max(0, box.lo.x() - 1); x < std::min(g.nx, box.hi.x() + 1); ++x)
+      dirty[static_cast<std::size_t>(y) * g.nx + x] = 1;
+}
+
+}  // namespace
+
+void validate(const SoilOptions& o) {
+  auto check = [](bool ok, const char* name, double v, const char* range) {
+    if (!ok)
+      throw Error(std::string("soil option ") + name + " is " + std::to_string(v) +
+                  "; it must lie in " + range);
+  };
+  check(std::isfinite(o.dt) && o.dt > 0 && o.dt <= 1, "dt (s)", o.dt, "(0, 1]");
+  check(std::isfinite(o.gravity) && o.gravity >= 0 && o.gravity <= 100, "gravity (m/s^2)",
+        o.gravity, "[0, 100]");
+  check(o.propagation_iterations >= 0 && o.propagation_iterations <= 64, "propagation_iterations",
+        o.propagation_iterations, "[0, 64]");
+  check(o.overflow_passes >= 0 && o.overflow_passes <= 64, "overflow_passes", o.overflow_passes,
+        "[0, 64]");
+  validate(o.soil);
+}
+
+SoilSimulation::SoilSimulation(SoilState state, std::vector<RigidObject> bodies,
+                               const SoilOptions& options)
+    : state_(std::move(state)), options_(options), slippage_(state_.shape) {
+  validate(options_);
+  for (RigidObject& b : bodies) {
+    validate(b, "body");
+    if (b.moves()) {
+      bodies_.push_back(std::move(b));
+    } else {
+      add_coverage(b.primitives, b.position(0.0), state_.shape, state_.psi_static);
+    }
+  }
+  rebuild_collision_field();
+}
+
+void SoilSimulation::rebuild_collision_field() {
+  state_.psi = state_.psi_static;
+  for (const RigidObject& b : bodies_)
+    add_coverage(b.primitives, b.position(time_), state_.shape, state_.psi);
+}
+
+void SoilSimulation::step() {
+  const double dt = options_.dt;
+  // Move the bodies to the end of the step; their velocity over it drives eq. 33.
+  std::vector<BodyMotion> motion;
+  for (const RigidObject& b : bodies_)
+    motion.push_back({voxel_box(b.primitives, b.position(time_ + dt), state_.shape),
+                      b.velocity(time_ + 0.5 * dt)});
+  time_ += dt;
+  rebuild_collision_field();
+
+  // Overflow can only arise where soil moved or a body is: mark those columns.
+  ColumnMask dirty(state_.shape.columns(), 0);
+  auto mark = [&](const detail::Ranges& r) {
+    for (std::size_t c = 0; c < r.size(); ++c) dirty[c] |= r[c].first <= r[c].second;
+  };
+  for (const BodyMotion& m : motion) mark_box(m.box, dirty, state_.shape);
+
+  apply_forces(state_, motion);
+  for (int i = 0; i < options_.propagation_iterations; ++i) mark(propagate_forces(state_));
+
+  mark(advect(state_, dt));
+  resolve_overflow(state_, options_.overflow, options_.overflow_passes, &dirty);
+  if (options_.settle) settle_overflow(state_, &dirty);
+
+  apply_gravity(state_, options_.gravity, dt);
+  if (options_.slippage) slippage_.step(state_, options_.soil, options_.gravity, dt);
+  ++steps_;
+}
+
+void add_soil(SoilState& s, const std::vector<Primitive>& prims, const Eigen::Vector3d& pos) {
+  const terrain::Grid3Shape& g = s.shape;
+  const VoxelBox box = voxel_box(prims, pos, g);
+  if (box.empty()) return;
+  const double h = g.voxel_size;
+  tbb::parallel_for(box.lo.y(), box.hi.y(), [&](int y) {
+    for (int x = box.lo.x(); x < box.hi.x(); ++x)
+      for (int z = box.lo.z(); z < box.hi.z(); ++z) {
+        const Eigen::Vector3d lo = g.origin + h * Eigen::Vector3d(x, y, z);
+        const double c = coverage(prims, pos, lo, lo + Eigen::Vector3d::Constant(h));
+        const std::size_t i = g.index(x, y, z);
+        const float room = std::max(0.0f, 1.0f - std::max(s.psi_static[i], s.psi[i]) - s.rho[i]);
+        s.rho[i] += std::min(room, static_cast<float>(c));
+      }
+  });
+}
+
+}  // namespace drift::soil

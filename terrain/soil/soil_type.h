@@ -1,0 +1,47 @@
+// Soil properties for Li & Moshell's slippage (paper 004, sec. 2.1.2 and
+// table 6, taken from Li & Moshell 1993):
+//
+// | type       | phi (deg) | c (t/m)   | gamma (t/m^2) | preset used here    |
+// |------------|-----------|-----------|---------------|---------------------|
+// | dry sand   | 26 - 33   | 0         | 1.9 - 2.0     | 30, 0,   1.95       |
+// | sandy loam | 14 - 26   | 0 - 2.0   | 1.8 - 2.0     | 22, 0.2, 1.9        |
+// | loam       | 10 - 28   | 0.5 - 5.0 | 1.8 - 2.1     | 20, 0.5, 2.0        |
+//
+// c is per metre of slice width, so c / gamma is a length: cohesion holds
+// slopes steeper the smaller the voxels are (a cut in real loam stands
+// vertical up to about 4 c / gamma tan(45 + phi / 2) metres, Terzaghi), so a
+// cohesive soil is only seen to slump on coarse voxels.
+//
+// Moisture (thesis 5.3.4): wet sand holds steeper slopes through capillary
+// cohesion. moisture in [0, 1] (0 dry, 1 damp through) adds
+// kMoistCohesion * moisture to c; the renderer's wet coat reads it as
+// wetness.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace drift::soil {
+
+struct SoilType {
+  std::string name = "dry_sand";
+  double phi_deg = 30.0;  // angle of internal friction, degrees, [0, 60)
+  double cohesion = 0.0;  // c, t/m, [0, 20]
+  double gamma = 1.95;    // specific weight, t/m^2, (0, 10]
+  double moisture = 0.0;  // [0, 1]
+
+  // Apparent cohesion of moist sand, t/m at moisture 1 (about 3 kPa: the
+  // order of the capillary cohesion of damp sand).
+  static constexpr double kMoistCohesion = 0.3;
+  double effective_cohesion() const { return cohesion + kMoistCohesion * moisture; }
+};
+
+// The presets of table 6 ("dry_sand", "sandy_loam", "loam"); throws
+// drift::Error listing the names for anything else.
+SoilType soil_preset(const std::string& name);
+std::vector<std::string> soil_preset_names();
+
+// Throws drift::Error naming the field, the value and the valid range.
+void validate(const SoilType& soil);
+
+}  // namespace drift::soil

@@ -1,0 +1,20 @@
+// The top of the soil and of whatever it rests on, per column, as a height
+// raster: how voxel soil joins the height-field stages (marks in a spoil
+// heap, the renderer's terrain).
+#pragma once
+
+#include "terrain/grid.h"
+#include "terrain/soil/soil_state.h"
+
+namespace drift::soil {
+
+// Height in voxels above the grid's floor of the highest pile or body top of
+// column (x, y) (falling soil is ignored); 0 for an empty column.
+float column_top(const SoilState& state, int x, int y);
+
+// The raster of column tops in metres (origin.z + voxel_size * top), row 0 the
+// northern edge (y = ny - 1), with `geo` as its georeference (a local one of
+// the voxel size when geo is empty).
+terrain::HeightField top_surface(const SoilState& state, const terrain::GeoReference& geo);
+
+}  // namespace drift::soil
