@@ -41,8 +41,8 @@ marks::Motion read_motion(Section& s) {
   const auto m = s.string("motion");
   if (!m || *m == "sweep") return marks::Motion::Sweep;
   if (*m == "substeps") return marks::Motion::SubSteps;
-  if (*m == "place") return marks::Motion::Place;
-  s.invalid("motion", "is '" + *m + "'; use sweep, substeps or place");
+  if (*m != "place") s.invalid("motion", "is '" + *m + "'; use sweep, substeps or place");
+  return marks::Motion::Place;
 }
 
 int read_resolution(Section& s) {

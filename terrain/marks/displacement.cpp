@@ -119,7 +119,10 @@ void displace_contact(Patch& p, terrain::Grid<double>& h,
     return;
   }
   const double eps = 1e-9;
-  auto key = [&](int li) { return (li % p.w.width) * drag->x() + (li / p.w.width) * drag->y(); };
+  auto key = [&](int li) {
+    const int col = li % p.w.width, row = li / p.w.width;  // the cell's column and row
+    return col * drag->x() + row * drag->y();
+  };
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
   for (int li : order)
     hand_on(p, li, h, [&](int m, int k) {

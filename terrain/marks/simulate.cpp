@@ -43,6 +43,7 @@ MarksResult simulate_marks(const terrain::HeightField& ground,
   if (objects.empty()) throw Error("marks: no objects to move");
   MarksSimulation sim(ground, std::move(materials), options);
   std::vector<ObjectShape> shapes;
+  shapes.reserve(objects.size());
   for (const MarkObject& o : objects) shapes.push_back(ObjectShape::of(o.mesh));
   double t0 = 1e300, t1 = -1e300;
   for (const MarkObject& o : objects)
