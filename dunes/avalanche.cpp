@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "dunes/lattice.h"
-#include "dunes/tiles.h"
+#include "dunes/sweep_tiles.h"
 #include "terrain/simd.h"
 
 namespace drift::dunes {

@@ -12,11 +12,13 @@
 #include "dunes/avalanche.h"
 #include "dunes/height_range.h"
 #include "dunes/lattice.h"
-#include "dunes/tiles.h"
+#include "dunes/sand_parameters.h"
+#include "dunes/sweep_tiles.h"
 #include "dunes/wind_frame.h"
 #include "terrain/error.h"
 #include "terrain/hash.h"
 #include "terrain/memory.h"
+#include "terrain/parameter.h"
 #include "terrain/simd.h"
 
 namespace drift::dunes {
@@ -28,14 +30,6 @@ namespace {
 constexpr int kSweepsPerStep = 4;
 // At the end, relax fully (to a thousandth of a height unit).
 constexpr int kFinalSweeps = 20000;
-
-void require_range(const char* name, double v, double lo, double hi) {
-  if (!std::isfinite(v) || v < lo || v > hi) {
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "--%s is %g; it must lie in [%g, %g]", name, v, lo, hi);
-    throw Error(buf);
-  }
-}
 
 // tanh by its [7/6] Pade approximant (Lambert's continued fraction), within
 // 2e-7 for |x| < 4.97 and clamped to +-1 beyond, where tanh is 1 within 1e-4:
@@ -84,29 +78,23 @@ SandOptions default_options(Model model) {
 }
 
 void validate(const SandOptions& o) {
-  require_range("size", o.size, 8, 16384);
-  require_range("cell", o.cell_m, 1e-4, 1e3);
-  require_range("height-unit", o.height_unit, 1e-6, 1e3);
-  require_range("steps", o.steps, 0, 1e7);
-  require_range("L0", o.L0, 0.5, 64);
-  require_range("b", o.b, 0, 32);
-  require_range("q", o.q, 1e-4, 2);
-  require_range("b-prime", o.b_prime, 0, 2);
-  require_range("creep", o.creep, 0, 1);
-  require_range("amplitude", o.initial_amplitude, 0, 1e3);
-  require_range("repose", o.repose_deg, 1, 89);
-  require_range("wind", o.wind_from_deg, -360, 360);
-  require_range("shadow", o.shadow_deg, 0, 89);
-  require_range("reattach", o.reattach, 0, 16);
+  for (const SandParameter& p : sand_parameters()) {
+    const double v = p.get(o);
+    terrain::require_field(std::isfinite(v) && v >= p.lo && v <= p.hi, p.field, v, range_text(p));
+  }
   if (o.model == Model::Dunes) {
-    if (o.L0 <= o.b) throw Error("dunes need --L0 > --b, or windward flights go backwards");
-    if (o.q <= o.b_prime) throw Error("dunes need --q > --b-prime, or the lift turns negative");
+    if (o.L0 <= o.b)
+      throw terrain::ParameterError("L0",
+                                    "must exceed b for dunes, or windward flights go backwards");
+    if (o.q <= o.b_prime)
+      throw terrain::ParameterError("q",
+                                    "must exceed b_prime for dunes, or the lift turns negative");
   }
   const std::uint64_t cells = static_cast<std::uint64_t>(o.size) * o.size;
   // Heights, the next field (saltation, creep, avalanching) and the wind
   // shadow on the wind lattice (at most as many points as the grid), then
   // the field on the grid and its next.
-  require_memory(cells * (4 + 4 + 2 + 4 + 4), "the sand grid", "choose a smaller --size");
+  require_memory(cells * (4 + 4 + 2 + 4 + 4), "the sand grid", "choose a smaller size");
 }
 
 terrain::HeightField initial_field(const SandOptions& o) {
@@ -195,11 +183,11 @@ DRIFT_SIMD_KERNEL void flights_kernel(const float* __restrict c, int n, float be
     const float along = length * per_cell;
     const float positive = along > 0.0f ? along : 0.0f;
     const float bounded = positive < max_columns ? positive : max_columns;
-    const float to_shadow = static_cast<float>(s >> 1);
+    const float to_shadow = static_cast<float>(columns_to_shadow(s));
     const float columns = bounded < to_shadow ? bounded : to_shadow;
     // Times 1 or 0 (lifts are >= 0, so exact; GCC vectorises it, unlike a
     // select).
-    const float lifted = lift * static_cast<float>(~s & 1) * recovery[x];
+    const float lifted = lift * static_cast<float>(lit(s)) * recovery[x];
     const int whole = static_cast<int>(columns);
     land[x] = x + whole;
     part[x] = lifted;

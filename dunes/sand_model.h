@@ -85,8 +85,8 @@ struct Workspace {
 // options.size) (for a wind along the grid's axes, the grid itself).
 //
 // Saltation along the wind (paper eq. 1 or eqs. 2-3): every point lifts q
-// and drops it L cells downwind on its wind line, L / h columns on; a
-// landing between points is shared linearly between the 2 around it, as the
+// and drops it L cells downwind on its wind line, L / s columns on (s: the lattice spacing,
+// dunes/wind_frame.h); a landing between points is shared linearly between the 2 around it, as the
 // paper has it. Summed in double precision in a fixed order: exact mass
 // bookkeeping and the same bits for any thread count.
 void saltate(terrain::HeightField& h, const SandOptions& options, Workspace& workspace);
@@ -95,7 +95,7 @@ void saltate(terrain::HeightField& h, const SandOptions& options);
 // Creep: H += D/4 * (sum of the 4 neighbours - 4 H) (the paper's diffusion),
 // as antisymmetric fluxes across edges, so mass is conserved. `shift`: the
 // wind lattice's (dunes/lattice.h); the coefficient per lattice spacing
-// (D / h^2 for the paper's D per cell).
+// (D / s^2 for the paper's D per cell).
 void creep(terrain::HeightField& h, double coefficient, Workspace& workspace, int shift = 0);
 void creep(terrain::HeightField& h, double coefficient, int shift = 0);
 

@@ -12,8 +12,9 @@
 // The wind lattice. On an n x n grid the residual is rounded to a direction
 // (p, q) of whole columns and rows (p, q coprime, |q| <= p), and the sand
 // lives on a square lattice turned to it, whose rows are the wind lines:
-// lattice point (i, j) sits at i h (cos a, sin a) + j h (-sin a, cos a) on
-// the model grid, h = n / (c K) grid cells apart, c = sqrt(p^2 + q^2),
+// lattice point (i, j) sits at i s (cos a, sin a) + j s (-sin a, cos a) on
+// the model grid, s = n / (c K) grid cells apart (the spacing; `h` is the
+// height field throughout dunes/), c = sqrt(p^2 + q^2),
 // K = floor(n / c). The
 // model grid is a torus (n x n, periodic), and so is the turned lattice when
 // it has K rows of M = c^2 K points: a row closes on itself after M points
@@ -27,7 +28,7 @@
 // staircase, so slip faces across an oblique wind form as they do along the
 // grid (a lattice sheared along the grid's columns wore them down,
 // docs/dunes.md). The field is interpolated onto the grid at the end;
-// for the axes the lattice is the grid itself (h = 1, S = 0, M = K = n).
+// for the axes the lattice is the grid itself (s = 1, S = 0, M = K = n).
 #pragma once
 
 #include "terrain/grid.h"
@@ -51,7 +52,7 @@ struct WindLattice {
   int columns = 0;    // M = (p^2 + q^2) K points a row
   int rows = 0;       // K
   int shift = 0;      // S, in [0, M): past the last row, row 0 S columns back
-  double cell = 1.0;  // h: the lattice's spacing in grid cells, in [1, 1 + 1 / K)
+  double cell = 1.0;  // s: the lattice's spacing in grid cells, in [1, 1 + 1 / K)
   bool turned() const { return q != 0; }
 };
 
@@ -59,7 +60,7 @@ struct WindLattice {
 // directions (p, q) with c <= max(sqrt 2, sqrt n) (rows of at most
 // max(2, sqrt n) grid widths: long thin lattices cost cache and parallel
 // rows) and at least 4 rows, the one that minimises the angle from the wind
-// (radians) plus h - 1 (a coarser lattice costs resolution: 1 % of it
+// (radians) plus s - 1 (a coarser lattice costs resolution: 1 % of it
 // weighs as much as 0.57 degrees). The axes and diagonals are exact.
 WindLattice wind_lattice(double wind_from_deg, int n);
 
@@ -69,7 +70,7 @@ double lattice_wind_from(double wind_from_deg, int n);
 
 // Wind lattice -> n x n model grid: each grid cell bilinearly from the 4
 // lattice points around it, then the mean (so the mass: the lattice's points
-// stand for h^2 cells each, and M K h^2 = n^2) restored to float rounding.
+// stand for s^2 cells each, and M K s^2 = n^2) restored to float rounding.
 // The lattice itself for a wind along the axes.
 terrain::HeightField lattice_to_grid(const terrain::HeightField& lattice, const WindLattice& l,
                                      int n);

@@ -49,7 +49,10 @@ void shadow_recovery(const ShadowMap& shadow, int width, double ratio,
 // many.
 void line_recovery(const std::uint16_t* line, int width, double ratio, float* out);
 
-inline bool shadowed(std::uint16_t s) { return (s & 1u) != 0; }
-inline int columns_to_shadow(std::uint16_t s) { return s >> 1; }
+// The only decoders of a ShadowMap entry (int, so that the vectorised
+// flight kernels keep their integer arithmetic).
+inline bool shadowed(int s) { return (s & 1) != 0; }
+inline int lit(int s) { return ~s & 1; }  // 1 where the wind reaches, 0 in a shadow
+inline int columns_to_shadow(int s) { return s >> 1; }
 
 }  // namespace drift::dunes

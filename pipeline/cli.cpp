@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <memory>
 
+#include "terrain/parameter.h"
+
 namespace drift::pipeline {
 
 CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
@@ -25,6 +27,17 @@ CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::s
   return sub;
 }
 
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
+                         std::function<void(const CLI::App&)> run) {
+  // The App exists only once add_subcommand returns: the action finds it
+  // through a slot filled in afterwards.
+  auto self = std::make_shared<CLI::App*>(nullptr);
+  CLI::App* sub =
+      add_subcommand(parent, name, description, [self, run = std::move(run)] { run(**self); });
+  *self = sub;
+  return sub;
+}
+
 CLI::App& command_group(CLI::App& root, const std::string& name, const std::string& description) {
   for (CLI::App* existing : root.get_subcommands({})) {
     if (existing->get_name() == name) return *existing;
@@ -37,6 +50,21 @@ CLI::App& command_group(CLI::App& root, const std::string& name, const std::stri
 void add_seed_option(CLI::App& sub, unsigned long long& seed) {
   sub.add_option("--seed", seed, "random seed; the same seed gives the same bits")
       ->capture_default_str();
+}
+
+void validate_flags(const std::function<void()>& validate, const FlagNames& flags, bool usage) {
+  try {
+    validate();
+  } catch (const terrain::ParameterError& e) {
+    for (const auto& [field, flag] : flags) {
+      if (field != e.field()) continue;
+      const std::string message = flag + " " + e.problem();
+      if (usage) usage_error(message);
+      throw Error(message);
+    }
+    if (usage) usage_error(e.what());
+    throw;
+  }
 }
 
 void usage_error(const std::string& message) { throw CLI::ValidationError(message); }

@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace CLI {
@@ -22,6 +23,10 @@ namespace drift::pipeline {
 // called (with TBB limited to N threads when N > 0) once its options are parsed.
 CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
                          std::function<void()> run);
+// The same for an action that reads its own App (e.g. to ask whether a flag
+// was given): `run` receives the subcommand.
+CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
+                         std::function<void(const CLI::App&)> run);
 
 // A group of subcommands such as `drift snow cover` / `drift snow fall`: returns
 // the group `name` under `root`, creating it on first use.
@@ -29,6 +34,16 @@ CLI::App& command_group(CLI::App& root, const std::string& name, const std::stri
 
 // Adds the standard --seed option (a 64-bit unsigned seed).
 void add_seed_option(CLI::App& sub, unsigned long long& seed);
+
+// The flags that set an options struct's fields, as (field, flag) pairs.
+using FlagNames = std::vector<std::pair<std::string, std::string>>;
+
+// Runs `validate` (an options struct's validate()) and turns a
+// terrain::ParameterError about a field into one about its flag ("--region is
+// 40; it must lie in [1, 32]"): a usage error (exit 2) if `usage`, else a
+// drift::Error (exit 1). Fields without a flag keep the library's message.
+void validate_flags(const std::function<void()>& validate, const FlagNames& flags,
+                    bool usage = true);
 
 // Throws a usage error (exit 2) with `message`, e.g. for incompatible options.
 [[noreturn]] void usage_error(const std::string& message);

@@ -58,11 +58,9 @@ void run_merge(const MergeOptions& o, const CLI::App& sub) {
 
 void add_merge_command(CLI::App& root) {
   auto o = std::make_shared<MergeOptions>();
-  auto self = std::make_shared<CLI::App*>(nullptr);
   CLI::App* sub =
       add_subcommand(root, "merge", "join tiles of drift render --tile i/n into the whole frame",
-                     [o, self] { run_merge(*o, **self); });
-  *self = sub;
+                     [o](const CLI::App& self) { run_merge(*o, self); });
   sub->add_option("tiles", o->tiles, "tile EXR files, in any order")->required();
   sub->add_option("-o,--output", o->outputs, "output file(s), .exr and/or .png")->required();
   sub->add_option("--exposure", o->exposure, "PNG exposure in EV (default: the render's)")

@@ -55,22 +55,25 @@ void print_exposure(const render::Image& image, const render::DisplayTransform& 
   std::printf("exposure: metered %+.2f EV (--exposure EV fixes it)\n", fixed.exposure_ev);
 }
 
-void run_render(const RenderOptions& o, const CLI::App& sub) {
-  SceneFile scene = read_scene_file(o.scene);
+// --size WIDTHxHEIGHT into the settings.
+void apply_size(const std::string& size, render::RenderSettings& settings) {
+  std::smatch m;
+  if (!std::regex_match(size, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
+    usage_error("--size '" + size + "' must be WIDTHxHEIGHT, e.g. 1280x720");
+  }
+  settings.width = std::stoi(m[1]);
+  settings.height = std::stoi(m[2]);
+  if (settings.width < 1 || settings.height < 1 || settings.width > 16384 ||
+      settings.height > 16384) {
+    usage_error("--size '" + size + "': each side must be 1..16384");
+  }
+}
+
+// The command line's overrides of the scene file.
+void apply_overrides(const RenderOptions& o, const CLI::App& sub, SceneFile& scene) {
   if (o.spp > 0) scene.settings.samples_per_pixel = o.spp;
   if (o.noise_target >= 0.0) scene.settings.noise_target = static_cast<float>(o.noise_target);
-  if (!o.size.empty()) {
-    std::smatch m;
-    if (!std::regex_match(o.size, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
-      usage_error("--size '" + o.size + "' must be WIDTHxHEIGHT, e.g. 1280x720");
-    }
-    scene.settings.width = std::stoi(m[1]);
-    scene.settings.height = std::stoi(m[2]);
-    if (scene.settings.width < 1 || scene.settings.height < 1 || scene.settings.width > 16384 ||
-        scene.settings.height > 16384) {
-      usage_error("--size '" + o.size + "': each side must be 1..16384");
-    }
-  }
+  if (!o.size.empty()) apply_size(o.size, scene.settings);
   if (sub.count("--seed")) scene.settings.seed = o.seed;
   // Placed over the DEM when the terrain is loaded, replacing [sun]'s direction.
   if (!o.sun_time.empty()) scene.sun_time = parse_sun_time(o.sun_time);
@@ -97,6 +100,10 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     scene.outputs.clear();
     for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
   }
+}
+
+// Outputs are PNG or EXR, a tile (--tile i/n) only EXR.
+void check_outputs(const RenderOptions& o, SceneFile& scene) {
   if (scene.outputs.empty()) {
     throw Error("nothing to write: give -o NAME.png|NAME.exr or [output] files in '" + o.scene +
                 "'");
@@ -108,37 +115,27 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       throw Error("cannot write '" + f.string() + "': use a .png or .exr file name");
     }
   }
-  if (!o.tile.empty()) {
-    const auto [index, count] = render::parse_tile(o.tile);
-    const render::RowRange rows = render::tile_rows(scene.settings.height, index, count);
-    scene.settings.row_begin = rows.begin;
-    scene.settings.row_end = rows.end;
-    for (const auto& f : scene.outputs) {
-      if (f.extension() != ".exr") {
-        throw Error("a tile is written as EXR (it keeps its place in the frame); '" + f.string() +
-                    "' is not: give -o TILE.exr and join the tiles with drift merge");
-      }
+  if (o.tile.empty()) return;
+  std::pair<int, int> tile;
+  try {
+    tile = render::parse_tile(o.tile);
+  } catch (const Error& e) {
+    usage_error(std::string("--") + e.what());
+  }
+  const auto [index, count] = tile;
+  const render::RowRange rows = render::tile_rows(scene.settings.height, index, count);
+  scene.settings.row_begin = rows.begin;
+  scene.settings.row_end = rows.end;
+  for (const auto& f : scene.outputs) {
+    if (f.extension() != ".exr") {
+      throw Error("a tile is written as EXR (it keeps its place in the frame); '" + f.string() +
+                  "' is not: give -o TILE.exr and join the tiles with drift merge");
     }
   }
-  load_scene_terrain(scene);
-  const auto start = std::chrono::steady_clock::now();
-  const render::TerrainScene embree_scene(scene.input);
-  const render::Camera camera =
-      scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
-  render::RenderStats stats;
-  render::Image image = render::render_image(embree_scene, scene.input, camera, scene.settings,
-                                             terminal_progress("render"), &stats);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The display settings ride along so that `drift merge` can write the PNG.
-  image.attributes = {
-      {"exposure", scene.display.auto_exposure ? "auto" : std::to_string(scene.display.exposure_ev)},
-      {"exposure_compensation",
-       std::to_string(scene.display.auto_exposure ? scene.display.exposure_ev : 0.0)},
-      {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"},
-      {"white_balance",
-       scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
-  for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
+}
+
+void print_summary(const SceneFile& scene, const render::Image& image,
+                   const render::RenderStats& stats, double seconds) {
   if (scene.settings.noise_target > 0.0f) {
     const double mean_spp =
         static_cast<double>(stats.camera_rays) / (static_cast<double>(image.width) * image.height);
@@ -151,6 +148,33 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   }
   for (const auto& f : scene.outputs) std::printf("%s ", f.c_str());
   std::printf("\n");
+}
+
+void run_render(const RenderOptions& o, const CLI::App& sub) {
+  SceneFile scene = read_scene_file(o.scene);
+  apply_overrides(o, sub, scene);
+  check_outputs(o, scene);
+  load_scene_terrain(scene);
+  const auto start = std::chrono::steady_clock::now();
+  const render::TerrainScene embree_scene(scene.input);
+  const render::Camera camera =
+      scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
+  render::RenderStats stats;
+  render::Image image = render::render_image(embree_scene, scene.input, camera, scene.settings,
+                                             terminal_progress("render"), &stats);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The display settings ride along so that `drift merge` can write the PNG.
+  image.attributes = {
+      {"exposure",
+       scene.display.auto_exposure ? "auto" : std::to_string(scene.display.exposure_ev)},
+      {"exposure_compensation",
+       std::to_string(scene.display.auto_exposure ? scene.display.exposure_ev : 0.0)},
+      {"tone", scene.display.curve == render::ToneCurve::Clamp ? "clamp" : "filmic"},
+      {"white_balance",
+       scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"}};
+  for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
+  print_summary(scene, image, stats, seconds);
   print_exposure(image, scene.display, o.tile.empty());
 }
 
@@ -158,12 +182,8 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
 
 void add_render_command(CLI::App& root) {
   auto o = std::make_shared<RenderOptions>();
-  // The action needs its own App (to ask whether --seed was given), which exists
-  // only after add_subcommand returns: hand it over through a shared slot.
-  auto self = std::make_shared<CLI::App*>(nullptr);
   CLI::App* sub = add_subcommand(root, "render", "path-trace a scene file (TOML) to EXR and/or PNG",
-                                 [o, self] { run_render(*o, **self); });
-  *self = sub;
+                                 [o](const CLI::App& self) { run_render(*o, self); });
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
   sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, 1 << 20));
@@ -187,9 +207,10 @@ void add_render_command(CLI::App& root) {
                   "put the sun where it stands over the DEM at this local time, "
                   "\"YYYY-MM-DD HH:MM[:SS] [UTC offset]\" (e.g. \"2026-10-15 17:05 +09:00\"; "
                   "default offset UTC); overrides [sun] azimuth/elevation or date/time");
-  sub->add_option("--exposure", o->exposure_ev,
-                  "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
-                  "EXR stays linear)")
+  sub->add_option(
+         "--exposure", o->exposure_ev,
+         "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
+         "EXR stays linear)")
       ->check(CLI::Range(-20.0, 20.0));
   sub->add_option("--exposure-compensation", o->compensation_ev,
                   "EV added to the metered exposure (overrides [output] exposure_compensation)")

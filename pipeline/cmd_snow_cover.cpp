@@ -30,6 +30,14 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
   o.hemisphere = c.hemisphere == "north"   ? snow::Hemisphere::North
                  : c.hemisphere == "south" ? snow::Hemisphere::South
                                            : snow::Hemisphere::Auto;
+  // The ranges live in CoverOptions::validate(); checked before reading the DEM.
+  validate_flags([&o] { o.validate(); }, {{"region", "--region"},
+                                          {"iterations", "--iterations"},
+                                          {"floor", "--floor"},
+                                          {"sun_range_deg", "--sun-range"},
+                                          {"radius_m", "--radius"},
+                                          {"radius_cells", "--radius-cells"},
+                                          {"band_m", "--band"}});
   const terrain::HeightField dem = terrain::read_raster(c.dem);
   snow::CoverResult r;
   try {
@@ -58,38 +66,28 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
 void add_snow_cover_command(CLI::App& root) {
   CLI::App& group = command_group(root, "snow", "snow stages: cover (descriptor), fall");
   auto c = std::make_shared<CoverCommand>();
-  auto self = std::make_shared<CLI::App*>(nullptr);
   CLI::App* sub = add_subcommand(group, "cover",
                                  "snow-cover descriptor of a DEM (tangent sphere accessibility, "
                                  "altitude, sun aspect; paper 001)",
-                                 [c, self] { run_cover(*c, **self); });
-  *self = sub;
+                                 [c](const CLI::App& self) { run_cover(*c, self); });
   snow::CoverOptions& o = c->options;
   sub->add_option("dem", c->dem, "DEM GeoTIFF in metres (drift import)")->required();
   sub->add_option("-o,--output", c->output, "snow cover GeoTIFF, 1 - t in [0, 1]")->required();
   sub->add_option("--region", o.region, "smoothing region n, cells (diamond of 4n + 2n(n-1))")
-      ->check(CLI::Range(1, 32))
       ->capture_default_str();
-  sub->add_option("--iterations", o.iterations, "smoothing passes k")
-      ->check(CLI::Range(0, 100))
-      ->capture_default_str();
-  sub->add_option("--radius", o.radius_m, "probe radius r in metres (default: 55 cells)")
-      ->check(CLI::PositiveNumber);
+  sub->add_option("--iterations", o.iterations, "smoothing passes k")->capture_default_str();
+  sub->add_option("--radius", o.radius_m, "probe radius r in metres (default: 55 cells)");
   sub->add_option("--radius-cells", o.radius_cells,
                   "probe radius in cells (the paper's 5.5 at its 0.1 spacing = 55)")
-      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   sub->add_option("--floor", o.floor, "b: rock showing where TSA is 0, [0, 1]")
-      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   sub->add_option("--sun-range", o.sun_range_deg,
                   "theta1: slopes facing within this many degrees of the sun lose snow (0: off)")
-      ->check(CLI::Range(0.0, 90.0))
       ->capture_default_str();
   sub->add_option("--snow-line", c->snow_line,
                   "snow line in metres: no snow below, full above (default: (z/zmax)^2)");
   sub->add_option("--band", o.band_m, "width of the snow line's transition, metres")
-      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   sub->add_option("--hemisphere", c->hemisphere,
                   "where the sun stands: auto (from the DEM's CRS), north or south")

@@ -35,11 +35,19 @@ void run_snowfall(SnowfallCommand& c) {
       c.occlusion == "opengl" ? snow::TerrainOcclusion::OpenGL : snow::TerrainOcclusion::Sweep;
   if (!c.mesh_out.empty() && c.objects.empty())
     usage_error("--mesh-out needs --objects (there are no objects to write)");
-  try {
-    o.validate();  // before reading anything large
-  } catch (const Error& e) {
-    usage_error(e.what());
-  }
+  // Before reading anything large; the ranges live in SnowfallOptions::validate().
+  validate_flags([&o] { o.validate(); }, {{"azimuth_deg", "--direction's azimuth"},
+                                          {"elevation_deg", "--direction's elevation"},
+                                          {"spread_deg", "--spread"},
+                                          {"maps", "--maps"},
+                                          {"rate_m_per_h", "--rate"},
+                                          {"hours", "--hours"},
+                                          {"repose_deg", "--repose"},
+                                          {"mesh_max_edge", "--mesh-edge"},
+                                          {"occlusion.object_texel", "--object-texel"},
+                                          {"coverage.thin_depth", "--thin-depth"},
+                                          {"coverage.adhesion", "--adhesion"},
+                                          {"max_iterations", "--max-iterations"}});
 
   const terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);

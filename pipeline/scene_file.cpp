@@ -2,6 +2,8 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -18,6 +20,7 @@
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/mesh_io.h"
+#include "terrain/products.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -42,16 +45,17 @@ void read_exposure(Section& out, const toml::table* table, render::DisplayTransf
   display.auto_exposure = !node || node->is_string();
   if (node && node->is_string()) {
     const std::string mode = *out.string("exposure");
-    if (mode != "auto") out.invalid("exposure", "is '" + mode + "'; use \"auto\" or a number of EV");
+    if (mode != "auto")
+      out.invalid("exposure", "is '" + mode + "'; use \"auto\" or a number of EV");
   } else if (node) {
     display.exposure_ev = out.number("exposure", 0.0, -20.0, 20.0);
   }
   const double compensation = out.number("exposure_compensation", 0.0, -20.0, 20.0);
   if (compensation != 0.0 && !display.auto_exposure)
-    out.invalid("exposure_compensation", "needs exposure = \"auto\"; with a fixed exposure set that instead");
+    out.invalid("exposure_compensation",
+                "needs exposure = \"auto\"; with a fixed exposure set that instead");
   if (display.auto_exposure) display.exposure_ev = compensation;
 }
-
 
 // The detail keys of a material (render/ground_detail.h): `variation`,
 // `bump`, `bump_scale`, each over the preset's (or none).
@@ -67,16 +71,6 @@ void read_detail(Section& s, render::MaterialOverride& m) {
   m.detail = d;
 }
 
-// [terrain] surround (rasters), surround_reach and surround_blend: the
-// ground beyond the DEM's edge (render/surround.h).
-template <class Resolve>
-void read_surround(Section& terrain, SceneFile& scene, const Resolve& resolve) {
-  for (const std::string& f : terrain.strings("surround"))
-    scene.surround_rasters.push_back(resolve(f));
-  render::SurroundOptions& o = scene.input.surround;
-  o.reach = terrain.number("surround_reach", o.reach, 0.0, 1e6);
-  o.blend = terrain.number("surround_blend", o.blend, 0.0, 1e5);
-}
 
 // The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
 // `material` names a preset (which sets every field), and `color`,
@@ -177,42 +171,58 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
   return layer;
 }
 
-}  // namespace
+// The scene file's sections, each read by its own function below; the order
+// here is the order `unknown section` lists them in.
+constexpr std::array<const char*, 9> kSections = {"terrain", "snow",    "ripples", "sun",   "sky",
+                                                  "camera",  "objects", "render",  "output"};
 
-SceneFile read_scene_file(const fs::path& path) {
-  const toml::table root = parse_toml_file(path, "scene");
-  static const std::set<std::string> sections = {"terrain", "snow",   "ripples", "sun",    "sky",
-                                                 "camera",  "render", "output",  "objects"};
+// Every top-level key must be a known section.
+void check_sections(const toml::table& root, const fs::path& path) {
   for (const auto& [k, node] : root) {
-    if (!sections.count(std::string(k.str()))) {
-      throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
-                  ": unknown section '" + std::string(k.str()) +
-                  "' (known: terrain, snow, ripples, sun, sky, camera, objects, render, output)");
-    }
+    const std::string key(k.str());
+    if (std::find(kSections.begin(), kSections.end(), key) != kSections.end()) continue;
+    std::string known;
+    for (const char* s : kSections) known += std::string(known.empty() ? "" : ", ") + s;
+    throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
+                ": unknown section '" + key + "' (known: " + known + ")");
   }
-  const fs::path base = path.parent_path();
-  SceneFile scene;
-  render::SceneInput& in = scene.input;
+}
 
+// A path in the scene file, relative to the scene file's folder.
+fs::path resolve(const fs::path& scene_path, const std::string& p) {
+  return fs::path(p).is_absolute() ? fs::path(p) : scene_path.parent_path() / p;
+}
+
+// [terrain] surround (rasters), surround_reach and surround_blend: the
+// ground beyond the DEM's edge (render/surround.h).
+void read_surround(Section& terrain, const fs::path& path, SceneFile& scene) {
+  for (const std::string& f : terrain.strings("surround"))
+    scene.surround_rasters.push_back(resolve(path, f));
+  render::SurroundOptions& o = scene.input.surround;
+  o.reach = terrain.number("surround_reach", o.reach, 0.0, 1e6);
+  o.blend = terrain.number("surround_blend", o.blend, 0.0, 1e5);
+}
+
+// [terrain]: the DEM, its ground material, rules and layers. Returns the
+// objects file it names, if any.
+std::optional<fs::path> read_terrain(const toml::table& root, const fs::path& path,
+                                     SceneFile& scene) {
+  render::SceneInput& in = scene.input;
   Section terrain(subtable(root, "terrain", path), "terrain", path);
   const auto raster = terrain.string("raster");
-  if (!raster) throw Error(path.string() + ": '[terrain] raster' is required (a DEM GeoTIFF)");
-  auto resolve = [&](const std::string& p) {
-    return fs::path(p).is_absolute() ? fs::path(p) : base / p;
-  };
-  scene.terrain_raster = resolve(*raster);
+  if (!raster) terrain.invalid_table("needs 'raster' (a DEM GeoTIFF)");
+  scene.terrain_raster = resolve(path, *raster);
   in.vertical_exaggeration = terrain.number("exaggeration", 1.0, 0.01, 100.0);
   scene.terrain_repeat = terrain.integer("repeat", 1, 1, 9);
+  if (scene.terrain_repeat % 2 == 0)
+    terrain.invalid("repeat", "must be odd (the raster stays in the middle)");
   scene.position_radius = terrain.number("position_radius", scene.position_radius, 1.0, 1e5);
-  read_surround(terrain, scene, resolve);
-  if (const auto map = terrain.string("albedo_map")) scene.albedo_map = resolve(*map);
+  read_surround(terrain, path, scene);
+  if (const auto map = terrain.string("albedo_map")) scene.albedo_map = resolve(path, *map);
   // Objects standing on the terrain from an objects file (as `drift snow fall
   // --objects` reads), in addition to any [[objects]] here.
   std::optional<fs::path> objects_file;
-  if (const auto file = terrain.string("objects")) objects_file = resolve(*file);
-  if (scene.terrain_repeat % 2 == 0) {
-    throw Error(path.string() + ": 'terrain.repeat' must be odd (the raster stays in the middle)");
-  }
+  if (const auto file = terrain.string("objects")) objects_file = resolve(path, *file);
   std::string ground_preset;
   in.surface.ground = render::blend(in.surface.ground, read_material(terrain, ground_preset), 1.0f);
   if (!ground_preset.empty()) in.surface.ground_name = ground_preset;
@@ -223,173 +233,215 @@ SceneFile read_scene_file(const fs::path& path) {
         read_layer(layer, path, in.surface.layers.size(), scene.layer_masks.emplace_back()));
   }
   terrain.finish();
+  return objects_file;
+}
 
+// [snow]: the snow products (rasters, snowy objects) and the snow's look.
+void read_snow(const toml::table& root, const fs::path& path, SceneFile& scene) {
+  render::TerrainSurface& surface = scene.input.surface;
   Section snow(subtable(root, "snow", path), "snow", path);
-  if (const auto cover = snow.string("cover")) scene.snow_cover = resolve(*cover);
-  if (const auto depth = snow.string("depth")) scene.snow_depth = resolve(*depth);
-  if (const auto objects = snow.string("objects")) scene.snow_objects = resolve(*objects);
-  in.surface.snow.albedo = snow.color("color", in.surface.snow.albedo);
-  in.surface.snow.roughness = static_cast<float>(
-      snow.number("roughness", in.surface.snow.roughness, 0.0, render::kMaxRoughness));
-  in.surface.snow.forward_scattering = static_cast<float>(
-      snow.number("forward_scattering", in.surface.snow.forward_scattering, 0.0, 1.0));
-  in.surface.snow_scattering =
-      static_cast<float>(snow.number("scattering", in.surface.snow_scattering, 1.0, 1e5));
-  in.surface.snow_cover_outside = static_cast<float>(
-      snow.number("cover_outside", in.surface.snow_cover_outside, 0.0, 1.0));
+  if (const auto cover = snow.string("cover")) scene.snow_cover = resolve(path, *cover);
+  if (const auto depth = snow.string("depth")) scene.snow_depth = resolve(path, *depth);
+  if (const auto objects = snow.string("objects")) scene.snow_objects = resolve(path, *objects);
+  surface.snow.albedo = snow.color("color", surface.snow.albedo);
+  surface.snow.roughness = static_cast<float>(
+      snow.number("roughness", surface.snow.roughness, 0.0, render::kMaxRoughness));
+  surface.snow.forward_scattering = static_cast<float>(
+      snow.number("forward_scattering", surface.snow.forward_scattering, 0.0, 1.0));
+  surface.snow_scattering =
+      static_cast<float>(snow.number("scattering", surface.snow_scattering, 1.0, 1e5));
+  surface.snow_cover_outside = static_cast<float>(
+      snow.number("cover_outside", surface.snow_cover_outside, 0.0, 1.0));
   snow.finish();
+}
 
-  if (const toml::table* ripple_table = subtable(root, "ripples", path)) {
-    Section rip(ripple_table, "ripples", path);
-    const auto ripple_raster = rip.string("raster");
-    if (!ripple_raster)
-      throw Error(path.string() + ": [ripples] needs 'raster' (a tileable height field from " +
-                  "drift dunes --model ripples)");
-    scene.ripples = resolve(*ripple_raster);
-    render::RippleLayer layer;
-    const double cell = rip.number("cell", 0.0, 0.0, 100.0);
-    if (cell > 0.0) scene.ripple_texel_metres = cell;
-    layer.rotation_deg = rip.number("rotation", 0.0, -360.0, 360.0);
-    layer.strength = static_cast<float>(rip.number("strength", 1.0, 0.0, 100.0));
-    const auto fade = rip.vector<2>("fade_slope", 0.0, 90.0);
-    if (fade) {
-      if (!((*fade)[0] < (*fade)[1]))
-        throw Error(path.string() + ": 'ripples.fade_slope' must be [start, end] with start < end");
-      layer.fade_start_deg = static_cast<float>((*fade)[0]);
-      layer.fade_end_deg = static_cast<float>((*fade)[1]);
-    }
-    rip.finish();
-    in.surface.ripples = std::move(layer);
+// [ripples]: the ripple tile bump-mapped on the ground (paper 002).
+void read_ripples(const toml::table& root, const fs::path& path, SceneFile& scene) {
+  const toml::table* ripple_table = subtable(root, "ripples", path);
+  if (!ripple_table) return;
+  Section rip(ripple_table, "ripples", path);
+  const auto ripple_raster = rip.string("raster");
+  if (!ripple_raster)
+    rip.invalid_table("needs 'raster' (a tileable height field from drift dunes --model ripples)");
+  scene.ripples = resolve(path, *ripple_raster);
+  render::RippleLayer layer;
+  const double cell = rip.number("cell", 0.0, 0.0, 100.0);
+  if (cell > 0.0) scene.ripple_texel_metres = cell;
+  layer.rotation_deg = rip.number("rotation", 0.0, -360.0, 360.0);
+  layer.strength = static_cast<float>(rip.number("strength", 1.0, 0.0, 100.0));
+  if (const auto fade = rip.vector<2>("fade_slope", 0.0, 90.0)) {
+    if (!((*fade)[0] < (*fade)[1]))
+      rip.invalid("fade_slope", "must be [start, end] with start < end");
+    layer.fade_start_deg = static_cast<float>((*fade)[0]);
+    layer.fade_end_deg = static_cast<float>((*fade)[1]);
   }
+  rip.finish();
+  scene.input.surface.ripples = std::move(layer);
+}
 
+// [sun]: by azimuth and elevation, or by date and time over the DEM.
+void read_sun(const toml::table& root, const fs::path& path, SceneFile& scene) {
+  render::Sun& s = scene.input.sun;
   Section sun(subtable(root, "sun", path), "sun", path);
-  in.sun.azimuth_deg = sun.number("azimuth", in.sun.azimuth_deg, 0.0, 360.0);
-  in.sun.elevation_deg = sun.number("elevation", in.sun.elevation_deg, -90.0, 90.0);
-  in.sun.angular_diameter_deg =
-      sun.number("angular_diameter", in.sun.angular_diameter_deg, 1e-3, 20.0);
-  in.sun.irradiance = sun.number("irradiance", in.sun.irradiance, 0.0, 1e6);
-  in.sun.color = sun.color("color", in.sun.color);
+  const bool placed = sun.has("azimuth") || sun.has("elevation");
+  s.azimuth_deg = sun.number("azimuth", s.azimuth_deg, 0.0, 360.0);
+  s.elevation_deg = sun.number("elevation", s.elevation_deg, -90.0, 90.0);
+  s.angular_diameter_deg = sun.number("angular_diameter", s.angular_diameter_deg, 1e-3, 20.0);
+  s.irradiance = sun.number("irradiance", s.irradiance, 0.0, 1e6);
+  s.color = sun.color("color", s.color);
   const auto date = sun.string("date"), time = sun.string("time"), zone = sun.string("timezone");
   sun.finish();
-  if (date || time || zone) {
-    if (!date || !time) {
-      throw Error(path.string() + ": [sun] needs both 'date' (\"YYYY-MM-DD\") and 'time' " +
-                  "(\"HH:MM\"), with 'timezone' as a UTC offset (\"+09:00\", default UTC)");
-    }
-    const toml::table* table = subtable(root, "sun", path);
-    if (table->contains("azimuth") || table->contains("elevation")) {
-      throw Error(path.string() + ": [sun] gives both a date/time and azimuth/elevation; give one");
-    }
-    try {
-      scene.sun_time = render::parse_local_time(*date, *time, zone.value_or("UTC"));
-    } catch (const Error& e) {
-      throw Error(path.string() + ": [sun] " + e.what());
-    }
+  if (!date && !time && !zone) return;
+  if (!date || !time) {
+    sun.invalid_table(
+        "needs both 'date' (\"YYYY-MM-DD\") and 'time' (\"HH:MM\"), with 'timezone' as a UTC "
+        "offset (\"+09:00\", default UTC)");
   }
+  if (placed) sun.invalid_table("gives both a date/time and azimuth/elevation; give one");
+  try {
+    scene.sun_time = render::parse_local_time(*date, *time, zone.value_or("UTC"));
+  } catch (const Error& e) {
+    sun.invalid_table(e.what());
+  }
+}
 
-  const toml::table* sky_table = subtable(root, "sky", path);
-  Section sky(sky_table, "sky", path);
+// [sky]: the physical atmosphere (haze or visibility, light shafts) or the
+// simple gradient.
+void read_sky(const toml::table& root, const fs::path& path, render::Sky& sky_out) {
+  Section sky(subtable(root, "sky", path), "sky", path);
   if (const auto model = sky.string("model")) {
     if (*model == "physical") {
-      in.sky.model = render::SkyModel::Physical;
+      sky_out.model = render::SkyModel::Physical;
     } else if (*model == "simple") {
-      in.sky.model = render::SkyModel::Simple;
+      sky_out.model = render::SkyModel::Simple;
     } else {
-      throw Error(path.string() + ": 'sky.model' is '" + *model +
-                  "'; use \"physical\" (an Earth atmosphere) or \"simple\" (a gradient)");
+      sky.invalid(
+          "model",
+          "is '" + *model + "'; use \"physical\" (an Earth atmosphere) or \"simple\" (a gradient)");
     }
   }
-  in.sky.haze = static_cast<float>(sky.number("haze", in.sky.haze, 0.0, 1000.0));
-  if (sky_table && sky_table->contains("visibility")) {
-    if (sky_table->contains("haze"))
-      throw Error(path.string() + ": give [sky] haze or visibility, not both");
+  if (sky.has("visibility") && sky.has("haze"))
+    sky.invalid("visibility", "and 'sky.haze' are both given: give haze or visibility, not both");
+  sky_out.haze = static_cast<float>(sky.number("haze", sky_out.haze, 0.0, 1000.0));
+  if (sky.has("visibility")) {
     const double km = sky.number("visibility", 0.0, 1.0, 1000.0);
     try {
-      in.sky.haze = static_cast<float>(render::Atmosphere::aerosol_scale_for_visibility(km));
+      sky_out.haze = static_cast<float>(render::Atmosphere::aerosol_scale_for_visibility(km));
     } catch (const Error& e) {
-      throw Error(path.string() + ": 'sky.visibility': " + e.what());
+      sky.invalid("visibility", e.what());
     }
   }
-  in.sky.zenith = sky.color("zenith", in.sky.zenith);
-  in.sky.horizon = sky.color("horizon", in.sky.horizon);
-  in.sky.intensity = static_cast<float>(sky.number("intensity", in.sky.intensity, 0.0, 1e6));
-  in.sky.ground_factor =
-      static_cast<float>(sky.number("ground_factor", in.sky.ground_factor, 0.0, 10.0));
-  in.sky.constant = sky.boolean("constant", in.sky.constant);
-  in.sky.light_shafts = sky.boolean("light_shafts", in.sky.light_shafts);
-  in.sky.shaft_steps = sky.integer("shaft_steps", in.sky.shaft_steps, 1, 1024);
+  sky_out.zenith = sky.color("zenith", sky_out.zenith);
+  sky_out.horizon = sky.color("horizon", sky_out.horizon);
+  sky_out.intensity = static_cast<float>(sky.number("intensity", sky_out.intensity, 0.0, 1e6));
+  sky_out.ground_factor =
+      static_cast<float>(sky.number("ground_factor", sky_out.ground_factor, 0.0, 10.0));
+  sky_out.constant = sky.boolean("constant", sky_out.constant);
+  sky_out.light_shafts = sky.boolean("light_shafts", sky_out.light_shafts);
+  sky_out.shaft_steps = sky.integer("shaft_steps", sky_out.shaft_steps, 1, 1024);
   sky.finish();
+}
 
-  if (const toml::table* cam_table = subtable(root, "camera", path)) {
-    Section cam(cam_table, "camera", path);
-    render::Camera camera;
-    const auto from = cam.vector<3>("from", -1e8, 1e8);
-    const auto to = cam.vector<3>("to", -1e8, 1e8);
-    const auto from_lonlat = cam.vector<2>("from_lonlat", -180.0, 180.0);
-    const auto to_lonlat = cam.vector<2>("to_lonlat", -180.0, 180.0);
-    const double from_height = cam.number("from_height", 2.0, -1e4, 1e6);
-    const double to_height = cam.number("to_height", 0.0, -1e4, 1e6);
-    camera.vertical_fov_deg = cam.number("fov", camera.vertical_fov_deg, 0.1, 179.0);
-    if (const double f = cam.number("focal_length", 0.0, 0.0, 1e5); f > 0.0)
-      camera.focal_length_mm = f;
-    camera.sensor_width_mm = cam.number("sensor_width", camera.sensor_width_mm, 0.1, 1000.0);
-    camera.f_number = cam.number("f_number", 0.0, 0.0, 1000.0);
-    if (const double d = cam.number("focus_distance", 0.0, 0.0, 1e8); d > 0.0)
-      camera.focus_distance = d;
-    cam.finish();
-    if (camera.f_number > 0.0 && !camera.focal_length_mm)
-      throw Error(path.string() + ": 'camera.f_number' needs 'camera.focal_length' (millimetres)");
-    if (from && from_lonlat)
-      throw Error(path.string() + ": [camera] has both 'from' and 'from_lonlat'; give one");
-    if (to && to_lonlat)
-      throw Error(path.string() + ": [camera] has both 'to' and 'to_lonlat'; give one");
-    if (!(from || from_lonlat) || !(to || to_lonlat))
-      throw Error(path.string() +
-                  ": [camera] needs where it stands ('from' = [x, y, z] in the raster's CRS, or "
-                  "'from_lonlat' = [lon, lat]) and where it looks ('to' or 'to_lonlat')");
-    auto geo_point = [](const Eigen::Vector2d& ll, double h) { return GeoPoint{ll[0], ll[1], h}; };
-    if (from_lonlat) scene.camera_from_lonlat = geo_point(*from_lonlat, from_height);
-    if (to_lonlat) scene.camera_to_lonlat = geo_point(*to_lonlat, to_height);
-    if (from) camera.from = *from;
-    if (to) camera.to = *to;
-    in.camera = camera;  // lon/lat ends are placed by load_scene_terrain
+// [camera]'s lens: a field of view, or a focal length with an optional
+// aperture for depth of field.
+void read_lens(Section& cam, render::Camera& camera) {
+  camera.vertical_fov_deg = cam.number("fov", camera.vertical_fov_deg, 0.1, 179.0);
+  if (const double f = cam.number("focal_length", 0.0, 0.0, 1e5); f > 0.0)
+    camera.focal_length_mm = f;
+  camera.sensor_width_mm = cam.number("sensor_width", camera.sensor_width_mm, 0.1, 1000.0);
+  camera.f_number = cam.number("f_number", 0.0, 0.0, 1000.0);
+  if (const double d = cam.number("focus_distance", 0.0, 0.0, 1e8); d > 0.0)
+    camera.focus_distance = d;
+  if (camera.f_number > 0.0 && !camera.focal_length_mm)
+    cam.invalid("f_number", "needs 'camera.focal_length' (millimetres)");
+}
+
+// [camera]: where it stands and looks (CRS points, or lon/lat placed on the
+// DEM by load_scene_terrain) and its lens.
+void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene) {
+  const toml::table* cam_table = subtable(root, "camera", path);
+  if (!cam_table) return;
+  Section cam(cam_table, "camera", path);
+  render::Camera camera;
+  const auto from = cam.vector<3>("from", -1e8, 1e8);
+  const auto to = cam.vector<3>("to", -1e8, 1e8);
+  const auto from_lonlat = cam.vector<2>("from_lonlat", -180.0, 180.0);
+  const auto to_lonlat = cam.vector<2>("to_lonlat", -180.0, 180.0);
+  const double from_height = cam.number("from_height", 2.0, -1e4, 1e6);
+  const double to_height = cam.number("to_height", 0.0, -1e4, 1e6);
+  read_lens(cam, camera);
+  cam.finish();
+  if (from && from_lonlat) cam.invalid_table("has both 'from' and 'from_lonlat'; give one");
+  if (to && to_lonlat) cam.invalid_table("has both 'to' and 'to_lonlat'; give one");
+  if (!(from || from_lonlat) || !(to || to_lonlat)) {
+    cam.invalid_table(
+        "needs where it stands ('from' = [x, y, z] in the raster's CRS, or 'from_lonlat' = "
+        "[lon, lat]) and where it looks ('to' or 'to_lonlat')");
   }
+  auto geo_point = [](const Eigen::Vector2d& ll, double h) { return GeoPoint{ll[0], ll[1], h}; };
+  if (from_lonlat) scene.camera_from_lonlat = geo_point(*from_lonlat, from_height);
+  if (to_lonlat) scene.camera_to_lonlat = geo_point(*to_lonlat, to_height);
+  if (from) camera.from = *from;
+  if (to) camera.to = *to;
+  scene.input.camera = camera;  // lon/lat ends are placed by load_scene_terrain
+}
 
-  in.meshes = read_objects(root, path);
-  if (objects_file) {
-    for (auto& placed : read_objects_file(*objects_file)) in.meshes.push_back(std::move(placed));
-  }
-
+// [render]: size, sampling and seed.
+void read_render(const toml::table& root, const fs::path& path, render::RenderSettings& settings) {
   Section rs(subtable(root, "render", path), "render", path);
-  scene.settings.width = rs.integer("width", scene.settings.width, 1, 16384);
-  scene.settings.height = rs.integer("height", scene.settings.height, 1, 16384);
-  scene.settings.samples_per_pixel =
-      rs.integer("spp", scene.settings.samples_per_pixel, 1, 1 << 20);
-  scene.settings.max_depth = rs.integer("max_depth", scene.settings.max_depth, 1, 1024);
-  scene.settings.noise_target =
-      static_cast<float>(rs.number("noise_target", scene.settings.noise_target, 0.0, 1.0));
-  scene.settings.min_samples = rs.integer("min_spp", scene.settings.min_samples, 1, 1 << 20);
-  scene.settings.seed = static_cast<std::uint64_t>(rs.integer("seed", 1, 0, 2147483647));
-  scene.settings.sample_sky = rs.boolean("sample_sky", scene.settings.sample_sky);
+  settings.width = rs.integer("width", settings.width, 1, 16384);
+  settings.height = rs.integer("height", settings.height, 1, 16384);
+  settings.samples_per_pixel = rs.integer("spp", settings.samples_per_pixel, 1, 1 << 20);
+  settings.max_depth = rs.integer("max_depth", settings.max_depth, 1, 1024);
+  settings.noise_target =
+      static_cast<float>(rs.number("noise_target", settings.noise_target, 0.0, 1.0));
+  settings.min_samples = rs.integer("min_spp", settings.min_samples, 1, 1 << 20);
+  settings.seed = rs.seed("seed", settings.seed);
+  settings.sample_sky = rs.boolean("sample_sky", settings.sample_sky);
   rs.finish();
+}
 
+// [output]: files and the PNG's display transform.
+void read_output(const toml::table& root, const fs::path& path, SceneFile& scene) {
   Section out(subtable(root, "output", path), "output", path);
   for (const std::string& f : out.strings("files")) scene.outputs.emplace_back(f);
   read_exposure(out, subtable(root, "output", path), scene.display);
   const auto tone = out.string("tone");
-  if (tone && *tone != "filmic" && *tone != "clamp") {
-    throw Error(path.string() + ": 'output.tone' is '" + *tone + "'; use \"filmic\" or \"clamp\"");
-  }
+  if (tone && *tone != "filmic" && *tone != "clamp")
+    out.invalid("tone", "is '" + *tone + "'; use \"filmic\" or \"clamp\"");
   scene.display.curve =
       (tone && *tone == "clamp") ? render::ToneCurve::Clamp : render::ToneCurve::Filmic;
   const std::string balance = out.string("white_balance").value_or("daylight");
   if (balance != "daylight" && balance != "none") {
-    throw Error(path.string() + ": 'output.white_balance' is '" + balance +
-                "'; use \"daylight\" (the sun 60 degrees up reads white) or \"none\" (sRGB's D65)");
+    out.invalid("white_balance",
+                "is '" + balance +
+                    "'; use \"daylight\" (the sun 60 degrees up reads white) or \"none\" (sRGB's "
+                    "D65)");
   }
   scene.display.white_balance =
       balance == "daylight" ? render::kDaylightWhiteBalance : std::array<float, 3>{1, 1, 1};
   out.finish();
+}
+
+}  // namespace
+
+SceneFile read_scene_file(const fs::path& path) {
+  const toml::table root = parse_toml_file(path, "scene");
+  check_sections(root, path);
+  SceneFile scene;
+  const std::optional<fs::path> objects_file = read_terrain(root, path, scene);
+  read_snow(root, path, scene);
+  read_ripples(root, path, scene);
+  read_sun(root, path, scene);
+  read_sky(root, path, scene.input.sky);
+  read_camera(root, path, scene);
+  scene.input.meshes = read_objects(root, path);
+  if (objects_file) {
+    for (auto& placed : read_objects_file(*objects_file))
+      scene.input.meshes.push_back(std::move(placed));
+  }
+  read_render(root, path, scene.settings);
+  read_output(root, path, scene);
   return scene;
 }
 
@@ -428,7 +480,7 @@ void place_snowy_objects(SceneFile& scene) {
   const terrain::Mesh snowy = terrain::read_ply(scene.snow_objects);
   std::vector<terrain::Mesh> parts;
   try {
-    parts = terrain::split_by_attribute(snowy, "object");
+    parts = terrain::split_by_attribute(snowy, terrain::products::kObjectIndex);
   } catch (const Error& e) {
     throw Error("'" + scene.snow_objects.string() + "': " + e.what() +
                 " (write it with drift snow fall --mesh-out)");
@@ -439,7 +491,7 @@ void place_snowy_objects(SceneFile& scene) {
                 "; give the scene the objects file drift snow fall was given");
   }
   for (std::size_t o = 0; o < parts.size(); ++o) {
-    const std::vector<float>* cover = parts[o].attribute("snow_coverage");
+    const std::vector<float>* cover = parts[o].attribute(terrain::products::kSnowCoverage);
     meshes[o].position = parts[o].origin;
     meshes[o].snow_coverage = cover ? *cover : std::vector<float>{};
     meshes[o].mesh = std::move(parts[o]);

@@ -7,9 +7,11 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <set>
@@ -35,11 +37,17 @@ inline toml::table parse_toml_file(const std::filesystem::path& path, const char
 }
 
 // Reads one table's keys, remembering which were used, so that anything left
-// over is reported as unknown (like pbrt's ReportUnused).
+// over is reported as unknown (like pbrt's ReportUnused). Every error names
+// the file and the line of the key (or of the table).
 class Section {
  public:
-  Section(const toml::table* table, std::string name, const std::filesystem::path& file)
-      : table_(table), name_(std::move(name)), file_(file) {}
+  // `doc`: the page that lists the table's keys, named by finish().
+  Section(const toml::table* table, std::string name, const std::filesystem::path& file,
+          std::string doc = "docs/rendering.md")
+      : table_(table), name_(std::move(name)), file_(file), doc_(std::move(doc)) {}
+
+  // Whether the table gives `key` (without taking it).
+  bool has(const char* key) const { return table_ && table_->contains(key); }
 
   double number(const char* key, double fallback, double lo, double hi) {
     const toml::node* node = take(key);
@@ -62,6 +70,26 @@ class Section {
                std::to_string(hi) + "]");
     }
     return static_cast<int>(*v);
+  }
+  // A 64-bit seed, the range of the command line's --seed: an integer >= 0,
+  // or a string of decimal digits for seeds above 2^63 - 1 (TOML's integers
+  // are signed 64-bit).
+  std::uint64_t seed(const char* key, std::uint64_t fallback) {
+    const toml::node* node = take(key);
+    if (!node) return fallback;
+    const char* range = "must be a whole number in [0, 18446744073709551615] (a string above 2^63)";
+    if (const auto v = node->as_integer() ? node->value<std::int64_t>() : std::nullopt) {
+      if (*v < 0) fail(key, *node, "is " + std::to_string(*v) + "; it " + range);
+      return static_cast<std::uint64_t>(*v);
+    }
+    const auto text = node->value<std::string>();
+    if (!node->is_string() || text->empty() || text->size() > 20 ||
+        text->find_first_not_of("0123456789") != std::string::npos)
+      fail(key, *node, range);
+    errno = 0;
+    const unsigned long long v = std::strtoull(text->c_str(), nullptr, 10);
+    if (errno == ERANGE) fail(key, *node, "is " + *text + "; it " + range);
+    return v;
   }
   bool boolean(const char* key, bool fallback) {
     const toml::node* node = take(key);
@@ -153,7 +181,7 @@ class Section {
     for (const auto& [k, node] : *table_) {
       if (!used_.count(std::string(k.str()))) {
         throw Error(where(node) + ": unknown key '" + name_ + "." + std::string(k.str()) +
-                    "' (see docs/rendering.md for the keys of [" + name_ + "])");
+                    "' (see " + doc_ + " for the keys of [" + name_ + "])");
       }
     }
   }
@@ -180,6 +208,7 @@ class Section {
   const toml::table* table_;
   std::string name_;
   std::filesystem::path file_;
+  std::string doc_;
   std::set<std::string> used_;
 };
 

@@ -229,6 +229,23 @@ Spectrum Atmosphere::multiple_scattering(double h, double mu_sun) const {
 }
 
 Atmosphere::Atmosphere(const AtmosphereParameters& parameters) : parameters_(parameters) {
+  init_sun_colour();
+  transmittance_table_.resize(static_cast<std::size_t>(kAltitudes) * kMus);
+  tbb::parallel_for(0, kAltitudes, [&](int a) {
+    for (int m = 0; m < kMus; ++m)
+      transmittance_table_[a * kMus + m] =
+          transmittance_to_space_exact(altitude_of(a, kAltitudes), mu_of(m, kMus));
+  });
+  ms_table_.resize(static_cast<std::size_t>(kMsAltitudes) * kMsMus);
+  tbb::parallel_for(0, kMsAltitudes, [&](int a) {
+    const double fa = static_cast<double>(a) / (kMsAltitudes - 1);
+    const double h = kTableTop * fa * fa;
+    for (int m = 0; m < kMsMus; ++m)
+      ms_table_[a * kMsMus + m] = multiple_scattering_entry(h, -1.0 + 2.0 * m / (kMsMus - 1));
+  });
+}
+
+void Atmosphere::init_sun_colour() {
   // Colour: the sun's spectrum per band in linear sRGB (IEC 61966-2-1 matrix),
   // normalised to a top-of-atmosphere luminance of 1.
   double sun_y = 0.0;
@@ -242,70 +259,65 @@ Atmosphere::Atmosphere(const AtmosphereParameters& parameters) : parameters_(par
         (xyz_to_srgb * xyz * (kSolarIrradiance[3 * b] * kBandWidthNm / sun_y)).cast<float>();
     sun_rgb_total_ += sun_band_rgb_[b];
   }
+}
 
-  transmittance_table_.resize(static_cast<std::size_t>(kAltitudes) * kMus);
-  tbb::parallel_for(0, kAltitudes, [&](int a) {
-    for (int m = 0; m < kMus; ++m)
-      transmittance_table_[a * kMus + m] =
-          transmittance_to_space_exact(altitude_of(a, kAltitudes), mu_of(m, kMus));
-  });
+Spectrum Atmosphere::multiple_scattering_entry(double h, double mu_s) const {
+  // Multiple scattering (Hillaire 2020, eqs. 5-10): at altitude h and sun
+  // zenith cosine mu_s, integrate over the sphere of directions the
+  // second-order light (isotropic phase) and the transfer f_ms;
+  // Psi = L2 / (1 - f_ms).
+  constexpr int kDirections = 64;
+  const double r = kBottomRadius + h;
+  const Eigen::Vector3d sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+  std::array<double, kBands> l2{}, f{};
+  for (int d = 0; d < kDirections; ++d) {
+    // Fibonacci sphere: even directions.
+    const double z = 1.0 - 2.0 * (d + 0.5) / kDirections;
+    const double phi = d * kPi * (3.0 - std::sqrt(5.0));
+    const double s = std::sqrt(1.0 - z * z);
+    second_order_light(r, Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z), sun, l2, f);
+  }
+  Spectrum psi{};
+  for (int b = 0; b < kBands; ++b) {
+    const double l2_avg = l2[b] / kDirections, f_avg = f[b] / kDirections;
+    psi[b] = static_cast<float>(l2_avg / (1.0 - std::min(f_avg, 0.99)));
+  }
+  return psi;
+}
 
-  // Multiple scattering (Hillaire 2020, eqs. 5-10): at each altitude and sun
-  // zenith, integrate over the sphere of directions the second-order light
-  // (isotropic phase) and the transfer f_ms; Psi = L2 / (1 - f_ms).
-  ms_table_.resize(static_cast<std::size_t>(kMsAltitudes) * kMsMus);
-  constexpr int kDirections = 64, kSteps = 20;
-  const double albedo = parameters_.ground_albedo;
-  tbb::parallel_for(0, kMsAltitudes, [&](int a) {
-    const double fa = static_cast<double>(a) / (kMsAltitudes - 1);
-    const double h = kTableTop * fa * fa;
-    const double r = kBottomRadius + h;
-    for (int m = 0; m < kMsMus; ++m) {
-      const double mu_s = -1.0 + 2.0 * m / (kMsMus - 1);
-      const Eigen::Vector3d sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
-      std::array<double, kBands> l2{}, f{};
-      for (int d = 0; d < kDirections; ++d) {
-        // Fibonacci sphere: even directions.
-        const double z = 1.0 - 2.0 * (d + 0.5) / kDirections;
-        const double phi = d * kPi * (3.0 - std::sqrt(5.0));
-        const double s = std::sqrt(1.0 - z * z);
-        const Eigen::Vector3d w(s * std::cos(phi), s * std::sin(phi), z);
-        const double ground = distance_to_ground(r, z);
-        const double length = ground >= 0.0 ? ground : distance_to_top(r, z);
-        const double dt = length / kSteps;
-        std::array<double, kBands> trans;
-        trans.fill(1.0);
-        const Eigen::Vector3d origin(0.0, 0.0, r);
-        for (int k = 0; k < kSteps; ++k) {
-          const Eigen::Vector3d x = origin + w * ((k + 0.5) * dt);
-          const double rx = x.norm(), hx = rx - kBottomRadius;
-          const Spectrum ext = extinction(hx);
-          const Spectrum sr = rayleigh_scattering(hx), sm = mie_scattering(hx);
-          const Spectrum sun_t = transmittance_to_space(hx, x.dot(sun) / rx);
-          for (int b = 0; b < kBands; ++b) {
-            const double sigma_s = sr[b] + sm[b];
-            const double seg = (1.0 - std::exp(-ext[b] * dt)) / std::max<double>(ext[b], 1e-12);
-            l2[b] += trans[b] * sigma_s * sun_t[b] / (4.0 * kPi) * seg;
-            f[b] += trans[b] * sigma_s * seg;
-            trans[b] *= std::exp(-ext[b] * dt);
-          }
-        }
-        if (ground >= 0.0) {  // Lambertian ground lit by the sun
-          const Eigen::Vector3d g = origin + w * ground;
-          const double mu_g = g.dot(sun) / g.norm();
-          const Spectrum sun_t = transmittance_to_space(0.0, mu_g);
-          for (int b = 0; b < kBands; ++b)
-            l2[b] += trans[b] * sun_t[b] * std::max(mu_g, 0.0) * albedo / kPi;
-        }
-      }
-      Spectrum psi{};
-      for (int b = 0; b < kBands; ++b) {
-        const double l2_avg = l2[b] / kDirections, f_avg = f[b] / kDirections;
-        psi[b] = static_cast<float>(l2_avg / (1.0 - std::min(f_avg, 0.99)));
-      }
-      ms_table_[a * kMsMus + m] = psi;
+void Atmosphere::second_order_light(double r, const Eigen::Vector3d& w, const Eigen::Vector3d& sun,
+                                    std::array<double, kBands>& l2,
+                                    std::array<double, kBands>& f) const {
+  // Along direction w from radius r to the ground or the top: the sun's light
+  // scattered once towards the start (l2) and the share scattered at all (f).
+  constexpr int kSteps = 20;
+  const double ground = distance_to_ground(r, w.z());
+  const double length = ground >= 0.0 ? ground : distance_to_top(r, w.z());
+  const double dt = length / kSteps;
+  std::array<double, kBands> trans;
+  trans.fill(1.0);
+  const Eigen::Vector3d origin(0.0, 0.0, r);
+  for (int k = 0; k < kSteps; ++k) {
+    const Eigen::Vector3d x = origin + w * ((k + 0.5) * dt);
+    const double rx = x.norm(), hx = rx - kBottomRadius;
+    const Spectrum ext = extinction(hx);
+    const Spectrum sr = rayleigh_scattering(hx), sm = mie_scattering(hx);
+    const Spectrum sun_t = transmittance_to_space(hx, x.dot(sun) / rx);
+    for (int b = 0; b < kBands; ++b) {
+      const double sigma_s = sr[b] + sm[b];
+      const double seg = (1.0 - std::exp(-ext[b] * dt)) / std::max<double>(ext[b], 1e-12);
+      l2[b] += trans[b] * sigma_s * sun_t[b] / (4.0 * kPi) * seg;
+      f[b] += trans[b] * sigma_s * seg;
+      trans[b] *= std::exp(-ext[b] * dt);
     }
-  });
+  }
+  if (ground >= 0.0) {  // Lambertian ground lit by the sun
+    const Eigen::Vector3d g = origin + w * ground;
+    const double mu_g = g.dot(sun) / g.norm();
+    const Spectrum sun_t = transmittance_to_space(0.0, mu_g);
+    for (int b = 0; b < kBands; ++b)
+      l2[b] += trans[b] * sun_t[b] * std::max(mu_g, 0.0) * parameters_.ground_albedo / kPi;
+  }
 }
 
 Spectrum Atmosphere::in_scattering(double h0, const Eigen::Vector3d& view, double length,

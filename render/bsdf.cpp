@@ -4,8 +4,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "render/brdf.h"
 #include "render/color.h"
+#include "render/oren_nayar.h"
 #include "render/sampling.h"
 
 namespace drift::render {
@@ -59,25 +59,32 @@ class AlbedoTable {
   float average_ = 0.0f;
 };
 
+// The sum of f(a, b) over the cells of an n x n grid, in order: the one loop
+// of the tables' midpoint and stratified rules.
+template <class F>
+double grid_sum(int n, const F& f) {
+  double sum = 0.0;
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) sum += f(a, b);
+  return sum;
+}
+
 // The coat's E(mu) by stratified sampling of the microfacet normals (Walter
 // et al. 2007, eqs. 35-36 and 41); computed once, deterministically.
 const AlbedoTable& coat_table() {
   static const AlbedoTable table([](const Eigen::Vector3f& wo) {
     const Eigen::Vector3f n(0, 0, 1);
     constexpr int strata = 96;
-    double sum = 0.0;
-    for (int a = 0; a < strata; ++a) {
-      for (int b = 0; b < strata; ++b) {
-        const float u1 = (a + 0.5f) / strata, u2 = (b + 0.5f) / strata;
-        const float tan2 = kWetCoatAlpha * kWetCoatAlpha * u1 / (1.0f - u1);
-        const Eigen::Vector3f h = around(n, 1.0f / std::sqrt(1.0f + tan2), 2.0f * kPi * u2);
-        const Eigen::Vector3f wi = 2.0f * wo.dot(h) * h - wo;
-        if (wi.z() <= 0.0f) continue;
-        // f cos_i / pdf with pdf = D cos_h / (4 |wo.h|).
-        const float pdf = ggx_d(h.z(), kWetCoatAlpha) * h.z() / (4.0f * std::abs(wo.dot(h)));
-        sum += coat_f(n, wi, wo) * wi.z() / pdf;
-      }
-    }
+    const double sum = grid_sum(strata, [&](int a, int b) {
+      const float u1 = (a + 0.5f) / strata, u2 = (b + 0.5f) / strata;
+      const float tan2 = kWetCoatAlpha * kWetCoatAlpha * u1 / (1.0f - u1);
+      const Eigen::Vector3f h = around(n, 1.0f / std::sqrt(1.0f + tan2), 2.0f * kPi * u2);
+      const Eigen::Vector3f wi = 2.0f * wo.dot(h) * h - wo;
+      if (wi.z() <= 0.0f) return 0.0f;
+      // f cos_i / pdf with pdf = D cos_h / (4 |wo.h|).
+      const float pdf = ggx_d(h.z(), kWetCoatAlpha) * h.z() / (4.0f * std::abs(wo.dot(h)));
+      return coat_f(n, wi, wo) * wi.z() / pdf;
+    });
     return static_cast<float>(sum / (strata * strata));
   });
   return table;
@@ -97,14 +104,11 @@ const AlbedoTable& snow_table() {
   static const AlbedoTable table([](const Eigen::Vector3f& wo) {
     const Eigen::Vector3f n(0, 0, 1);
     constexpr int cells = 256;
-    double sum = 0.0;
-    for (int a = 0; a < cells; ++a) {
+    const double sum = grid_sum(cells, [&](int a, int b) {
       const float cos_i = (a + 0.5f) / cells;
-      for (int b = 0; b < cells; ++b) {
-        const Eigen::Vector3f wi = around(n, cos_i, 2.0f * kPi * (b + 0.5f) / cells);
-        sum += snow_single(n, wi, wo) * cos_i;  // dw = dcos dphi
-      }
-    }
+      const Eigen::Vector3f wi = around(n, cos_i, 2.0f * kPi * (b + 0.5f) / cells);
+      return snow_single(n, wi, wo) * cos_i;  // dw = dcos dphi
+    });
     return static_cast<float>(sum * 2.0 * std::numbers::pi / (cells * cells));
   });
   return table;

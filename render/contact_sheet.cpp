@@ -30,20 +30,10 @@ void draw_text(Image& sheet, const std::filesystem::path& font, int x, int y,
   }
 }
 
-}  // namespace
-
-std::filesystem::path default_font() {
-  for (const char* p :
-       {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf", "/usr/share/fonts/TTF/DejaVuSans.ttf",
-        "/usr/share/fonts/dejavu/DejaVuSans.ttf"}) {
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(p, ec)) return p;
-  }
-  return {};
-}
-
-Image contact_sheet(const std::vector<Image>& images, const ContactSheetOptions& o,
-                    const ProgressFn& progress) {
+// Checks the options against the images; returns the font for the labels
+// (empty when nothing is written).
+std::filesystem::path check_sheet(const std::vector<Image>& images, const ContactSheetOptions& o,
+                                  bool has_labels) {
   if (images.empty()) throw Error("a contact sheet needs at least one image");
   if (!o.labels.empty() && o.labels.size() != images.size()) {
     throw Error(std::to_string(o.labels.size()) + " labels for " + std::to_string(images.size()) +
@@ -60,8 +50,6 @@ Image contact_sheet(const std::vector<Image>& images, const ContactSheetOptions&
   if (o.font_size < 6 || o.font_size > 128) {
     throw Error("font size " + std::to_string(o.font_size) + " must be in [6, 128]");
   }
-  const bool has_labels = std::any_of(o.labels.begin(), o.labels.end(),
-                                      [](const std::string& s) { return !s.empty(); });
   std::filesystem::path font = o.font.empty() ? default_font() : o.font;
   if ((has_labels || !o.title.empty())) {
     std::error_code ec;
@@ -71,53 +59,91 @@ Image contact_sheet(const std::vector<Image>& images, const ContactSheetOptions&
                   "; install fonts-dejavu-core (scripts/install-deps.sh) or pass --font FILE.ttf");
     }
   }
-  if (progress && !progress(0.0, "contact sheet")) throw Cancelled();
+  return font;
+}
 
-  const int columns =
-      o.columns > 0 ? o.columns : static_cast<int>(std::ceil(std::sqrt(double(count))));
-  const int rows = (count + columns - 1) / columns;
-  int cell_w = 0, cell_h = 0;
+// The grid of cells: as many columns as asked (or a square), each cell as
+// large as the largest image, with bands for the title and labels.
+struct SheetLayout {
+  int columns = 1, cell_w = 0, cell_h = 0, pad = 0, label_band = 0, title_size = 0, title_band = 0;
+  long long width = 0, height = 0;
+};
+
+SheetLayout sheet_layout(const std::vector<Image>& images, const ContactSheetOptions& o,
+                         bool has_labels) {
+  const int count = static_cast<int>(images.size());
+  SheetLayout l;
+  l.columns = o.columns > 0 ? o.columns : static_cast<int>(std::ceil(std::sqrt(double(count))));
+  const int rows = (count + l.columns - 1) / l.columns;
   for (const Image& im : images) {
-    cell_w = std::max(cell_w, im.width);
-    cell_h = std::max(cell_h, im.height);
+    l.cell_w = std::max(l.cell_w, im.width);
+    l.cell_h = std::max(l.cell_h, im.height);
   }
-  const int pad = o.padding;
-  const int label_band = has_labels ? o.font_size + pad : 0;
-  const int title_size = o.font_size * 3 / 2;
-  const int title_band = o.title.empty() ? 0 : title_size + 2 * pad;
-  const long long width = static_cast<long long>(columns) * (cell_w + pad) + pad;
-  const long long height =
-      title_band + static_cast<long long>(rows) * (cell_h + label_band + pad) + pad;
-  if (width > 65535 || height > 65535) {
-    throw Error("contact sheet of " + std::to_string(width) + "x" + std::to_string(height) +
+  l.pad = o.padding;
+  l.label_band = has_labels ? o.font_size + l.pad : 0;
+  l.title_size = o.font_size * 3 / 2;
+  l.title_band = o.title.empty() ? 0 : l.title_size + 2 * l.pad;
+  l.width = static_cast<long long>(l.columns) * (l.cell_w + l.pad) + l.pad;
+  l.height =
+      l.title_band + static_cast<long long>(rows) * (l.cell_h + l.label_band + l.pad) + l.pad;
+  if (l.width > 65535 || l.height > 65535) {
+    throw Error("contact sheet of " + std::to_string(l.width) + "x" + std::to_string(l.height) +
                 " pixels is too large; use fewer or smaller images");
   }
-  Image sheet(static_cast<int>(width), static_cast<int>(height), {"R", "G", "B"}, kBackground);
+  return l;
+}
 
+// Image `i` tone-mapped into its cell, centred.
+void place_image(Image& sheet, const Image& im, int i, int cx, int cy, const SheetLayout& l,
+                 const DisplayTransform& display) {
+  int ir = im.channel_index("R"), ig = im.channel_index("G"), ib = im.channel_index("B");
+  if (ir < 0 || ig < 0 || ib < 0) {
+    if (im.channel_count() != 1) {
+      throw Error("image " + std::to_string(i + 1) +
+                  " of the contact sheet has no R, G, B channels and more than one channel");
+    }
+    ir = ig = ib = 0;
+  }
+  const int ox = cx + (l.cell_w - im.width) / 2, oy = cy + (l.cell_h - im.height) / 2;
+  for (int y = 0; y < im.height; ++y) {
+    for (int x = 0; x < im.width; ++x) {
+      sheet.at(ox + x, oy + y, 0) = apply_tone_curve(im.at(x, y, ir), display);
+      sheet.at(ox + x, oy + y, 1) = apply_tone_curve(im.at(x, y, ig), display);
+      sheet.at(ox + x, oy + y, 2) = apply_tone_curve(im.at(x, y, ib), display);
+    }
+  }
+}
+
+}  // namespace
+
+std::filesystem::path default_font() {
+  for (const char* p :
+       {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf", "/usr/share/fonts/TTF/DejaVuSans.ttf",
+        "/usr/share/fonts/dejavu/DejaVuSans.ttf"}) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(p, ec)) return p;
+  }
+  return {};
+}
+
+Image contact_sheet(const std::vector<Image>& images, const ContactSheetOptions& o,
+                    const ProgressFn& progress) {
+  const bool has_labels = std::any_of(o.labels.begin(), o.labels.end(),
+                                      [](const std::string& s) { return !s.empty(); });
+  const std::filesystem::path font = check_sheet(images, o, has_labels);
+  if (progress && !progress(0.0, "contact sheet")) throw Cancelled();
+  const SheetLayout l = sheet_layout(images, o, has_labels);
+  Image sheet(static_cast<int>(l.width), static_cast<int>(l.height), {"R", "G", "B"}, kBackground);
   if (!o.title.empty())
-    draw_text(sheet, font, static_cast<int>(width / 2), pad, o.title, title_size);
+    draw_text(sheet, font, static_cast<int>(l.width / 2), l.pad, o.title, l.title_size);
+  const int count = static_cast<int>(images.size());
   for (int i = 0; i < count; ++i) {
-    const Image& im = images[i];
-    int ir = im.channel_index("R"), ig = im.channel_index("G"), ib = im.channel_index("B");
-    if (ir < 0 || ig < 0 || ib < 0) {
-      if (im.channel_count() != 1) {
-        throw Error("image " + std::to_string(i + 1) +
-                    " of the contact sheet has no R, G, B channels and more than one channel");
-      }
-      ir = ig = ib = 0;
-    }
-    const int cx = pad + (i % columns) * (cell_w + pad);
-    const int cy = title_band + pad + (i / columns) * (cell_h + label_band + pad);
-    const int ox = cx + (cell_w - im.width) / 2, oy = cy + (cell_h - im.height) / 2;
-    for (int y = 0; y < im.height; ++y) {
-      for (int x = 0; x < im.width; ++x) {
-        sheet.at(ox + x, oy + y, 0) = apply_tone_curve(im.at(x, y, ir), o.display);
-        sheet.at(ox + x, oy + y, 1) = apply_tone_curve(im.at(x, y, ig), o.display);
-        sheet.at(ox + x, oy + y, 2) = apply_tone_curve(im.at(x, y, ib), o.display);
-      }
-    }
+    const int cx = l.pad + (i % l.columns) * (l.cell_w + l.pad);
+    const int cy = l.title_band + l.pad + (i / l.columns) * (l.cell_h + l.label_band + l.pad);
+    place_image(sheet, images[i], i, cx, cy, l, o.display);
     if (has_labels) {
-      draw_text(sheet, font, cx + cell_w / 2, cy + cell_h + pad / 2, o.labels[i], o.font_size);
+      draw_text(sheet, font, cx + l.cell_w / 2, cy + l.cell_h + l.pad / 2, o.labels[i],
+                o.font_size);
     }
     if (progress && !progress(double(i + 1) / count, "contact sheet")) throw Cancelled();
   }

@@ -138,7 +138,9 @@ double ssim_index(const std::vector<float>& x, const std::vector<float>& y, int 
   return sum / static_cast<double>(n);  // eq. 13: mean SSIM
 }
 
-ComparisonResult compare_images(const Image& a, const Image& b, const ComparisonOptions& o) {
+namespace {
+
+void check_comparison(const Image& a, const Image& b, const ComparisonOptions& o) {
   if (a.width != b.width || a.height != b.height) {
     throw Error("image sizes differ: " + std::to_string(a.width) + "x" + std::to_string(a.height) +
                 " vs " + std::to_string(b.width) + "x" + std::to_string(b.height) +
@@ -151,17 +153,16 @@ ComparisonResult compare_images(const Image& a, const Image& b, const Comparison
     throw Error("fail percent " + std::to_string(o.fail_percent) + " must be in [0, 100]");
   }
   if (!(o.relmse_epsilon > 0)) throw Error("relMSE epsilon must be > 0");
+}
 
-  ComparisonResult r;
-  r.channels = choose_channels(a, b, o.channels);
-  std::vector<int> ia, ib;
-  for (const auto& c : r.channels) {
-    ia.push_back(a.channel_index(c));
-    ib.push_back(b.channel_index(c));
-  }
+// RMSE and relMSE over the compared channels (ia of a, ib of b), whole and per pixel.
+void squared_errors(const Image& a, const Image& b, const std::vector<int>& ia,
+                    const std::vector<int>& ib, double epsilon, ComparisonResult& r,
+                    std::vector<float>& pix_rmse, std::vector<float>& pix_rel) {
   const std::size_t n = static_cast<std::size_t>(a.width) * a.height;
-  const std::size_t nc = r.channels.size();
-  std::vector<float> pix_rmse(n), pix_rel(n);
+  const std::size_t nc = ia.size();
+  pix_rmse.assign(n, 0.0f);
+  pix_rel.assign(n, 0.0f);
   double se = 0, rel = 0;
   for (std::size_t p = 0; p < n; ++p) {
     const float* pa = &a.pixels[p * a.channels.size()];
@@ -171,7 +172,7 @@ ComparisonResult compare_images(const Image& a, const Image& b, const Comparison
       const double d = static_cast<double>(pa[ia[c]]) - pb[ib[c]];
       const double ref = pb[ib[c]];
       pse += d * d;
-      prel += d * d / (ref * ref + o.relmse_epsilon);
+      prel += d * d / (ref * ref + epsilon);
     }
     se += pse;
     rel += prel;
@@ -181,15 +182,14 @@ ComparisonResult compare_images(const Image& a, const Image& b, const Comparison
   const double count = static_cast<double>(n * nc);
   r.rmse = std::sqrt(se / count);
   r.relmse = rel / count;
+}
 
-  std::vector<float> ssim_map;
-  r.ssim = ssim_index(luma8(a, ia), luma8(b, ib), a.width, a.height, &ssim_map);
-  if (!std::isfinite(r.rmse) || !std::isfinite(r.relmse) || !std::isfinite(r.ssim)) {
-    throw Error("the images hold NaN or infinite values in the compared channels (" +
-                join(r.channels) + "); they cannot be compared");
-  }
-
-  r.pixel_error = Image(a.width, a.height, {"error"});
+// The per-pixel error of the chosen metric, the share of pixels over the
+// per-pixel threshold and the verdict.
+void judge(const ComparisonOptions& o, const std::vector<float>& pix_rmse,
+           const std::vector<float>& pix_rel, const std::vector<float>& ssim_map,
+           ComparisonResult& r) {
+  const std::size_t n = pix_rmse.size();
   for (std::size_t p = 0; p < n; ++p) {
     switch (o.metric) {
       case CompareMetric::Rmse:
@@ -214,6 +214,28 @@ ComparisonResult compare_images(const Image& a, const Image& b, const Comparison
   }
   r.percent_over = 100.0 * static_cast<double>(over) / static_cast<double>(n);
   r.passed = r.error <= o.threshold && r.percent_over <= o.fail_percent;
+}
+
+}  // namespace
+
+ComparisonResult compare_images(const Image& a, const Image& b, const ComparisonOptions& o) {
+  check_comparison(a, b, o);
+  ComparisonResult r;
+  r.channels = choose_channels(a, b, o.channels);
+  std::vector<int> ia, ib;
+  for (const auto& c : r.channels) {
+    ia.push_back(a.channel_index(c));
+    ib.push_back(b.channel_index(c));
+  }
+  std::vector<float> pix_rmse, pix_rel, ssim_map;
+  squared_errors(a, b, ia, ib, o.relmse_epsilon, r, pix_rmse, pix_rel);
+  r.ssim = ssim_index(luma8(a, ia), luma8(b, ib), a.width, a.height, &ssim_map);
+  if (!std::isfinite(r.rmse) || !std::isfinite(r.relmse) || !std::isfinite(r.ssim)) {
+    throw Error("the images hold NaN or infinite values in the compared channels (" +
+                join(r.channels) + "); they cannot be compared");
+  }
+  r.pixel_error = Image(a.width, a.height, {"error"});
+  judge(o, pix_rmse, pix_rel, ssim_map, r);
   return r;
 }
 

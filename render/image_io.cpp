@@ -46,65 +46,36 @@ void write_with_oiio(const std::filesystem::path& target, const std::filesystem:
   }
 }
 
-}  // namespace
-
-Image read_image(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error("image " + path.string() + " does not exist or is not a file; check the path");
-  }
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) {
-    throw Error("cannot read image " + path.string() + ": " + oiio_message(OIIO::geterror()) +
-                " (expected EXR, PNG, JPEG or TIFF)");
-  }
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.depth > 1) {
-    throw Error("image " + path.string() + " has an unsupported shape (" +
-                std::to_string(spec.width) + "x" + std::to_string(spec.height) + ", " +
-                std::to_string(spec.nchannels) + " channels)");
-  }
+// Linear data as stored, channel names kept (EXR names AOVs "albedo.R" etc.),
+// with the data window and drift's own attributes.
+Image linear_image(const OIIO::ImageSpec& spec, std::vector<float> raw) {
   const int nc = spec.nchannels;
-  std::vector<float> raw(static_cast<std::size_t>(spec.width) * spec.height * nc);
-  const bool ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, raw.data());
-  const std::string read_error = ok ? std::string() : in->geterror();
-  in->close();
-  if (!ok) {
-    throw Error("cannot read the pixels of image " + path.string() + ": " +
-                oiio_message(read_error) + " (the file may be truncated or corrupt)");
+  std::vector<std::string> names;
+  for (int c = 0; c < nc; ++c) {
+    std::string name =
+        c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : std::string();
+    if (name.empty()) name = "channel" + std::to_string(c);
+    names.push_back(name);
   }
-
-  const bool is_float_format = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
-                               spec.format.basetype == OIIO::TypeDesc::HALF ||
-                               spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-  const bool is_exr =
-      lower_extension(path) == ".exr" || std::string(in->format_name()) == "openexr";
-  if (is_exr || is_float_format) {
-    // Linear data as stored, channel names kept (EXR names AOVs "albedo.R" etc.).
-    std::vector<std::string> names;
-    for (int c = 0; c < nc; ++c) {
-      std::string name =
-          c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : std::string();
-      if (name.empty()) name = "channel" + std::to_string(c);
-      names.push_back(name);
-    }
-    Image image(spec.width, spec.height, names);
-    image.pixels = std::move(raw);
-    if (spec.x != 0 || spec.y != 0 || spec.full_width != spec.width ||
-        spec.full_height != spec.height) {
-      image.frame = {spec.x, spec.y, spec.full_width, spec.full_height};
-    }
-    for (const OIIO::ParamValue& p : spec.extra_attribs) {
-      const std::string name = p.name().string();
-      if (name.rfind("drift:", 0) == 0 && p.type() == OIIO::TypeDesc::STRING) {
-        image.attributes.emplace_back(name.substr(6), p.get_string());
-      }
-    }
-    return image;
+  Image image(spec.width, spec.height, names);
+  image.pixels = std::move(raw);
+  if (spec.x != 0 || spec.y != 0 || spec.full_width != spec.width ||
+      spec.full_height != spec.height) {
+    image.frame = {spec.x, spec.y, spec.full_width, spec.full_height};
   }
+  for (const OIIO::ParamValue& p : spec.extra_attribs) {
+    const std::string name = p.name().string();
+    if (name.rfind("drift:", 0) == 0 && p.type() == OIIO::TypeDesc::STRING) {
+      image.attributes.emplace_back(name.substr(6), p.get_string());
+    }
+  }
+  return image;
+}
 
-  // Display-referred integer image: sRGB-decode to linear R, G, B[, A]. Grey
-  // (1 channel) and grey+alpha (2 channels) are spread over R, G, B.
+// Display-referred integer image: sRGB-decode to linear R, G, B[, A]. Grey
+// (1 channel) and grey+alpha (2 channels) are spread over R, G, B.
+Image display_image(const OIIO::ImageSpec& spec, const std::vector<float>& raw) {
+  const int nc = spec.nchannels;
   const bool has_alpha = spec.alpha_channel >= 0 || nc == 2 || nc >= 4;
   const int colour = nc >= 3 ? 3 : 1;
   std::vector<std::string> names = {"R", "G", "B"};
@@ -119,6 +90,42 @@ Image read_image(const std::filesystem::path& path) {
     if (has_alpha) d[3] = alpha_src >= 0 ? s[alpha_src] : 1.0f;  // alpha is linear coverage
   }
   return image;
+}
+
+}  // namespace
+
+Image read_image(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw Error("image " + path.string() + " does not exist or is not a file; check the path");
+  }
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) {
+    throw Error("cannot read image " + path.string() + ": " + oiio_message(OIIO::geterror()) +
+                " (expected EXR, PNG, JPEG or TIFF)");
+  }
+  const OIIO::ImageSpec spec = in->spec();
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.depth > 1) {
+    throw Error("image " + path.string() + " has an unsupported shape (" +
+                std::to_string(spec.width) + "x" + std::to_string(spec.height) + ", " +
+                std::to_string(spec.nchannels) + " channels)");
+  }
+  const int nc = spec.nchannels;
+  std::vector<float> raw(static_cast<std::size_t>(spec.width) * spec.height * nc);
+  const bool ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, raw.data());
+  const std::string read_error = ok ? std::string() : in->geterror();
+  in->close();
+  if (!ok) {
+    throw Error("cannot read the pixels of image " + path.string() + ": " +
+                oiio_message(read_error) + " (the file may be truncated or corrupt)");
+  }
+  const bool is_float_format = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
+                               spec.format.basetype == OIIO::TypeDesc::HALF ||
+                               spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+  const bool is_exr =
+      lower_extension(path) == ".exr" || std::string(in->format_name()) == "openexr";
+  if (is_exr || is_float_format) return linear_image(spec, std::move(raw));
+  return display_image(spec, raw);
 }
 
 void write_exr(const Image& image, const std::filesystem::path& path) {

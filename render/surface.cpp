@@ -62,15 +62,11 @@ terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
   return out;
 }
 
-SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
-                           const Eigen::Vector3f& normal, double footprint, const Relief& relief,
-                           const CoverageChannels* channels) {
-  SurfacePoint p;
-  p.normal = normal;
-  p.snow = surface.snow_cover
-               ? std::clamp(sample_raster(*surface.snow_cover, x, y, surface.snow_cover_outside),
-                            0.0f, 1.0f)
-               : 0.0f;
+namespace {
+
+// The ground's own material: its preset, with the draped albedo where the
+// image covers (x, y).
+Material base_material(const TerrainSurface& surface, double x, double y) {
   Material ground = surface.ground;
   if (surface.albedo_map) {
     const auto& map = *surface.albedo_map;
@@ -82,9 +78,13 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
               .cwiseMin(1.0f);
     }
   }
-  // The stack over the base, each entry over what lies beneath in order (so
-  // later ones win where they overlap), and its coverage share.
-  if (channels) p.coverage[channels->ground] = 1.0f;
+  return ground;
+}
+
+// The rules and layers over the base, each over what lies beneath in order
+// (so later ones win where they overlap), and their coverage shares.
+void stack_layers(const TerrainSurface& surface, double x, double y, const Relief& relief,
+                  const CoverageChannels* channels, Material& ground, SurfacePoint& p) {
   auto put_on_top = [&](const MaterialOverride& material, float w,
                         const std::vector<int> CoverageChannels::*entries, std::size_t i) {
     if (!(w > 0.0f)) return;
@@ -96,8 +96,9 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   for (std::size_t i = 0; i < surface.rules.size(); ++i) {
     const MaterialRule& rule = surface.rules[i];
     if (rule.altitude_jitter > 0.0f && std::isnan(ragged)) ragged = raggedness(x, y);
-    const float altitude =
-        rule.altitude_jitter > 0.0f ? relief.altitude + rule.altitude_jitter * ragged : relief.altitude;
+    const float altitude = rule.altitude_jitter > 0.0f
+                               ? relief.altitude + rule.altitude_jitter * ragged
+                               : relief.altitude;
     put_on_top(rule.material, rule.weight(altitude, relief.slope_deg, position),
                &CoverageChannels::rules, i);
   }
@@ -106,6 +107,54 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
     const float mask = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f);
     put_on_top(layer.material, mask * layer.opacity, &CoverageChannels::layers, i);
   }
+}
+
+// Ripples as bump mapping (paper 002, section 5): the tile's slope at the
+// footprint's level tilts the normal and its unresolved variance roughens
+// the sand; they fade under snow and on slip faces.
+void apply_ripples(const RippleLayer& r, double x, double y, const Eigen::Vector3f& normal,
+                   double footprint, SurfacePoint& p) {
+  // Ripples live on sand: not under snow, not on slip faces.
+  const float slope_deg =
+      std::acos(std::clamp(normal.z(), -1.0f, 1.0f)) * static_cast<float>(180.0 / std::numbers::pi);
+  const float keep =
+      (1.0f - p.snow) * (1.0f - smoothstep(r.fade_start_deg, r.fade_end_deg, slope_deg));
+  if (keep <= 0.0f) return;
+  // Ground (x, y) -> tile (u, v): turn by -rotation (the tile is turned clockwise).
+  const double a = r.rotation_deg * std::numbers::pi / 180.0;
+  const double c = std::cos(a), s = std::sin(a);
+  const double u = c * x - s * y, v = s * x + c * y;
+  const SlopePyramid::Moments m = r.slopes.sample_moments(u, v, footprint);
+  const float scale = r.strength * keep;
+  const Eigen::Vector2f g_tile = m.slope * scale;
+  // The ripple relief the footprint averaged away roughens the sand (LEAN
+  // mapping): facets tilted by its rms slope, added in quadrature to the
+  // sand's own Oren-Nayar sigma.
+  const float rms_slope = std::sqrt(m.variance) * scale;
+  const float sigma = std::atan(rms_slope);
+  p.material.roughness = std::min(std::hypot(p.material.roughness, sigma), kMaxRoughness);
+  // Slope back to ground axes (the inverse rotation).
+  const Eigen::Vector2f g(static_cast<float>(c * g_tile.x() + s * g_tile.y()),
+                          static_cast<float>(-s * g_tile.x() + c * g_tile.y()));
+  // Surface z = Z(x, y) + h(x, y): n ~ (-(Zx + hx), -(Zy + hy), 1).
+  const Eigen::Vector3f base = normal / normal.z();
+  p.normal = Eigen::Vector3f(base.x() - g.x(), base.y() - g.y(), 1.0f).normalized();
+}
+
+}  // namespace
+
+SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
+                           const Eigen::Vector3f& normal, double footprint, const Relief& relief,
+                           const CoverageChannels* channels) {
+  SurfacePoint p;
+  p.normal = normal;
+  p.snow = surface.snow_cover
+               ? std::clamp(sample_raster(*surface.snow_cover, x, y, surface.snow_cover_outside),
+                            0.0f, 1.0f)
+               : 0.0f;
+  Material ground = base_material(surface, x, y);
+  if (channels) p.coverage[channels->ground] = 1.0f;
+  stack_layers(surface, x, y, relief, channels, ground, p);
   Material snow = surface.snow;
   if (surface.snow_depth && p.snow > 0.0f) {
     // Thin snow lets the ground show through (translucency).
@@ -114,36 +163,8 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   }
   p.material = mix(ground, snow, p.snow);
   if (channels) cover(p.coverage, channels->snow, p.snow);
-
-  if (surface.ripples && normal.z() > 1e-3f) {
-    const RippleLayer& r = surface.ripples.value();
-    // Ripples live on sand: not under snow, not on slip faces.
-    const float slope_deg = std::acos(std::clamp(normal.z(), -1.0f, 1.0f)) *
-                            static_cast<float>(180.0 / std::numbers::pi);
-    const float keep =
-        (1.0f - p.snow) * (1.0f - smoothstep(r.fade_start_deg, r.fade_end_deg, slope_deg));
-    if (keep > 0.0f) {
-      // Ground (x, y) -> tile (u, v): turn by -rotation (the tile is turned clockwise).
-      const double a = r.rotation_deg * std::numbers::pi / 180.0;
-      const double c = std::cos(a), s = std::sin(a);
-      const double u = c * x - s * y, v = s * x + c * y;
-      const SlopePyramid::Moments m = r.slopes.sample_moments(u, v, footprint);
-      const float scale = r.strength * keep;
-      const Eigen::Vector2f g_tile = m.slope * scale;
-      // The ripple relief the footprint averaged away roughens the sand
-      // (LEAN mapping): facets tilted by its rms slope, added in quadrature
-      // to the sand's own Oren-Nayar sigma.
-      const float rms_slope = std::sqrt(m.variance) * scale;
-      const float sigma = std::atan(rms_slope);
-      p.material.roughness = std::min(std::hypot(p.material.roughness, sigma), kMaxRoughness);
-      // Slope back to ground axes (the inverse rotation).
-      const Eigen::Vector2f g(static_cast<float>(c * g_tile.x() + s * g_tile.y()),
-                              static_cast<float>(-s * g_tile.x() + c * g_tile.y()));
-      // Surface z = Z(x, y) + h(x, y): n ~ (-(Zx + hx), -(Zy + hy), 1).
-      const Eigen::Vector3f base = normal / normal.z();
-      p.normal = Eigen::Vector3f(base.x() - g.x(), base.y() - g.y(), 1.0f).normalized();
-    }
-  }
+  if (surface.ripples && normal.z() > 1e-3f)
+    apply_ripples(surface.ripples.value(), x, y, normal, footprint, p);
   const DetailedGround detail = ground_detail(p.material, x, y, p.normal, footprint);
   p.material.albedo = detail.albedo;
   p.material.roughness = detail.roughness;

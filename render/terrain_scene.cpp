@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include "terrain/bilinear.h"
@@ -248,56 +249,62 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;
-  Eigen::Vector3f n;
-  if (rh.hit.geomID == surround_geometry_) {
-    // Beyond the DEM: its facets' normal, facing up.
-    n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
-    if (n.z() < 0.0f) n = -n;
-  } else if (rh.hit.geomID < terrain_geometries_) {
-    // Smooth shading: bilinear vertex normals at the hit's cell position.
-    const auto nw = vertices_.front();
-    auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
-    n = terrain::bilinear_clamped(vn, width_, height_, (hit.position.x() - nw.x()) / dx_,
-                                  (nw.y() - hit.position.y()) / dy_)
-            .normalized();
-  }
-  if (rh.hit.geomID < terrain_geometries_ || rh.hit.geomID == surround_geometry_) {
-    const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
-    // Material rules see the real relief: heights and slopes without the
-    // vertical exaggeration (n ~ (-k Zx, -k Zy, 1)).
-    Relief relief;
-    relief.altitude = static_cast<float>(world.z() / exaggeration_);
-    relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
-                       static_cast<float>(180.0 / std::numbers::pi);
-    const SurfacePoint surface =
-        shade_terrain(surface_, world.x(), world.y(), n, cone.width + cone.spread * hit.distance,
-                      relief, &coverage_);
-    n = surface.normal;
-    hit.material = surface.material;
-    hit.snow = surface.snow;
-    hit.coverage = surface.coverage;
-  } else {
-    n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
-    hit.material = Material{mesh_albedo_[rh.hit.geomID]};
-    hit.snow = 0.0f;
-    hit.coverage = {};
-    if (rh.hit.geomID < mesh_snow_.size() && !mesh_snow_[rh.hit.geomID].empty()) {
-      // Snow coverage interpolated over the triangle (Embree's barycentrics).
-      const std::vector<float>& cover = mesh_snow_[rh.hit.geomID];
-      const std::array<int, 3>& tri = mesh_snow_triangles_[rh.hit.geomID][rh.hit.primID];
-      const float c = std::clamp((1.0f - rh.hit.u - rh.hit.v) * cover[tri[0]] +
-                                     rh.hit.u * cover[tri[1]] + rh.hit.v * cover[tri[2]],
-                                 0.0f, 1.0f);
-      hit.material = mix(hit.material, surface_.snow, c);
-      hit.snow = c;
-      hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel
-    }
-  }
+  const bool surround = rh.hit.geomID == surround_geometry_;
+  std::optional<Eigen::Vector3f> facet;  // beyond the DEM: its facets' normal, facing up
+  if (surround) facet = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+  const Eigen::Vector3f n = rh.hit.geomID < terrain_geometries_ || surround
+                                ? shade_terrain_hit(hit, cone, facet)
+                                : shade_mesh_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v,
+                                                 {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, hit);
   // Face the ray: a mesh may be seen from either side, and terrain from below
   // at the edges. (Embree's Ng of our grids points down: rows run south.)
-  if (n.dot(d) > 0) n = -n;
-  hit.normal = n;
+  hit.normal = n.dot(d) > 0 ? Eigen::Vector3f(-n) : n;
   return true;
+}
+
+Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
+                                                const std::optional<Eigen::Vector3f>& facet) const {
+  // Smooth shading: bilinear vertex normals at the hit's cell position (on
+  // the DEM), or the facet's normal turned up (beyond it).
+  const auto nw = vertices_.front();
+  auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
+  const Eigen::Vector3f n =
+      facet ? (facet->z() < 0.0f ? Eigen::Vector3f(-*facet) : *facet)
+            : terrain::bilinear_clamped(vn, width_, height_, (hit.position.x() - nw.x()) / dx_,
+                                        (nw.y() - hit.position.y()) / dy_)
+                  .normalized();
+  const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
+  // Material rules see the real relief: heights and slopes without the
+  // vertical exaggeration (n ~ (-k Zx, -k Zy, 1)).
+  Relief relief;
+  relief.altitude = static_cast<float>(world.z() / exaggeration_);
+  relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
+                     static_cast<float>(180.0 / std::numbers::pi);
+  const SurfacePoint surface =
+      shade_terrain(surface_, world.x(), world.y(), n, cone.width + cone.spread * hit.distance,
+                    relief, &coverage_);
+  hit.material = surface.material;
+  hit.snow = surface.snow;
+  hit.coverage = surface.coverage;
+  return surface.normal;
+}
+
+Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangle, float u, float v,
+                                             const Eigen::Vector3f& ng, Hit& hit) const {
+  hit.material = Material{mesh_albedo_[geometry]};
+  hit.snow = 0.0f;
+  hit.coverage = {};
+  if (geometry < mesh_snow_.size() && !mesh_snow_[geometry].empty()) {
+    // Snow coverage interpolated over the triangle (Embree's barycentrics).
+    const std::vector<float>& cover = mesh_snow_[geometry];
+    const std::array<int, 3>& tri = mesh_snow_triangles_[geometry][triangle];
+    const float c = std::clamp(
+        (1.0f - u - v) * cover[tri[0]] + u * cover[tri[1]] + v * cover[tri[2]], 0.0f, 1.0f);
+    hit.material = mix(hit.material, surface_.snow, c);
+    hit.snow = c;
+    hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel
+  }
+  return ng.normalized();
 }
 
 bool TerrainScene::occluded(const Eigen::Vector3f& o, const Eigen::Vector3f& d,

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "render/render_settings.h"
@@ -77,6 +78,15 @@ class TerrainScene {
   void fill_vertices(const terrain::HeightField& dem, float vertical_exaggeration);
   void attach_terrain_grids();
   void attach_mesh(const terrain::PlacedMesh& placed);
+
+  // The hit's material, snow and coverage on the terrain (a footprint from
+  // `cone`) or on mesh `geometry`'s `triangle` at barycentrics (u, v) with
+  // geometric normal `ng`; each returns the shading normal, not yet facing
+  // the ray.
+  Eigen::Vector3f shade_terrain_hit(Hit& hit, const RayCone& cone,
+                                    const std::optional<Eigen::Vector3f>& facet = {}) const;
+  Eigen::Vector3f shade_mesh_hit(unsigned geometry, unsigned triangle, float u, float v,
+                                 const Eigen::Vector3f& ng, Hit& hit) const;
 
   // The unit shading normal at vertex (x, row), from the vertex buffer.
   Eigen::Vector3f vertex_normal(int x, int row) const;

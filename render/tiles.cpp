@@ -21,7 +21,7 @@ RowRange tile_rows(int height, int index, int count) {
 std::pair<int, int> parse_tile(const std::string& text) {
   std::smatch m;
   if (!std::regex_match(text, m, std::regex(R"((\d{1,6})/(\d{1,6}))"))) {
-    throw Error("--tile '" + text + "' must be INDEX/COUNT with a 0-based index, e.g. 0/8");
+    throw Error("tile '" + text + "' must be INDEX/COUNT with a 0-based index, e.g. 0/8");
   }
   return {std::stoi(m[1]), std::stoi(m[2])};
 }

@@ -14,6 +14,7 @@
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/parameter.h"
 
 namespace drift::snow {
 
@@ -140,14 +141,10 @@ HeightField tangent_sphere_accessibility(const HeightField& dem) {
   return out;
 }
 
-CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {
-  require(o.region >= 1 && o.region <= 32, "--region must be 1..32 cells");
-  require(o.iterations >= 0 && o.iterations <= 100, "--iterations must be 0..100");
-  require(o.floor >= 0.0 && o.floor <= 1.0, "--floor must lie in [0, 1]");
-  require(o.sun_range_deg >= 0.0 && o.sun_range_deg <= 90.0, "--sun-range must lie in [0, 90]");
-  require(o.radius_m >= 0.0 && std::isfinite(o.radius_m), "--radius must be positive (metres)");
-  require(o.radius_cells > 0.0, "--radius-cells must be positive");
-  require(o.band_m > 0.0, "--band must be positive (metres)");
+namespace {
+
+void check_cover_input(const HeightField& dem, const CoverOptions& o) {
+  o.validate();
   require(dem.width() >= 3 && dem.height() >= 3, "the DEM must be at least 3 x 3 cells");
   require(dem.geo().north_up() && dem.geo().cell_size_x() > 0 && dem.geo().cell_size_y() > 0,
           "the DEM must be north-up with positive cell sizes; warp it with drift import");
@@ -157,27 +154,19 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
   for (float v : dem.values()) nodata += std::isnan(v) ? 1 : 0;
   require(nodata == 0, "the DEM has " + std::to_string(nodata) +
                            " nodata cells; drift import fills them (run it first)");
+}
 
-  CoverResult result;
-  bool southern = false;
-  if (o.hemisphere == Hemisphere::South) southern = true;
-  if (o.hemisphere == Hemisphere::Auto && !dem.geo().crs_wkt.empty()) {
-    southern = terrain::centre_lonlat(dem.geo(), dem.width(), dem.height())[1] < 0.0;
-  }
-  result.southern = southern;
+bool southern_hemisphere(const HeightField& dem, Hemisphere hemisphere) {
+  if (hemisphere == Hemisphere::South) return true;
+  if (hemisphere == Hemisphere::Auto && !dem.geo().crs_wkt.empty())
+    return terrain::centre_lonlat(dem.geo(), dem.width(), dem.height())[1] < 0.0;
+  return false;
+}
 
-  // 1. Smoothing (paper sec. 4.1 lines 1-3), k times.
-  progress(0.0, "smoothing");
-  HeightField smoothed = dem;
-  for (int i = 0; i < o.iterations; ++i) {
-    smoothed = smooth(smoothed, o.region);
-    if (!progress(0.4 * (i + 1) / std::max(o.iterations, 1), "")) throw Cancelled();
-  }
-  // 2. TSA of the smoothed surface (lines 4-5).
-  result.accessibility = tangent_sphere_accessibility(smoothed);
-  if (!progress(0.7, "accessibility")) throw Cancelled();
-
-  // 3-4. Transfer g (eq. 4) and altitude (SPEC 3b.4: on the snow amount).
+// Steps 3-4: the transfer g (paper eq. 4) of the accessibility and the
+// altitude factor (SPEC 3b.4: on the snow amount); t = 1 - snow.
+HeightField transfer(const HeightField& dem, const HeightField& accessibility,
+                     const CoverOptions& o) {
   const double cell = dem.geo().cell_size_x();
   const float r = static_cast<float>(o.radius_m > 0.0 ? o.radius_m : o.radius_cells * cell);
   const float b = static_cast<float>(o.floor);
@@ -196,50 +185,94 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
   t.geo().nodata = std::nullopt;
   for_rows(dem.height(), [&](int row) {
     for (int x = 0; x < dem.width(); ++x) {
-      const float tsa = result.accessibility(x, row);
+      const float tsa = accessibility(x, row);
       const float g = tsa >= r ? 1.0f : (1.0f - b) * tsa / r + b;
       const float snow = (1.0f - g) * altitude_factor(dem(x, row));
       t(x, row) = 1.0f - snow;
     }
   });
+  return t;
+}
+
+// phi of one cell (paper lines 10-15): triangles facing within theta1 of the
+// sun's side (sun_y: +1 north, -1 south) count by their angle from it,
+// averaged over the 12 triangles; 1 is no effect.
+float sun_phi(const HeightField& smoothed, int x, int row, float dx, float dy, float sun_y,
+              float theta1) {
+  const float cos_theta1 = std::cos(theta1);
+  const Vector3f X = position(smoothed, x, row, dx, dy);
+  float phi_sum = 0.0f;
+  for (const auto& tri : kTriangles) {
+    const Vector3f a = position(smoothed, x + tri[0], row + tri[1], dx, dy) - X;
+    const Vector3f c = position(smoothed, x + tri[2], row + tri[3], dx, dy) - X;
+    const Vector3f m = a.cross(c);  // the face normal, up or down (sign below)
+    const float h2 = m.x() * m.x() + m.y() * m.y();
+    float phi = 1.0f;  // 1: no effect (outside the range, or flat)
+    if (h2 > 1e-12f * m.squaredNorm()) {
+      // Cosine of the angle between the face's aspect and the sun's side.
+      const float sign = m.z() < 0.0f ? -1.0f : 1.0f;
+      const float cos_off = sign * m.y() * sun_y / std::sqrt(h2);
+      if (cos_off >= cos_theta1) phi = std::acos(std::min(cos_off, 1.0f)) / theta1;
+    }
+    phi_sum += phi;
+  }
+  return phi_sum / static_cast<float>(kTriangles.size());
+}
+
+// Step 6: triangles facing the sun's side lose snow, the more the closer to it.
+HeightField sun_correction(const HeightField& smoothed, const HeightField& t, double range_deg,
+                           bool southern) {
+  const float dx = static_cast<float>(smoothed.geo().cell_size_x());
+  const float dy = static_cast<float>(smoothed.geo().cell_size_y());
+  // Horizontal unit vector towards the sun's side: south (0, -1) in the
+  // northern hemisphere, north (0, 1) in the southern.
+  const float sun_y = southern ? 1.0f : -1.0f;
+  const float theta1 = static_cast<float>(range_deg * std::numbers::pi / 180.0);
+  HeightField corrected = t;
+  for_rows(t.height(), [&](int row) {
+    for (int x = 0; x < t.width(); ++x) {
+      const float phi = sun_phi(smoothed, x, row, dx, dy, sun_y, theta1);
+      corrected(x, row) = t(x, row) * phi + (1.0f - phi);
+    }
+  });
+  return corrected;
+}
+
+}  // namespace
+
+void CoverOptions::validate() const {
+  terrain::require_in("region", region, 1, 32, "cells");
+  terrain::require_in("iterations", iterations, 0, 100);
+  terrain::require_in("floor", floor, 0.0, 1.0);
+  terrain::require_in("sun_range_deg", sun_range_deg, 0.0, 90.0, "degrees");
+  terrain::require_field(radius_m >= 0.0 && std::isfinite(radius_m), "radius_m", radius_m,
+                         "[0, inf) m (0: radius_cells)");
+  terrain::require_field(radius_cells > 0.0 && std::isfinite(radius_cells), "radius_cells",
+                         radius_cells, "(0, inf)");
+  terrain::require_field(band_m > 0.0 && std::isfinite(band_m), "band_m", band_m, "(0, inf) m");
+}
+
+CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {
+  check_cover_input(dem, o);
+  CoverResult result;
+  result.southern = southern_hemisphere(dem, o.hemisphere);
+
+  // 1. Smoothing (paper sec. 4.1 lines 1-3), k times.
+  progress(0.0, "smoothing");
+  HeightField smoothed = dem;
+  for (int i = 0; i < o.iterations; ++i) {
+    smoothed = smooth(smoothed, o.region);
+    if (!progress(0.4 * (i + 1) / std::max(o.iterations, 1), "")) throw Cancelled();
+  }
+  // 2. TSA of the smoothed surface (lines 4-5).
+  result.accessibility = tangent_sphere_accessibility(smoothed);
+  if (!progress(0.7, "accessibility")) throw Cancelled();
+  // 3-4. Transfer and altitude.
+  HeightField t = transfer(dem, result.accessibility, o);
   // 5. Smooth t once (its locality makes colours blotchy otherwise).
   t = smooth(t, 1);
-
-  // 6. Sun (lines 10-15): triangles facing within theta1 of the sun's side
-  // lose snow, the more the closer to it; phi averaged over the 12 triangles.
-  if (o.sun_range_deg > 0.0) {
-    const float dx = static_cast<float>(dem.geo().cell_size_x());
-    const float dy = static_cast<float>(dem.geo().cell_size_y());
-    // Horizontal unit vector towards the sun's side: south (0, -1) in the
-    // northern hemisphere, north (0, 1) in the southern.
-    const float sun_y = southern ? 1.0f : -1.0f;
-    const float theta1 = static_cast<float>(o.sun_range_deg * std::numbers::pi / 180.0);
-    const float cos_theta1 = std::cos(theta1);
-    HeightField corrected = t;
-    for_rows(dem.height(), [&](int row) {
-      for (int x = 0; x < dem.width(); ++x) {
-        const Vector3f X = position(smoothed, x, row, dx, dy);
-        float phi_sum = 0.0f;
-        for (const auto& tri : kTriangles) {
-          const Vector3f a = position(smoothed, x + tri[0], row + tri[1], dx, dy) - X;
-          const Vector3f c = position(smoothed, x + tri[2], row + tri[3], dx, dy) - X;
-          const Vector3f m = a.cross(c);  // the face normal, up or down (sign below)
-          const float h2 = m.x() * m.x() + m.y() * m.y();
-          float phi = 1.0f;  // 1: no effect (outside the range, or flat)
-          if (h2 > 1e-12f * m.squaredNorm()) {
-            // Cosine of the angle between the face's aspect and the sun's side.
-            const float sign = m.z() < 0.0f ? -1.0f : 1.0f;
-            const float cos_off = sign * m.y() * sun_y / std::sqrt(h2);
-            if (cos_off >= cos_theta1) phi = std::acos(std::min(cos_off, 1.0f)) / theta1;
-          }
-          phi_sum += phi;
-        }
-        const float phi = phi_sum / static_cast<float>(kTriangles.size());
-        corrected(x, row) = t(x, row) * phi + (1.0f - phi);
-      }
-    });
-    t = std::move(corrected);
-  }
+  // 6. Sun (lines 10-15).
+  if (o.sun_range_deg > 0.0) t = sun_correction(smoothed, t, o.sun_range_deg, result.southern);
   progress(1.0, "");
   result.descriptor = std::move(t);
   return result;

@@ -51,6 +51,9 @@ struct CoverOptions {
   std::optional<double> snow_line_m;  // altitude factor: a snow line instead of (z/zmax)^2
   double band_m = 200.0;              // ... with a transition band this wide
   Hemisphere hemisphere = Hemisphere::Auto;  // Auto: from the DEM's CRS (north if none)
+
+  // Throws terrain::ParameterError naming the field out of its range.
+  void validate() const;
 };
 
 struct CoverResult {

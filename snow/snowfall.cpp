@@ -11,45 +11,171 @@
 #include "snow/stabilise_mesh.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
+#include "terrain/parameter.h"
+#include "terrain/products.h"
 
 namespace drift::snow {
 
 namespace {
 
-void check(bool ok, const char* name, double value, const char* range) {
-  if (ok) return;
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", value);
-  throw Error(std::string("snowfall parameter '") + name + "' is " + buf + "; it must lie in " +
-              range);
+// The one idiom of options structs (terrain/parameter.h).
+void check(bool ok, const char* field, double value, const char* range) {
+  terrain::require_field(ok, field, value, range);
 }
 
 // Snow on one object: the polygon variant.
 struct ObjectSnow {
+  std::vector<double> footprint;  // horizontal area each vertex stands for (m^2)
+  std::vector<double> volume;     // m^3 of snow a vertex holds
   std::vector<double> depth, probability, adhesion;
   double fallen = 0, kept = 0;
 };
 
+// Paper 2.3(1)-(2): each face's snow (probability x amount over its
+// horizontal area) shared among its vertices, the vertex probability as the
+// mean of its faces' and the adhesion of steep faces.
+ObjectSnow fall_on_object(const terrain::Mesh& m, const std::vector<float>& face_probability,
+                          const std::vector<float>& face_facing, double amount,
+                          const CoverageOptions& coverage) {
+  ObjectSnow os;
+  os.footprint = vertex_footprints(m);
+  os.volume.assign(m.vertex_count(), 0.0);
+  std::vector<double> face_count(m.vertex_count(), 0.0);
+  os.probability.assign(m.vertex_count(), 0.0);
+  os.adhesion.assign(m.vertex_count(), 0.0);
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const auto& tri = m.triangles[t];
+    const Eigen::Vector3d p0 = m.positions[tri[0]].cast<double>();
+    const Eigen::Vector3d cross =
+        (m.positions[tri[1]].cast<double>() - p0).cross(m.positions[tri[2]].cast<double>() - p0);
+    const double horizontal = std::max(0.0, 0.5 * cross.z());
+    const Eigen::Vector3d n =
+        cross.norm() > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::UnitZ();
+    const double adhesion = adhesion_coverage(n, face_facing[t], amount, coverage);
+    for (int k = 0; k < 3; ++k) {
+      os.volume[tri[k]] += horizontal / 3.0 * face_probability[t] * amount;
+      os.probability[tri[k]] += face_probability[t];
+      os.adhesion[tri[k]] += adhesion;
+      face_count[tri[k]] += 1.0;
+    }
+  }
+  for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+    os.fallen += os.volume[i];
+    if (face_count[i] > 0) os.adhesion[i] /= face_count[i];
+    // Paper 2.3(2): a vertex's probability is the mean of its faces'; where the
+    // vertex holds snow, weighted by the footprint each face gives it.
+    os.probability[i] = os.footprint[i] > 0 ? os.volume[i] / (os.footprint[i] * amount)
+                        : face_count[i] > 0 ? os.probability[i] / face_count[i]
+                                            : 0.0;
+  }
+  return os;
+}
+
+// Paper 2.3(3): stabilises an object's snow along its mesh; what falls off
+// lands on the ground cell below (`snow`, m) or, off the raster, is lost.
+void settle_object(const SnowScene& scene, const terrain::Mesh& m,
+                   const StabiliseOptions& stabilise, ObjectSnow& os, terrain::Grid<double>& snow,
+                   SnowfallResult& result) {
+  const int W = scene.ground.width(), H = scene.ground.height();
+  const double cell_area = scene.dx * scene.dy;
+  const MeshStabiliseReport r = stabilise_mesh(m, os.footprint, os.volume, stabilise);
+  result.object_iterations = std::max(result.object_iterations, r.iterations);
+  result.converged = result.converged && r.converged;
+  os.depth.assign(m.vertex_count(), 0.0);
+  for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+    if (os.footprint[i] > 0) os.depth[i] = os.volume[i] / os.footprint[i];
+    os.kept += os.volume[i];
+    if (r.shed[i] <= 0) continue;
+    result.shed_volume += r.shed[i];
+    const int col = static_cast<int>(std::lround(scene.col_of(m.positions[i].x())));
+    const int row = static_cast<int>(std::lround(scene.row_of(m.positions[i].y())));
+    if (col < 0 || row < 0 || col >= W || row >= H) {
+      result.lost_volume += r.shed[i];
+    } else {
+      snow(col, row) += r.shed[i] / cell_area;
+    }
+  }
+}
+
+// The depth and coverage rasters, NaN where the ground had no data.
+void write_ground_rasters(const terrain::HeightField& ground, const SnowScene& scene,
+                          const terrain::Grid<double>& snow, const terrain::Grid<float>& facing,
+                          double amount, const CoverageOptions& coverage, SnowfallResult& result) {
+  const int W = ground.width(), H = ground.height();
+  result.depth = terrain::HeightField(W, H, 0.0f, ground.geo());
+  result.coverage = terrain::HeightField(W, H, 0.0f, ground.geo());
+  tbb::parallel_for(0, H, [&](int row) {
+    for (int col = 0; col < W; ++col) {
+      if (std::isnan(ground(col, row))) {
+        result.depth(col, row) = result.coverage(col, row) = std::nanf("");
+        continue;
+      }
+      const double d = snow(col, row);
+      result.depth(col, row) = static_cast<float>(std::max(d, 0.0));  // -1e-16 from rounding
+      const double stuck =
+          adhesion_coverage(scene.ground_normal(col, row), facing(col, row), amount, coverage);
+      result.coverage(col, row) = static_cast<float>(std::max(thin_coverage(d, coverage), stuck));
+    }
+  });
+}
+
+// One mesh of all objects, raised by their snow (paper 2.3(4)), relative to
+// a whole-metre origin, with the per-vertex attributes of SnowfallResult.
+void write_snowy_objects(const SnowScene& scene, const std::vector<ObjectSnow>& object_snow,
+                         const CoverageOptions& coverage, SnowfallResult& result) {
+  result.mesh_origin =
+      Eigen::Vector3d(std::round(scene.origin.x()), std::round(scene.origin.y()), 0.0);
+  const Eigen::Vector3d shift = scene.origin - result.mesh_origin;
+  result.objects.origin = result.mesh_origin;
+  std::vector<float> a_depth, a_prob, a_cover, a_adhesion, a_object;
+  for (std::size_t o = 0; o < scene.meshes.size(); ++o) {
+    const terrain::Mesh& m = scene.meshes[o];
+    const ObjectSnow& os = object_snow[o];
+    const int base = static_cast<int>(result.objects.positions.size());
+    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+      Eigen::Vector3d p = m.positions[i].cast<double>() + shift;
+      p.z() += os.depth[i];
+      result.objects.positions.push_back(p.cast<float>());
+      a_depth.push_back(static_cast<float>(os.depth[i]));
+      a_prob.push_back(static_cast<float>(os.probability[i]));
+      a_adhesion.push_back(static_cast<float>(os.adhesion[i]));
+      a_object.push_back(static_cast<float>(o));
+      a_cover.push_back(
+          static_cast<float>(std::max(thin_coverage(os.depth[i], coverage), os.adhesion[i])));
+    }
+    for (auto t : m.triangles)
+      result.objects.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  namespace products = terrain::products;
+  result.objects.vertex_attributes = {{products::kSnowDepth, std::move(a_depth)},
+                                      {products::kSnowProbability, std::move(a_prob)},
+                                      {products::kSnowCoverage, std::move(a_cover)},
+                                      {products::kSnowAdhesion, std::move(a_adhesion)},
+                                      {products::kObjectIndex, std::move(a_object)}};
+}
+
 }  // namespace
 
 void SnowfallOptions::validate() const {
-  check(azimuth_deg >= 0 && azimuth_deg <= 360, "azimuth", azimuth_deg, "[0, 360]");
-  check(elevation_deg > 0 && elevation_deg <= 90, "elevation", elevation_deg, "(0, 90]");
-  check(spread_deg >= 0 && spread_deg <= 30, "spread", spread_deg, "[0, 30]");
+  check(azimuth_deg >= 0 && azimuth_deg <= 360, "azimuth_deg", azimuth_deg, "[0, 360]");
+  check(elevation_deg > 0 && elevation_deg <= 90, "elevation_deg", elevation_deg, "(0, 90]");
+  check(spread_deg >= 0 && spread_deg <= 30, "spread_deg", spread_deg, "[0, 30]");
   check(maps >= 1 && maps <= 1024, "maps", maps, "[1, 1024]");
-  check(rate_m_per_h > 0 && rate_m_per_h <= 10, "rate", rate_m_per_h, "(0, 10] m/h");
+  check(rate_m_per_h > 0 && rate_m_per_h <= 10, "rate_m_per_h", rate_m_per_h, "(0, 10] m/h");
   check(hours > 0 && hours <= 1e4, "hours", hours, "(0, 10000]");
-  check(repose_deg > 0 && repose_deg < 90, "repose", repose_deg, "(0, 90)");
+  check(repose_deg > 0 && repose_deg < 90, "repose_deg", repose_deg, "(0, 90)");
   check(mesh_max_edge >= 0 && std::isfinite(mesh_max_edge), "mesh_max_edge", mesh_max_edge,
         "[0, inf) m (0 keeps the meshes)");
-  check(occlusion.object_texel >= 0 && std::isfinite(occlusion.object_texel), "object_texel",
-        occlusion.object_texel, "[0, inf) m (0 = automatic)");
-  check(coverage.thin_depth > 0 && coverage.thin_depth <= 10, "thin_depth", coverage.thin_depth,
-        "(0, 10] m");
-  check(coverage.adhesion >= 0 && coverage.adhesion <= 1, "adhesion", coverage.adhesion, "[0, 1]");
-  check(coverage.adhesion_min_slope >= 0 && coverage.adhesion_min_slope < 90, "adhesion_min_slope",
-        coverage.adhesion_min_slope, "[0, 90)");
-  check(coverage.adhesion_depth > 0, "adhesion_depth", coverage.adhesion_depth, "(0, inf) m");
+  check(occlusion.object_texel >= 0 && std::isfinite(occlusion.object_texel),
+        "occlusion.object_texel", occlusion.object_texel, "[0, inf) m (0 = automatic)");
+  check(coverage.thin_depth > 0 && coverage.thin_depth <= 10, "coverage.thin_depth",
+        coverage.thin_depth, "(0, 10] m");
+  check(coverage.adhesion >= 0 && coverage.adhesion <= 1, "coverage.adhesion", coverage.adhesion,
+        "[0, 1]");
+  check(coverage.adhesion_min_slope >= 0 && coverage.adhesion_min_slope < 90,
+        "coverage.adhesion_min_slope", coverage.adhesion_min_slope, "[0, 90)");
+  check(coverage.adhesion_depth > 0, "coverage.adhesion_depth", coverage.adhesion_depth,
+        "(0, inf) m");
   check(tolerance > 0, "tolerance", tolerance, "(0, inf) m");
   check(max_iterations >= 1, "max_iterations", max_iterations, "[1, inf)");
 }
@@ -70,69 +196,23 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
       snow_probability(scene, dirs, options.occlusion, scaled_progress(report, 0.0, 0.6));
   const double amount = options.rate_m_per_h * options.hours;  // m on open flat ground
   const double cell_area = scene.dx * scene.dy;
-  const int W = scene.ground.width(), H = scene.ground.height();
   StabiliseOptions stabilise{options.repose_deg, options.tolerance, options.max_iterations};
   SnowfallResult result;
 
   // Fresh snow on the ground (paper 2.2(2)): probability x rate x time.
-  terrain::Grid<double> snow(W, H, 0.0);
+  terrain::Grid<double> snow(scene.ground.width(), scene.ground.height(), 0.0);
   for (std::size_t i = 0; i < snow.size(); ++i)
     snow.values()[i] = static_cast<double>(prob.ground.values()[i]) * amount;
   for (double v : snow.values()) result.fallen_volume += v * cell_area;
 
   // Objects (paper 2.3): per-vertex snow from the faces, stabilised along the mesh;
   // what falls off lands on the ground cell below.
-  std::vector<ObjectSnow> object_snow(scene.meshes.size());
+  std::vector<ObjectSnow> object_snow;
   for (std::size_t o = 0; o < scene.meshes.size(); ++o) {
-    const terrain::Mesh& m = scene.meshes[o];
-    ObjectSnow& os = object_snow[o];
-    const std::vector<double> footprint = vertex_footprints(m);
-    std::vector<double> volume(m.vertex_count(), 0.0), face_count(m.vertex_count(), 0.0);
-    os.probability.assign(m.vertex_count(), 0.0);
-    os.adhesion.assign(m.vertex_count(), 0.0);
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      const auto& tri = m.triangles[t];
-      const Eigen::Vector3d p0 = m.positions[tri[0]].cast<double>();
-      const Eigen::Vector3d cross =
-          (m.positions[tri[1]].cast<double>() - p0).cross(m.positions[tri[2]].cast<double>() - p0);
-      const double horizontal = std::max(0.0, 0.5 * cross.z());
-      const Eigen::Vector3d n =
-          cross.norm() > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::UnitZ();
-      const double adhesion = adhesion_coverage(n, prob.facing[o][t], amount, options.coverage);
-      for (int k = 0; k < 3; ++k) {
-        volume[tri[k]] += horizontal / 3.0 * prob.faces[o][t] * amount;
-        os.probability[tri[k]] += prob.faces[o][t];
-        os.adhesion[tri[k]] += adhesion;
-        face_count[tri[k]] += 1.0;
-      }
-    }
-    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
-      os.fallen += volume[i];
-      if (face_count[i] > 0) os.adhesion[i] /= face_count[i];
-      // Paper 2.3(2): a vertex's probability is the mean of its faces'; where the
-      // vertex holds snow, weighted by the footprint each face gives it.
-      os.probability[i] = footprint[i] > 0    ? volume[i] / (footprint[i] * amount)
-                          : face_count[i] > 0 ? os.probability[i] / face_count[i]
-                                              : 0.0;
-    }
+    ObjectSnow& os = object_snow.emplace_back(
+        fall_on_object(scene.meshes[o], prob.faces[o], prob.facing[o], amount, options.coverage));
     result.fallen_volume += os.fallen;
-    const MeshStabiliseReport r = stabilise_mesh(m, footprint, volume, stabilise);
-    result.object_iterations = std::max(result.object_iterations, r.iterations);
-    result.converged = result.converged && r.converged;
-    os.depth.assign(m.vertex_count(), 0.0);
-    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
-      if (footprint[i] > 0) os.depth[i] = volume[i] / footprint[i];
-      os.kept += volume[i];
-      if (r.shed[i] <= 0) continue;
-      result.shed_volume += r.shed[i];
-      const int col = static_cast<int>(std::lround(scene.col_of(m.positions[i].x())));
-      const int row = static_cast<int>(std::lround(scene.row_of(m.positions[i].y())));
-      if (col < 0 || row < 0 || col >= W || row >= H) {
-        result.lost_volume += r.shed[i];
-      } else {
-        snow(col, row) += r.shed[i] / cell_area;
-      }
-    }
+    settle_object(scene, scene.meshes[o], stabilise, os, snow, result);
     result.object_volume += os.kept;
   }
   if (!report(0.65, "snow on objects")) throw Cancelled();
@@ -144,53 +224,8 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   result.converged = result.converged && gr.converged;
   for (double v : snow.values()) result.ground_volume += v * cell_area;
 
-  // Rasters: depth and coverage, NaN where the ground had no data.
-  result.depth = terrain::HeightField(W, H, 0.0f, ground.geo());
-  result.coverage = terrain::HeightField(W, H, 0.0f, ground.geo());
-  tbb::parallel_for(0, H, [&](int row) {
-    for (int col = 0; col < W; ++col) {
-      if (std::isnan(ground(col, row))) {
-        result.depth(col, row) = result.coverage(col, row) = std::nanf("");
-        continue;
-      }
-      const double d = snow(col, row);
-      result.depth(col, row) = static_cast<float>(std::max(d, 0.0));  // -1e-16 from rounding
-      const double stuck = adhesion_coverage(
-          scene.ground_normal(col, row), prob.ground_facing(col, row), amount, options.coverage);
-      result.coverage(col, row) =
-          static_cast<float>(std::max(thin_coverage(d, options.coverage), stuck));
-    }
-  });
-
-  // One mesh of all objects, raised by their snow, relative to a whole-metre origin.
-  result.mesh_origin =
-      Eigen::Vector3d(std::round(scene.origin.x()), std::round(scene.origin.y()), 0.0);
-  const Eigen::Vector3d shift = scene.origin - result.mesh_origin;
-  result.objects.origin = result.mesh_origin;
-  std::vector<float> a_depth, a_prob, a_cover, a_adhesion, a_object;
-  for (std::size_t o = 0; o < scene.meshes.size(); ++o) {
-    const terrain::Mesh& m = scene.meshes[o];
-    const ObjectSnow& os = object_snow[o];
-    const int base = static_cast<int>(result.objects.positions.size());
-    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
-      Eigen::Vector3d p = m.positions[i].cast<double>() + shift;
-      p.z() += os.depth[i];  // paper 2.3(4): vertices raised by their snow
-      result.objects.positions.push_back(p.cast<float>());
-      a_depth.push_back(static_cast<float>(os.depth[i]));
-      a_prob.push_back(static_cast<float>(os.probability[i]));
-      a_adhesion.push_back(static_cast<float>(os.adhesion[i]));
-      a_object.push_back(static_cast<float>(o));
-      a_cover.push_back(static_cast<float>(
-          std::max(thin_coverage(os.depth[i], options.coverage), os.adhesion[i])));
-    }
-    for (auto t : m.triangles)
-      result.objects.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-  }
-  result.objects.vertex_attributes = {{"snow_depth", std::move(a_depth)},
-                                      {"snow_probability", std::move(a_prob)},
-                                      {"snow_coverage", std::move(a_cover)},
-                                      {"snow_adhesion", std::move(a_adhesion)},
-                                      {"object", std::move(a_object)}};
+  write_ground_rasters(ground, scene, snow, prob.ground_facing, amount, options.coverage, result);
+  write_snowy_objects(scene, object_snow, options.coverage, result);
   report(1.0, "snowfall");
   return result;
 }

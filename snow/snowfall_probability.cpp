@@ -133,33 +133,204 @@ std::array<Vector3d, 4> face_samples(const Vector3d& a, const Vector3d& b, const
   return {g, (a + 2 * g) / 3.0, (b + 2 * g) / 3.0, (c + 2 * g) / 3.0};
 }
 
+// Each object's bounding box and unit face normals (zero for a degenerate face).
+struct ObjectGeometry {
+  std::vector<Box> boxes;
+  std::vector<std::vector<Vector3d>> face_normals;
+};
+
+ObjectGeometry object_geometry(const SnowScene& scene) {
+  ObjectGeometry g;
+  for (const terrain::Mesh& m : scene.meshes) {
+    g.boxes.push_back(mesh_box(m));
+    std::vector<Vector3d>& normals = g.face_normals.emplace_back(m.triangle_count());
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      const auto& tri = m.triangles[t];
+      const Vector3d a = m.positions[tri[0]].cast<double>(), b = m.positions[tri[1]].cast<double>(),
+                     c = m.positions[tri[2]].cast<double>();
+      const Vector3d n = (b - a).cross(c - a);
+      normals[t] = n.norm() > 0 ? Vector3d(n.normalized()) : Vector3d::Zero();
+    }
+  }
+  return g;
+}
+
+// What the objects hide from one direction: a depth map around each object,
+// holding every object that overlaps it.
+struct ObjectMaps {
+  LightFrame frame;
+  std::vector<DepthMap> maps;
+  std::vector<Rect> rects;  // each object's light-space bounds
+  double finest = 0.0;      // the finest texel of any map (or the ground cell)
+
+  bool lit(const Vector3d& p, const Vector3d& n) const {
+    const Vector3d q = frame.project(p);
+    for (const DepthMap& m : maps)
+      if (m.contains(q.x(), q.y()) && !m.lit(p, n)) return false;
+    return true;
+  }
+};
+
+ObjectMaps object_maps(const SnowScene& scene, const std::vector<Box>& boxes,
+                       const LightFrame& frame, const ProbabilityOptions& options, double cell,
+                       OsmesaDepthRenderer* renderer) {
+  const std::size_t n = boxes.size();
+  ObjectMaps out{frame, std::vector<DepthMap>(n), std::vector<Rect>(n), cell};
+  for (std::size_t o = 0; o < n; ++o) out.rects[o] = project_box(frame, boxes[o]);
+  for (std::size_t o = 0; o < n; ++o) {
+    const Rect& r = out.rects[o];
+    const double extent = std::max({r.a_hi - r.a_lo, r.b_hi - r.b_lo, 1e-3});
+    const double texel =
+        options.object_texel > 0 ? options.object_texel : std::min(0.5 * cell, extent / 1024.0);
+    out.maps[o].frame = frame;
+    frame_map(out.maps[o], r, texel);
+    out.finest = std::min(out.finest, out.maps[o].texel);
+    std::vector<const terrain::Mesh*> drawn;
+    double c_lo = r.c_lo, c_hi = r.c_hi;
+    for (std::size_t q = 0; q < n; ++q) {
+      if (!out.rects[q].overlaps(r)) continue;
+      drawn.push_back(&scene.meshes[q]);
+      c_lo = std::min(c_lo, out.rects[q].c_lo), c_hi = std::max(c_hi, out.rects[q].c_hi);
+    }
+    renderer->render(out.maps[o], c_lo, c_hi, drawn, nullptr);
+  }
+  return out;
+}
+
+// Ground cells that objects may shade from direction w (sampled K x K): those
+// under an object's shadow volume whose centres project into its map.
+terrain::Grid<unsigned char> cells_near_objects(const SnowScene& scene,
+                                                const std::vector<Box>& boxes, const Vector3d& w,
+                                                const ObjectMaps& objects) {
+  const int W = scene.ground.width(), H = scene.ground.height();
+  terrain::Grid<unsigned char> near_object(W, H, 0);
+  for (std::size_t o = 0; o < boxes.size(); ++o) {
+    const Box& b = boxes[o];
+    const double t_max = std::max(0.0, (b.hi.z() - scene.ground_lo) / w.z());
+    const double x_lo = std::min(b.lo.x(), b.lo.x() - t_max * w.x());
+    const double x_hi = std::max(b.hi.x(), b.hi.x() - t_max * w.x());
+    const double y_lo = std::min(b.lo.y(), b.lo.y() - t_max * w.y());
+    const double y_hi = std::max(b.hi.y(), b.hi.y() - t_max * w.y());
+    const int c0 = std::max(0, static_cast<int>(std::floor(scene.col_of(x_lo))) - 1);
+    const int c1 = std::min(W - 1, static_cast<int>(std::ceil(scene.col_of(x_hi))) + 1);
+    const int r0 = std::max(0, static_cast<int>(std::floor(scene.row_of(y_hi))) - 1);
+    const int r1 = std::min(H - 1, static_cast<int>(std::ceil(scene.row_of(y_lo))) + 1);
+    const double margin = std::hypot(scene.dx, scene.dy) + 2 * objects.maps[o].texel;
+    const Rect& r = objects.rects[o];
+    for (int row = r0; row <= r1; ++row)
+      for (int col = c0; col <= c1; ++col) {
+        const Vector3d q = objects.frame.project(scene.cell_point(col, row));
+        if (q.x() >= r.a_lo - margin && q.x() <= r.a_hi + margin && q.y() >= r.b_lo - margin &&
+            q.y() <= r.b_hi + margin)
+          near_object(col, row) = 1;
+      }
+  }
+  return near_object;
+}
+
+// The lit share of a cell near objects, from K x K points over it (the centre
+// by the terrain's own test), and its n . w in `cos_phi`.
+float cell_lit_share(const SnowScene& scene, const TerrainOccluder& occluder,
+                     const ObjectMaps& objects, const Vector3d& w, int K, int col, int row,
+                     double& cos_phi) {
+  const int W = scene.ground.width(), H = scene.ground.height();
+  const Vector3d n = scene.ground_normal(col, row);
+  cos_phi = n.dot(w);
+  int count = 0;
+  for (int j = 0; j < K; ++j)
+    for (int i = 0; i < K; ++i) {
+      const double c = std::clamp(col + (i + 0.5) / K - 0.5, 0.0, W - 1.0);
+      const double r = std::clamp(row + (j + 0.5) / K - 0.5, 0.0, H - 1.0);
+      const Vector3d p(scene.x0 + c * scene.dx, scene.y0 - r * scene.dy,
+                       terrain::bilinear_clamped(scene.ground, c, r));
+      const bool seen = (i * 2 + 1 == K && j * 2 + 1 == K)
+                            ? occluder.cell_lit(col, row, cos_phi)
+                            : cos_phi > 0 && occluder.point_lit(p, n);
+      count += seen && objects.lit(p, n);
+    }
+  return static_cast<float>(count) / static_cast<float>(K * K);
+}
+
+// Adds one direction's weighted lit share (and lit share x n . w) of every
+// ground cell to `acc` (and `acc_facing`).
+void accumulate_ground(const SnowScene& scene, const TerrainOccluder& occluder,
+                       const ObjectMaps& objects, const terrain::Grid<unsigned char>& near_object,
+                       const Vector3d& w, float weight, int K, terrain::Grid<float>& acc,
+                       terrain::Grid<float>& acc_facing) {
+  const int W = scene.ground.width(), H = scene.ground.height();
+  auto one_cell = [&](int col, int row) {
+    double cos_phi;
+    float lit;
+    if (!near_object(col, row)) {
+      cos_phi = scene.ground_normal(col, row).dot(w);
+      lit = occluder.cell_lit(col, row, cos_phi) ? 1.0f : 0.0f;
+    } else {
+      lit = cell_lit_share(scene, occluder, objects, w, K, col, row, cos_phi);
+    }
+    acc(col, row) += weight * lit;
+    acc_facing(col, row) += weight * lit * static_cast<float>(std::max(0.0, cos_phi));
+  };
+  // Cells in 64 x 64 blocks: a transposed shadow surface reads well within a block.
+  constexpr int B = 64;
+  tbb::parallel_for(tbb::blocked_range2d<int>(0, (H + B - 1) / B, 0, (W + B - 1) / B),
+                    [&](const tbb::blocked_range2d<int>& blocks) {
+                      for (int by = blocks.rows().begin(); by < blocks.rows().end(); ++by)
+                        for (int bx = blocks.cols().begin(); bx < blocks.cols().end(); ++bx)
+                          for (int row = by * B; row < std::min(H, (by + 1) * B); ++row)
+                            for (int col = bx * B; col < std::min(W, (bx + 1) * B); ++col)
+                              one_cell(col, row);
+                    });
+}
+
+// Adds one direction's weighted lit share of every object face (4 samples).
+void accumulate_faces(const SnowScene& scene, const ObjectGeometry& geometry,
+                      const TerrainOccluder& occluder, const ObjectMaps& objects, const Vector3d& w,
+                      float weight, SnowProbability& out) {
+  for (std::size_t o = 0; o < scene.meshes.size(); ++o) {
+    const terrain::Mesh& m = scene.meshes[o];
+    tbb::parallel_for(std::size_t{0}, m.triangle_count(), [&](std::size_t t) {
+      const Vector3d& n = geometry.face_normals[o][t];
+      const double facing = n.dot(w);
+      if (facing <= 0.0) return;
+      const auto& tri = m.triangles[t];
+      int count = 0;
+      for (const Vector3d& p :
+           face_samples(m.positions[tri[0]].cast<double>(), m.positions[tri[1]].cast<double>(),
+                        m.positions[tri[2]].cast<double>()))
+        count += occluder.point_lit(p, n) && objects.lit(p, n);
+      const float lit = static_cast<float>(count) / 4.0f;
+      out.faces[o][t] += weight * lit;
+      out.facing[o][t] += weight * lit * static_cast<float>(facing);
+    });
+  }
+}
+
+// Divides every sum by the same float sum of weights: a point lit in every
+// map gets exactly 1.
+void normalise(SnowProbability& out, float total_weight) {
+  for (auto* g : {&out.ground, &out.ground_facing})
+    for (float& v : g->values()) v /= total_weight;
+  for (std::size_t o = 0; o < out.faces.size(); ++o) {
+    for (float& v : out.faces[o]) v /= total_weight;
+    for (float& v : out.facing[o]) v /= total_weight;
+  }
+}
+
 }  // namespace
 
 SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallDirection>& dirs,
                                  const ProbabilityOptions& options, const ProgressFn& progress) {
   const int W = scene.ground.width(), H = scene.ground.height();
   SnowProbability out;
-  terrain::Grid<float> acc(W, H, 0.0f), acc_facing(W, H, 0.0f);
-  const std::size_t n_objects = scene.meshes.size();
-  std::vector<std::vector<float>> face_acc(n_objects), face_facing(n_objects);
-  std::vector<Box> boxes;
-  std::vector<std::vector<Vector3d>> face_normals(n_objects);
-  for (std::size_t o = 0; o < n_objects; ++o) {
-    const terrain::Mesh& m = scene.meshes[o];
-    boxes.push_back(mesh_box(m));
-    face_acc[o].assign(m.triangle_count(), 0.0f);
-    face_facing[o].assign(m.triangle_count(), 0.0f);
-    face_normals[o].resize(m.triangle_count());
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      const auto& tri = m.triangles[t];
-      const Vector3d a = m.positions[tri[0]].cast<double>(), b = m.positions[tri[1]].cast<double>(),
-                     c = m.positions[tri[2]].cast<double>();
-      const Vector3d n = (b - a).cross(c - a);
-      face_normals[o][t] = n.norm() > 0 ? Vector3d(n.normalized()) : Vector3d::Zero();
-    }
+  out.ground = terrain::Grid<float>(W, H, 0.0f);
+  out.ground_facing = terrain::Grid<float>(W, H, 0.0f);
+  for (const terrain::Mesh& m : scene.meshes) {
+    out.faces.emplace_back(m.triangle_count(), 0.0f);
+    out.facing.emplace_back(m.triangle_count(), 0.0f);
   }
+  const ObjectGeometry geometry = object_geometry(scene);
   std::unique_ptr<OsmesaDepthRenderer> renderer;
-  if (n_objects > 0 || options.terrain == TerrainOcclusion::OpenGL)
+  if (!scene.meshes.empty() || options.terrain == TerrainOcclusion::OpenGL)
     renderer = std::make_unique<OsmesaDepthRenderer>();
   const double cell = std::min(scene.dx, scene.dy);
   HorizonSweeper sweeper(scene.ground, scene.dx, scene.dy);
@@ -170,130 +341,20 @@ SnowProbability snow_probability(const SnowScene& scene, const std::vector<FallD
     const Vector3d w = dirs[k].toward_source;
     const float weight = dirs[k].weight;
     total_weight += weight;
-    const LightFrame frame = LightFrame::toward(w);
-    const TerrainOccluder terrain_occluder(scene, w, options.terrain, renderer.get(), sweeper);
-
-    // Object maps: one around each object, holding every object that overlaps it.
-    std::vector<DepthMap> maps(n_objects);
-    std::vector<Rect> rects(n_objects);
-    for (std::size_t o = 0; o < n_objects; ++o) rects[o] = project_box(frame, boxes[o]);
-    double finest = cell;
-    for (std::size_t o = 0; o < n_objects; ++o) {
-      const Rect& r = rects[o];
-      const double extent = std::max({r.a_hi - r.a_lo, r.b_hi - r.b_lo, 1e-3});
-      const double texel =
-          options.object_texel > 0 ? options.object_texel : std::min(0.5 * cell, extent / 1024.0);
-      maps[o].frame = frame;
-      frame_map(maps[o], r, texel);
-      finest = std::min(finest, maps[o].texel);
-      std::vector<const terrain::Mesh*> drawn;
-      double c_lo = r.c_lo, c_hi = r.c_hi;
-      for (std::size_t q = 0; q < n_objects; ++q) {
-        if (!rects[q].overlaps(r)) continue;
-        drawn.push_back(&scene.meshes[q]);
-        c_lo = std::min(c_lo, rects[q].c_lo), c_hi = std::max(c_hi, rects[q].c_hi);
-      }
-      renderer->render(maps[o], c_lo, c_hi, drawn, nullptr);
-    }
-    auto objects_lit = [&](const Vector3d& p, const Vector3d& n) {
-      const Vector3d q = frame.project(p);
-      for (const DepthMap& m : maps)
-        if (m.contains(q.x(), q.y()) && !m.lit(p, n)) return false;
-      return true;
-    };
-
-    // Ground cells that objects may shade: sampled K x K.
-    terrain::Grid<unsigned char> near_object(W, H, 0);
-    for (std::size_t o = 0; o < n_objects; ++o) {
-      const Box& b = boxes[o];
-      const double t_max = std::max(0.0, (b.hi.z() - scene.ground_lo) / w.z());
-      const double x_lo = std::min(b.lo.x(), b.lo.x() - t_max * w.x());
-      const double x_hi = std::max(b.hi.x(), b.hi.x() - t_max * w.x());
-      const double y_lo = std::min(b.lo.y(), b.lo.y() - t_max * w.y());
-      const double y_hi = std::max(b.hi.y(), b.hi.y() - t_max * w.y());
-      const int c0 = std::max(0, static_cast<int>(std::floor(scene.col_of(x_lo))) - 1);
-      const int c1 = std::min(W - 1, static_cast<int>(std::ceil(scene.col_of(x_hi))) + 1);
-      const int r0 = std::max(0, static_cast<int>(std::floor(scene.row_of(y_hi))) - 1);
-      const int r1 = std::min(H - 1, static_cast<int>(std::ceil(scene.row_of(y_lo))) + 1);
-      const double margin = std::hypot(scene.dx, scene.dy) + 2 * maps[o].texel;
-      const Rect& r = rects[o];
-      for (int row = r0; row <= r1; ++row)
-        for (int col = c0; col <= c1; ++col) {
-          const Vector3d q = frame.project(scene.cell_point(col, row));
-          if (q.x() >= r.a_lo - margin && q.x() <= r.a_hi + margin && q.y() >= r.b_lo - margin &&
-              q.y() <= r.b_hi + margin)
-            near_object(col, row) = 1;
-        }
-    }
-    const int K = options.ground_samples > 0
-                      ? std::clamp(options.ground_samples, 1, 16)
-                      : std::clamp(static_cast<int>(std::ceil(cell / (2.0 * finest))), 1, 8);
-
-    // Cells in 64 x 64 blocks: a transposed shadow surface reads well within a block.
-    constexpr int B = 64;
-    tbb::parallel_for(
-        tbb::blocked_range2d<int>(0, (H + B - 1) / B, 0, (W + B - 1) / B),
-        [&](const tbb::blocked_range2d<int>& blocks) {
-          for (int by = blocks.rows().begin(); by < blocks.rows().end(); ++by)
-            for (int bx = blocks.cols().begin(); bx < blocks.cols().end(); ++bx)
-              for (int row = by * B; row < std::min(H, (by + 1) * B); ++row)
-                for (int col = bx * B; col < std::min(W, (bx + 1) * B); ++col) {
-                  float lit = 0.0f;
-                  double cos_phi;
-                  if (!near_object(col, row)) {
-                    cos_phi = scene.ground_normal(col, row).dot(w);
-                    lit = terrain_occluder.cell_lit(col, row, cos_phi) ? 1.0f : 0.0f;
-                  } else {
-                    const Vector3d n = scene.ground_normal(col, row);
-                    cos_phi = n.dot(w);
-                    int count = 0;
-                    for (int j = 0; j < K; ++j)
-                      for (int i = 0; i < K; ++i) {
-                        const double c = std::clamp(col + (i + 0.5) / K - 0.5, 0.0, W - 1.0);
-                        const double r = std::clamp(row + (j + 0.5) / K - 0.5, 0.0, H - 1.0);
-                        const Vector3d p(scene.x0 + c * scene.dx, scene.y0 - r * scene.dy,
-                                         terrain::bilinear_clamped(scene.ground, c, r));
-                        const bool seen = (i * 2 + 1 == K && j * 2 + 1 == K)
-                                              ? terrain_occluder.cell_lit(col, row, cos_phi)
-                                              : cos_phi > 0 && terrain_occluder.point_lit(p, n);
-                        count += seen && objects_lit(p, n);
-                      }
-                    lit = static_cast<float>(count) / static_cast<float>(K * K);
-                  }
-                  acc(col, row) += weight * lit;
-                  acc_facing(col, row) += weight * lit * static_cast<float>(std::max(0.0, cos_phi));
-                }
-        });
-
-    for (std::size_t o = 0; o < n_objects; ++o) {
-      const terrain::Mesh& m = scene.meshes[o];
-      tbb::parallel_for(std::size_t{0}, m.triangle_count(), [&](std::size_t t) {
-        const Vector3d& n = face_normals[o][t];
-        const double facing = n.dot(w);
-        if (facing <= 0.0) return;
-        const auto& tri = m.triangles[t];
-        int count = 0;
-        for (const Vector3d& p :
-             face_samples(m.positions[tri[0]].cast<double>(), m.positions[tri[1]].cast<double>(),
-                          m.positions[tri[2]].cast<double>()))
-          count += terrain_occluder.point_lit(p, n) && objects_lit(p, n);
-        const float lit = static_cast<float>(count) / 4.0f;
-        face_acc[o][t] += weight * lit;
-        face_facing[o][t] += weight * lit * static_cast<float>(facing);
-      });
-    }
+    const TerrainOccluder occluder(scene, w, options.terrain, renderer.get(), sweeper);
+    const ObjectMaps objects =
+        object_maps(scene, geometry.boxes, LightFrame::toward(w), options, cell, renderer.get());
+    const terrain::Grid<unsigned char> near_object =
+        cells_near_objects(scene, geometry.boxes, w, objects);
+    const int K =
+        options.ground_samples > 0
+            ? std::clamp(options.ground_samples, 1, 16)
+            : std::clamp(static_cast<int>(std::ceil(cell / (2.0 * objects.finest))), 1, 8);
+    accumulate_ground(scene, occluder, objects, near_object, w, weight, K, out.ground,
+                      out.ground_facing);
+    accumulate_faces(scene, geometry, occluder, objects, w, weight, out);
   }
-  // Normalise by the same float sum of weights: a point lit in every map gets exactly 1.
-  for (auto* g : {&acc, &acc_facing})
-    for (float& v : g->values()) v /= total_weight;
-  for (std::size_t o = 0; o < n_objects; ++o) {
-    for (float& v : face_acc[o]) v /= total_weight;
-    for (float& v : face_facing[o]) v /= total_weight;
-  }
-  out.ground = std::move(acc);
-  out.ground_facing = std::move(acc_facing);
-  out.faces = std::move(face_acc);
-  out.facing = std::move(face_facing);
+  normalise(out, total_weight);
   progress(1.0, "snowfall depth maps");
   return out;
 }

@@ -1,7 +1,7 @@
 // Counter-based randomness: every random value is a pure function of a seed
 // and the counters that name it (cell, pixel, sample, step, dimension), so
 // results do not depend on the thread count, the tile split or the order of
-// work (docs/DESIGN.md, "Randomness"). Every module draws from these.
+// work. Every module draws from these.
 #pragma once
 
 #include <cstdint>

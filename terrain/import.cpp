@@ -11,6 +11,7 @@
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
+#include "terrain/parameter.h"
 #include "terrain/raster_io.h"
 
 namespace drift::terrain {
@@ -89,65 +90,70 @@ std::size_t fill_nodata(HeightField& g, const std::string& what) {
   return filled;
 }
 
-ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
-  if (o.crop && o.crop_lonlat) throw Error("give --crop or --crop-lonlat, not both");
-  if (o.resample_m && !(*o.resample_m > 0 && std::isfinite(*o.resample_m))) {
-    throw Error("--resample must be a positive cell size in metres");
-  }
-  if (!(o.exaggeration > 0 && o.exaggeration <= 100)) {
-    throw Error("--exaggerate must lie in (0, 100], got " + fmt(o.exaggeration));
-  }
-  const RasterHeader header = read_raster_header(path);  // clear errors for bad files
-  ImportResult result;
-  result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
-                          std::to_string(header.width) + " x " + std::to_string(header.height));
+namespace {
 
+// gdalwarp's arguments for an import and what they amount to.
+struct WarpPlan {
+  std::vector<std::string> args;
+  double cell = 0.0;  // output cell size (metres, or degrees with keep_crs)
+  bool has_crs = false, reproject = false, geographic = false;
+};
+
+// The target CRS and cell size: a geographic DEM goes to the UTM zone of its
+// centre at about its finest metric spacing, unless keep_crs.
+void plan_grid(const RasterHeader& header, const ImportOptions& o, WarpPlan& plan,
+               std::vector<std::string>& report) {
   OGRSpatialReference srs;
-  const bool has_crs =
+  plan.has_crs =
       !header.geo.crs_wkt.empty() && srs.importFromWkt(header.geo.crs_wkt.c_str()) == OGRERR_NONE;
-  const bool geographic = has_crs && srs.IsGeographic();
-  const bool reproject = geographic && !o.keep_crs;
-
-  std::vector<std::string> args = {"-of",      "GTiff",      "-ot", "Float32",   "-r",
-                                   "bilinear", "-dstnodata", "nan", "-overwrite"};
-  double cell = 0.0;
-  if (reproject) {
+  plan.geographic = plan.has_crs && srs.IsGeographic();
+  plan.reproject = plan.geographic && !o.keep_crs;
+  if (plan.reproject) {
     const auto lonlat = centre_lonlat(header.geo, header.width, header.height);
     const int epsg = utm_epsg(lonlat[0], lonlat[1]);
     // Square cells near the source's finest metric spacing.
     const auto metric = cell_size_metres(header.geo, header.width, header.height);
     const double cx = metric[0], cy = metric[1];
-    cell = std::round(std::min(cx, cy) * 100.0) / 100.0;
-    args.insert(args.end(), {"-t_srs", "EPSG:" + std::to_string(epsg)});
-    result.report.push_back("reprojected " + std::string(srs.GetName() ? srs.GetName() : "?") +
-                            " -> EPSG:" + std::to_string(epsg) + " (UTM zone " +
-                            std::to_string(epsg % 100) + (epsg < 32700 ? "N" : "S") +
-                            "), source cells " + fmt(std::round(cx * 100) / 100) + " x " +
-                            fmt(std::round(cy * 100) / 100) + " m");
+    plan.cell = std::round(std::min(cx, cy) * 100.0) / 100.0;
+    plan.args.insert(plan.args.end(), {"-t_srs", "EPSG:" + std::to_string(epsg)});
+    report.push_back("reprojected " + std::string(srs.GetName() ? srs.GetName() : "?") +
+                     " -> EPSG:" + std::to_string(epsg) + " (UTM zone " +
+                     std::to_string(epsg % 100) + (epsg < 32700 ? "N" : "S") + "), source cells " +
+                     fmt(std::round(cx * 100) / 100) + " x " + fmt(std::round(cy * 100) / 100) +
+                     " m");
   } else {
-    cell = std::fabs(header.geo.cell_size_x());
-    if (geographic)
-      result.report.push_back("kept the geographic CRS (--keep-crs): cells are degrees");
+    plan.cell = std::fabs(header.geo.cell_size_x());
+    if (plan.geographic)
+      report.push_back("kept the geographic CRS (--keep-crs): cells are degrees");
   }
-  if (o.resample_m) cell = *o.resample_m;
-  if (!(cell > 0)) throw Error("'" + path.string() + "' has no usable cell size");
-  args.insert(args.end(), {"-tr", fmt(cell), fmt(cell)});
+}
+
+// The whole warp: CRS, cell size and crop box.
+WarpPlan plan_warp(const fs::path& path, const RasterHeader& header, const ImportOptions& o,
+                   std::vector<std::string>& report) {
+  WarpPlan plan;
+  plan.args = {"-of",      "GTiff",      "-ot", "Float32",   "-r",
+               "bilinear", "-dstnodata", "nan", "-overwrite"};
+  plan_grid(header, o, plan, report);
+  if (o.resample_m) plan.cell = *o.resample_m;
+  if (!(plan.cell > 0)) throw Error("'" + path.string() + "' has no usable cell size");
+  plan.args.insert(plan.args.end(), {"-tr", fmt(plan.cell), fmt(plan.cell)});
   if (o.crop) {
     const auto& b = *o.crop;
-    args.insert(args.end(), {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3])});
-    if (has_crs) args.insert(args.end(), {"-te_srs", header.geo.crs_wkt});
+    plan.args.insert(plan.args.end(), {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3])});
+    if (plan.has_crs) plan.args.insert(plan.args.end(), {"-te_srs", header.geo.crs_wkt});
   } else if (o.crop_lonlat) {
     const auto& b = *o.crop_lonlat;
-    if (!(b[0] < b[2] && b[1] < b[3])) throw Error("--crop-lonlat needs W < E and S < N");
-    args.insert(args.end(),
-                {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3]), "-te_srs", "EPSG:4326"});
+    plan.args.insert(plan.args.end(),
+                     {"-te", fmt(b[0]), fmt(b[1]), fmt(b[2]), fmt(b[3]), "-te_srs", "EPSG:4326"});
   }
-  // The warped grid covers at most about the source's area at `cell`: check it fits.
-  const double src_area_cells = static_cast<double>(header.width) * header.height;
-  require_memory(static_cast<std::uint64_t>(src_area_cells * 4.0 * 6.0),
-                 "importing '" + path.string() + "'", "crop it with --crop-lonlat first");
+  return plan;
+}
 
+// Runs the warp into a temporary GeoTIFF and reads it back.
+HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const ImportOptions& o) {
   ensure_gdal();
+  std::vector<std::string> args = plan.args;
   std::vector<char*> argv;
   argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
@@ -169,8 +175,9 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
                 (o.crop || o.crop_lonlat ? " (does the crop box overlap the DEM?)" : ""));
   }
   GDALClose(dst);
+  HeightField grid;
   try {
-    result.grid = read_raster(temp);
+    grid = read_raster(temp);
   } catch (...) {
     std::error_code ec;
     fs::remove(temp, ec);
@@ -178,9 +185,41 @@ ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   }
   std::error_code ec;
   fs::remove(temp, ec);
+  return grid;
+}
+
+}  // namespace
+
+void ImportOptions::validate() const {
+  if (crop && crop_lonlat)
+    throw ParameterError("crop_lonlat", "and crop are both given; give one, not both");
+  if (resample_m) {
+    require_field(*resample_m > 0 && std::isfinite(*resample_m), "resample_m", *resample_m,
+                  "(0, inf) m, a cell size");
+  }
+  require_field(exaggeration > 0 && exaggeration <= 100, "exaggeration", exaggeration, "(0, 100]");
+  if (crop_lonlat) {
+    const auto& b = *crop_lonlat;
+    if (!(b[0] < b[2] && b[1] < b[3]))
+      throw ParameterError("crop_lonlat", "needs west < east and south < north");
+  }
+}
+
+ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
+  o.validate();
+  const RasterHeader header = read_raster_header(path);  // clear errors for bad files
+  ImportResult result;
+  result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
+                          std::to_string(header.width) + " x " + std::to_string(header.height));
+  const WarpPlan plan = plan_warp(path, header, o, result.report);
+  // The warped grid covers at most about the source's area at `cell`: check it fits.
+  const double src_area_cells = static_cast<double>(header.width) * header.height;
+  require_memory(static_cast<std::uint64_t>(src_area_cells * 4.0 * 6.0),
+                 "importing '" + path.string() + "'", "crop it first (a lon/lat crop box)");
+  result.grid = warp_to_grid(path, plan, o);
   result.report.push_back("grid " + std::to_string(result.grid.width()) + " x " +
-                          std::to_string(result.grid.height()) + " cells of " + fmt(cell) +
-                          (reproject || !geographic ? " m" : " deg"));
+                          std::to_string(result.grid.height()) + " cells of " + fmt(plan.cell) +
+                          (plan.reproject || !plan.geographic ? " m" : " deg"));
 
   result.filled_cells = fill_nodata(result.grid, path.string());
   if (result.filled_cells > 0) {

@@ -20,6 +20,9 @@ struct ImportOptions {
   std::optional<double> resample_m;  // output cell size in metres (> 0); default: the source's
   bool keep_crs = false;             // do not reproject a geographic DEM
   double exaggeration = 1.0;         // multiply heights, (0, 100]
+
+  // Throws ParameterError (terrain/parameter.h) naming the field out of range.
+  void validate() const;
 };
 
 struct ImportResult {

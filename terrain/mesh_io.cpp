@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -139,66 +140,74 @@ std::vector<Mesh> split_by_attribute(const Mesh& mesh, const std::string& name) 
   return out;
 }
 
-Mesh read_ply(const fs::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error("cannot read mesh '" + path.string() + "': no such file");
-  auto bad = [&](const std::string& what) {
-    return Error("cannot read mesh '" + path.string() + "': " + what +
-                 " (drift reads the binary PLY files it writes; convert others to OBJ)");
-  };
-  std::string line;
-  if (!std::getline(f, line) || line != "ply") throw bad("not a PLY file");
-  Mesh mesh;
-  std::vector<std::string> properties;
+namespace {
+
+// What a PLY header declares (only what drift writes: binary little-endian,
+// float vertex properties, triangles as uchar-counted int lists).
+struct PlyHeader {
+  std::vector<std::string> properties;  // vertex properties, in order
   std::size_t vertices = 0, faces = 0;
-  std::string element;
-  while (std::getline(f, line) && line != "end_header") {
-    std::istringstream in(line);
-    std::string word;
-    in >> word;
-    if (word == "format") {
-      std::string format;
-      in >> format;
-      if (format != "binary_little_endian") throw bad("format '" + format + "'");
-    } else if (word == "comment") {
-      std::string key;
-      double x, y, z;
-      if (in >> key && key == "origin" && in >> x >> y >> z) mesh.origin = {x, y, z};
-    } else if (word == "element") {
-      in >> element;
-      std::size_t count = 0;
-      in >> count;
-      if (element == "vertex")
-        vertices = count;
-      else if (element == "face")
-        faces = count;
-      else
-        throw bad("element '" + element + "'");
-    } else if (word == "property") {
-      std::string type;
-      in >> type;
-      if (element == "vertex") {
-        std::string name;
-        in >> name;
-        if (type != "float") {
-          std::string what = "vertex property '";
-          what += name;
-          what += "' of type ";
-          what += type;
-          throw bad(what);
-        }
-        properties.push_back(name);
-      } else if (line != "property list uchar int vertex_indices") {
-        throw bad("face property '" + line + "'");
-      }
+  Eigen::Vector3d origin{0, 0, 0};  // "comment origin X Y Z"
+};
+
+using PlyError = std::function<Error(const std::string&)>;
+
+// One header line after "ply"; `element` is the element being declared.
+void read_ply_header_line(const std::string& line, std::string& element, PlyHeader& h,
+                          const PlyError& bad) {
+  std::istringstream in(line);
+  std::string word;
+  in >> word;
+  if (word == "format") {
+    std::string format;
+    in >> format;
+    if (format != "binary_little_endian") throw bad("format '" + format + "'");
+  } else if (word == "comment") {
+    std::string key;
+    double x, y, z;
+    if (in >> key && key == "origin" && in >> x >> y >> z) h.origin = {x, y, z};
+  } else if (word == "element") {
+    in >> element;
+    std::size_t count = 0;
+    in >> count;
+    if (element == "vertex")
+      h.vertices = count;
+    else if (element == "face")
+      h.faces = count;
+    else
+      throw bad("element '" + element + "'");
+  } else if (word == "property") {
+    std::string type;
+    in >> type;
+    if (element == "vertex") {
+      std::string name;
+      in >> name;
+      if (type != "float") throw bad("vertex property '" + name + "' of type " + type);
+      h.properties.push_back(name);
+    } else if (line != "property list uchar int vertex_indices") {
+      throw bad("face property '" + line + "'");
     }
   }
+}
+
+PlyHeader read_ply_header(std::istream& f, const PlyError& bad) {
+  std::string line;
+  if (!std::getline(f, line) || line != "ply") throw bad("not a PLY file");
+  PlyHeader h;
+  std::string element;
+  while (std::getline(f, line) && line != "end_header") read_ply_header_line(line, element, h, bad);
   if (line != "end_header") throw bad("no end_header");
-  if (vertices > (std::size_t{1} << 31) || faces > (std::size_t{1} << 31)) {
+  if (h.vertices > (std::size_t{1} << 31) || h.faces > (std::size_t{1} << 31)) {
     throw bad("implausible element counts");
   }
-  std::vector<float> row(properties.size());
-  std::vector<std::vector<float>> columns(properties.size(), std::vector<float>(vertices));
+  return h;
+}
+
+// The vertex rows into positions, normals and named attributes.
+void read_ply_vertices(std::istream& f, const PlyHeader& h, Mesh& mesh, const PlyError& bad) {
+  const std::size_t vertices = h.vertices;
+  std::vector<float> row(h.properties.size());
+  std::vector<std::vector<float>> columns(h.properties.size(), std::vector<float>(vertices));
   for (std::size_t v = 0; v < vertices; ++v) {
     if (!f.read(reinterpret_cast<char*>(row.data()),
                 static_cast<std::streamsize>(row.size() * sizeof(float)))) {
@@ -207,8 +216,8 @@ Mesh read_ply(const fs::path& path) {
     for (std::size_t p = 0; p < row.size(); ++p) columns[p][v] = row[p];
   }
   auto column = [&](const char* name) -> std::vector<float>* {
-    for (std::size_t p = 0; p < properties.size(); ++p)
-      if (properties[p] == name) return &columns[p];
+    for (std::size_t p = 0; p < h.properties.size(); ++p)
+      if (h.properties[p] == name) return &columns[p];
     return nullptr;
   };
   const auto *x = column("x"), *y = column("y"), *z = column("z");
@@ -220,13 +229,16 @@ Mesh read_ply(const fs::path& path) {
     mesh.normals.resize(vertices);
     for (std::size_t v = 0; v < vertices; ++v) mesh.normals[v] = {(*nx)[v], (*ny)[v], (*nz)[v]};
   }
-  for (std::size_t p = 0; p < properties.size(); ++p) {
-    const std::string& n = properties[p];
+  for (std::size_t p = 0; p < h.properties.size(); ++p) {
+    const std::string& n = h.properties[p];
     if (n != "x" && n != "y" && n != "z" && n != "nx" && n != "ny" && n != "nz")
       mesh.vertex_attributes.emplace_back(n, std::move(columns[p]));
   }
-  mesh.triangles.resize(faces);
-  for (std::size_t t = 0; t < faces; ++t) {
+}
+
+void read_ply_faces(std::istream& f, const PlyHeader& h, Mesh& mesh, const PlyError& bad) {
+  mesh.triangles.resize(h.faces);
+  for (std::size_t t = 0; t < h.faces; ++t) {
     unsigned char count = 0;
     int idx[3];
     if (!f.read(reinterpret_cast<char*>(&count), 1) || count != 3 ||
@@ -234,11 +246,27 @@ Mesh read_ply(const fs::path& path) {
       throw bad("face " + std::to_string(t) + " is not a triangle or is truncated");
     }
     for (int k = 0; k < 3; ++k) {
-      if (idx[k] < 0 || static_cast<std::size_t>(idx[k]) >= vertices)
+      if (idx[k] < 0 || static_cast<std::size_t>(idx[k]) >= h.vertices)
         throw bad("face " + std::to_string(t) + " names vertex " + std::to_string(idx[k]));
     }
     mesh.triangles[t] = {idx[0], idx[1], idx[2]};
   }
+}
+
+}  // namespace
+
+Mesh read_ply(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw Error("cannot read mesh '" + path.string() + "': no such file");
+  const PlyError bad = [&](const std::string& what) {
+    return Error("cannot read mesh '" + path.string() + "': " + what +
+                 " (drift reads the binary PLY files it writes; convert others to OBJ)");
+  };
+  const PlyHeader header = read_ply_header(f, bad);
+  Mesh mesh;
+  mesh.origin = header.origin;
+  read_ply_vertices(f, header, mesh, bad);
+  read_ply_faces(f, header, mesh, bad);
   return mesh;
 }
 

@@ -71,7 +71,7 @@ HeightField reference_sweep(const HeightField& h, float limit, int shift) {
   return out;
 }
 
-// Sizes whose rows are cut into several strips (dunes/tiles.h) and rows
+// Sizes whose rows are cut into several strips (dunes/sweep_tiles.h) and rows
 // into blocks with a short last one, with wrapped columns: the grid, and
 // wind lattices whose rows wrap shifted.
 const std::pair<int, int> kSweepSizes[] = {{37, 23}, {64, 64}, {9, 40}, {2100, 19}, {1030, 3}};

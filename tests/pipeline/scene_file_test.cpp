@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "pipeline/toml_section.h"
 #include "render/image_io.h"
 #include "render/solar_position.h"
 #include "render/surface.h"
@@ -106,6 +107,58 @@ TEST(SceneFile, OutOfRangeValuesAreErrors) {
       error_of(std::string(kTerrain) + "[camera]\nfrom = [0, 0, 1]\nto = [0, 1, 1]\nfov = 180\n")
           .find("camera.fov"),
       std::string::npos);
+}
+
+TEST(SceneFile, EveryValueErrorNamesItsLine) {
+  // Checks that read a table as a whole or two keys together keep the line.
+  const std::pair<std::string, std::string> cases[] = {
+      {"[sun]\ndate = \"2026-01-01\"\n", "s.toml:3"},
+      {"[sun]\nazimuth = 3\ndate = \"2026-01-01\"\ntime = \"10:00\"\n", "s.toml:3"},
+      {"[sky]\nmodel = \"cloudy\"\n", "s.toml:4"},
+      {"[sky]\nhaze = 2\nvisibility = 20\n", "s.toml:5"},
+      {"[camera]\nfrom = [0, 0, 1]\n", "s.toml:3"},
+      {"[camera]\nfrom = [0, 0, 1]\nto = [0, 1, 1]\nf_number = 2\n", "s.toml:6"},
+      {"[ripples]\ncell = 1\n", "s.toml:3"},
+      {"[ripples]\nraster = \"r.tif\"\nfade_slope = [30, 20]\n", "s.toml:5"},
+      {"[output]\ntone = \"aces\"\n", "s.toml:4"},
+      {"[output]\nwhite_balance = \"tungsten\"\n", "s.toml:4"},
+  };
+  for (const auto& [text, where] : cases) {
+    const std::string e = error_of(std::string(kTerrain) + text);
+    EXPECT_NE(e.find(where), std::string::npos) << text << " -> " << e;
+  }
+  const std::string e = error_of("[terrain]\nrepeat = 2\nraster = \"dem.tif\"\n");
+  EXPECT_NE(e.find("s.toml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("terrain.repeat"), std::string::npos) << e;
+}
+
+TEST(SceneFile, SeedTakesTheCommandLinesSixtyFourBitRange) {
+  const auto seed_of = [](const std::string& value) {
+    const fs::path p =
+        write_scene("seed.toml", std::string(kTerrain) + "[render]\nseed = " + value + "\n");
+    return drift::pipeline::read_scene_file(p).settings.seed;
+  };
+  EXPECT_EQ(seed_of("0"), 0u);
+  EXPECT_EQ(seed_of("4294967296"), 4294967296u);  // beyond the old 2^31 - 1
+  EXPECT_EQ(seed_of("9223372036854775807"), 9223372036854775807u);
+  EXPECT_EQ(seed_of("\"18446744073709551615\""), 18446744073709551615u);
+  for (const char* bad : {"-1", "\"18446744073709551616\"", "\"12a\"", "1.5"}) {
+    const std::string e = error_of(std::string(kTerrain) + "[render]\nseed = " + bad + "\n");
+    EXPECT_NE(e.find("render.seed"), std::string::npos) << bad << " -> " << e;
+  }
+}
+
+TEST(SceneFile, UnknownKeyNamesTheDocumentOfItsTable) {
+  drift::pipeline::Section s(nullptr, "x", "f.toml", "docs/other.md");
+  toml::table t{{"a", 1}};
+  drift::pipeline::Section with(&t, "marks", "f.toml", "docs/marks.md");
+  try {
+    with.finish();
+    FAIL() << "an unread key must be reported";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("docs/marks.md"), std::string::npos) << e.what();
+  }
+  s.finish();  // no table: nothing to report
 }
 
 TEST(SceneFile, SyntaxErrorNamesFileAndLine) {

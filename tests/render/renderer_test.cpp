@@ -13,6 +13,7 @@
 #include "render/terrain_scene.h"
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
+#include "tests/dem_fixture.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -23,11 +24,18 @@ namespace {
 // in the local georeference's coordinates (NW corner at the origin).
 template <class F>
 HeightField make_dem(int n, double cell, F f) {
-  HeightField dem(n, n, 0.0f, drift::terrain::local_georeference(cell));
-  for (int r = 0; r < n; ++r)
-    for (int x = 0; x < n; ++x)
-      dem(x, r) = static_cast<float>(f((x + 0.5) * cell, -(r + 0.5) * cell));
-  return dem;
+  return drift::testing::dem_from(n, cell, 0.5, f);
+}
+
+// Flat ground of albedo 0.5 at `height` m (64 cells of 10 m) under a black
+// constant sky: only the sun lights it.
+SceneInput flat_ground_black_sky(double height) {
+  SceneInput in;
+  in.terrain = make_dem(64, 10.0, [height](double, double) { return height; });
+  in.surface.ground.albedo = {0.5f, 0.5f, 0.5f};
+  in.sky.constant = true;
+  in.sky.intensity = 0.0f;
+  return in;
 }
 
 Camera looking_down(const TerrainScene& scene, double height) {
@@ -49,11 +57,7 @@ double mean_channel(const Image& img, int c) {
 
 TEST(Renderer, CosineLawUnderTheSun) {
   // Flat Lambertian ground, black sky, one bounce: L = albedo/pi * E * sin(elevation).
-  SceneInput in;
-  in.terrain = make_dem(64, 10.0, [](double, double) { return 100.0; });
-  in.surface.ground.albedo = {0.5f, 0.5f, 0.5f};
-  in.sky.constant = true;
-  in.sky.intensity = 0.0f;
+  SceneInput in = flat_ground_black_sky(100.0);
   in.sun.color = {1, 1, 1};
   in.sun.irradiance = 2.0;
   const TerrainScene scene(in);
@@ -215,11 +219,7 @@ TEST(Renderer, AllNodataTerrainIsAnError) {
 TEST(Renderer, MeshRoofShadowsTheGround) {
   // A 40 m square roof 20 m above flat ground, sun overhead, black sky: the
   // ground under the roof's centre is dark, open ground follows the cosine law.
-  SceneInput in;
-  in.terrain = make_dem(64, 10.0, [](double, double) { return 0.0; });
-  in.surface.ground.albedo = {0.5f, 0.5f, 0.5f};
-  in.sky.constant = true;
-  in.sky.intensity = 0.0f;
+  SceneInput in = flat_ground_black_sky(0.0);
   in.sun.elevation_deg = 90.0;
   in.sun.color = {1, 1, 1};
   in.sun.irradiance = 1.0;

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <numbers>
 
-#include "render/brdf.h"
+#include "render/oren_nayar.h"
 #include "render/renderer.h"
 #include "render/terrain_scene.h"
 #include "render/tonemap.h"

@@ -12,6 +12,7 @@
 
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
 
 using namespace drift::snow;
 using drift::terrain::HeightField;
@@ -22,11 +23,7 @@ namespace {
 // n x n cells of `cell` metres, z = f(east, north) in metres from the centre.
 template <class F>
 HeightField surface(int n, double cell, F f) {
-  HeightField dem(n, n, 0.0f, drift::terrain::local_georeference(cell));
-  for (int row = 0; row < n; ++row)
-    for (int x = 0; x < n; ++x)
-      dem(x, row) = static_cast<float>(f((x - (n - 1) / 2.0) * cell, ((n - 1) / 2.0 - row) * cell));
-  return dem;
+  return drift::testing::dem_from(n, cell, -(n - 1) / 2.0, f);
 }
 
 HeightField bowl(int n, double cell, double radius, double base = 0.0) {

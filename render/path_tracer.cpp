@@ -1,0 +1,197 @@
+#include "render/path_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "render/sampling.h"
+#include "terrain/direction.h"
+
+namespace drift::render {
+
+namespace {
+
+using Eigen::Vector3f;
+
+float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCoeff()); }
+
+}  // namespace
+
+PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const CameraRays& camera,
+                       const RenderSettings& settings)
+    : scene_(scene), input_(input), camera_(camera), settings_(settings) {
+  const Sun& sun = input.sun;
+  sun_dir_ = terrain::direction_from_az_el(sun.azimuth_deg, sun.elevation_deg).cast<float>();
+  sun_cos_max_ = static_cast<float>(std::cos(sun.angular_diameter_deg * std::numbers::pi / 360.0));
+  sun_irradiance_ = sun.color * static_cast<float>(sun.irradiance);
+  sun_up_ = sun.irradiance > 0.0 && sun_dir_.z() > -0.2f;
+
+  // The physical atmosphere, precomputed for this camera and sun.
+  if (input.sky.model == SkyModel::Physical && !input.sky.constant) {
+    AtmosphereParameters parameters;
+    parameters.aerosol_scale = input.sky.haze;
+    atmosphere_ = std::make_unique<Atmosphere>(parameters);
+    const double camera_altitude = scene.origin().z() + camera.eye.z();
+    const double reach = camera.eye.head<2>().norm() + scene.extent().norm() +
+                           scene.surround_reach();  // the ground beyond the DEM (render/surround.h)
+    air_ = std::make_unique<PhysicalSky>(*atmosphere_, camera_altitude, sun_dir_.cast<double>(),
+                                         static_cast<float>(sun.irradiance), reach);
+  }
+  base_altitude_ = static_cast<float>(scene.origin().z());
+  // Light shafts: what the terrain's shadow takes from a camera ray's air.
+  shafts_ = air_ && input.sky.light_shafts && sun_up_;
+  shadow_slab_ = {scene.bottom(), scene.top()};
+  air_reach_ = camera.eye.head<2>().norm() + scene.extent().norm() + scene.surround_reach();
+  // The sky as a light, tabulated once for this camera and sun and
+  // importance-sampled at every vertex (render/sky_sampler.h).
+  if (settings.sample_sky) sky_sampler_.emplace([this](const Vector3f& d) { return sky_light(d); });
+}
+
+PathTracer::~PathTracer() = default;
+
+Vector3f PathTracer::sky_light(const Vector3f& dir) const {
+  return air_ ? air_->sky(dir) : sky_radiance(input_.sky, dir);
+}
+
+Vector3f PathTracer::shaft_loss(const Path& path, float distance, std::uint64_t& rays) const {
+  rays += static_cast<std::uint64_t>(input_.sky.shaft_steps);
+  const auto in_shadow = [&](const Vector3f& p) { return scene_.occluded(p, sun_dir_, 1e30f); };
+  return shaft_shadow_loss(*air_, base_altitude_, {path.origin, path.dir, distance}, shadow_slab_,
+                           input_.sky.shaft_steps, path.shaft_jitter, in_shadow);
+}
+
+PathTracer::Path PathTracer::camera_path(int px, int py, SampleStream& rng) const {
+  Path path;
+  const float jx = rng.next(), jy = rng.next();
+  // Lens samples only for a thin lens, so pinhole renders keep their bits.
+  const float lu = camera_.lens_radius > 0.0f ? rng.next() : 0.0f;
+  const float lv = camera_.lens_radius > 0.0f ? rng.next() : 0.0f;
+  camera_.ray(static_cast<float>(px) + jx, static_cast<float>(py) + jy, lu, lv, path.origin,
+              path.dir);
+  path.shaft_jitter = shafts_ ? rng.next() : 0.0f;  // likewise only when used
+  // Camera rays start as wide as a pixel's angle; see RayCone.
+  path.cone = {0.0f, 2.0f * camera_.tan_half / static_cast<float>(settings_.height)};
+  return path;
+}
+
+PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& rays) const {
+  PixelSample out;
+  Path path = camera_path(px, py, rng);
+  // Vertices 0 .. max_depth - 1 are shaded; the ray leaving the last one is
+  // traced too, only to see whether it escapes to the sky, so that both
+  // strategies of the last vertex's sky light are there (PBRT's loop).
+  for (int depth = 0;; ++depth) {
+    Hit hit;
+    ++rays;
+    if (!scene_.intersect(path.origin, path.dir, hit, path.cone)) {
+      escape_to_sky(path, depth, out, rays);
+      break;
+    }
+    if (air_) cross_air(path, hit, depth, out, rays);
+    if (depth == settings_.max_depth) break;
+    if (depth == 0) {
+      out.depth = hit.distance;
+      out.normal = hit.normal;
+      out.albedo = hit.material.albedo;
+      out.coverage = hit.coverage;
+    }
+    const Vector3f wo = -path.dir;
+    const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
+    const GroundBsdf bsdf(hit.normal, wo, hit.material);
+    const float u1 = rng.next(), u2 = rng.next();
+    if (sun_up_) sample_sun(path, hit, p, bsdf, u1, u2, out, rays);
+    const float s1 = rng.next(), s2 = rng.next();
+    sample_sky(path, hit, p, bsdf, s1, s2, out, rays);
+    if (!bounce(path, hit, p, bsdf, depth, rng)) break;
+  }
+  return out;
+}
+
+void PathTracer::escape_to_sky(const Path& path, int depth, PixelSample& out,
+                               std::uint64_t& rays) const {
+  if (depth == 0) out.sky = 1.0f;
+  // An escaping bounce is the BSDF strategy's sample of the sky, weighted
+  // against the sky's own (camera rays see it as it is, less the terrain's
+  // shadow on the air with light shafts).
+  Vector3f light = sky_light(path.dir);
+  if (depth == 0 && shafts_) {
+    light -= shaft_loss(path, air_reach_, rays);
+    light = light.cwiseMax(0.0f);
+  }
+  const float w = depth > 0 && sky_sampler_
+                      ? power_heuristic(path.bounce_pdf, sky_sampler_->pdf(path.dir))
+                      : 1.0f;
+  out.radiance += path.throughput.cwiseProduct(light) * w;
+}
+
+void PathTracer::cross_air(Path& path, const Hit& hit, int depth, PixelSample& out,
+                           std::uint64_t& rays) const {
+  // The air between the ray's start and the hit: in-scattered light added,
+  // the light from behind attenuated (aerial perspective).
+  const AirSegment seg =
+      depth == 0 ? air_->from_camera(path.dir, hit.distance)
+                 : air_->segment(base_altitude_ + 0.5f * (path.origin.z() + hit.position.z()),
+                                 path.dir, hit.distance);
+  Vector3f inscatter = seg.inscatter;
+  if (depth == 0 && shafts_) {
+    inscatter -= shaft_loss(path, hit.distance, rays);
+    inscatter = inscatter.cwiseMax(0.0f);
+  }
+  out.radiance += path.throughput.cwiseProduct(inscatter);
+  path.throughput = path.throughput.cwiseProduct(seg.transmittance);
+}
+
+void PathTracer::sample_sun(const Path& path, const Hit& hit, const Vector3f& p,
+                            const GroundBsdf& bsdf, float u1, float u2, PixelSample& out,
+                            std::uint64_t& rays) const {
+  // Uniform in the sun's cone: pdf 1/solid angle, radiance E/solid angle, so
+  // the estimate is E * cos * f.
+  const Vector3f l = cone_sample(sun_dir_, sun_cos_max_, u1, u2);
+  const float cos_l = hit.normal.dot(l);
+  if (cos_l > 0.0f && l.z() > -0.2f && (++rays, !scene_.occluded(p, l, 1e30f))) {
+    const Vector3f e =
+        air_ ? air_->sun_irradiance(base_altitude_ + hit.position.z()) : sun_irradiance_;
+    out.radiance += path.throughput.cwiseProduct(bsdf.eval(l)).cwiseProduct(e) * cos_l;
+  }
+}
+
+void PathTracer::sample_sky(const Path& path, const Hit& hit, const Vector3f& p,
+                            const GroundBsdf& bsdf, float u1, float u2, PixelSample& out,
+                            std::uint64_t& rays) const {
+  // Weighted against the BSDF's sample of the same direction by the power
+  // heuristic (Veach 1997, eq. 9.13).
+  SkySampler::Sample light;
+  if (!sky_sampler_ || !sky_sampler_->sample(u1, u2, light)) return;
+  const float cos_l = hit.normal.dot(light.dir);
+  const Vector3f f = cos_l > 0.0f ? bsdf.eval(light.dir) : Vector3f::Zero();
+  if (f.maxCoeff() > 0.0f && (++rays, !scene_.occluded(p, light.dir, 1e30f))) {
+    const float w = power_heuristic(light.pdf, bsdf.pdf(light.dir));
+    out.radiance += path.throughput.cwiseProduct(f).cwiseProduct(sky_light(light.dir)) *
+                    (cos_l * w / light.pdf);
+  }
+}
+
+bool PathTracer::bounce(Path& path, const Hit& hit, const Vector3f& p, const GroundBsdf& bsdf,
+                        int depth, SampleStream& rng) const {
+  // Cosine-weighted on dry ground (weight: the albedo times the Oren-Nayar
+  // factor), the wet coat's lobe by its probability. Dry ground draws no
+  // lobe number.
+  const float u_lobe = bsdf.specular_probability() > 0.0f ? rng.next() : 0.0f;
+  const float b1 = rng.next(), b2 = rng.next();
+  GroundBsdf::Sample sample;
+  if (!bsdf.sample(u_lobe, b1, b2, sample)) return false;
+  path.bounce_pdf = sample.pdf;
+  path.dir = sample.wi;
+  path.origin = p;
+  path.throughput = path.throughput.cwiseProduct(sample.weight);
+  // A diffuse bounce spreads the footprint over about a radian.
+  path.cone = {path.cone.width + path.cone.spread * hit.distance, 1.0f};
+  if (depth >= 2) {  // Russian roulette (unbiased)
+    const float q = std::min(0.95f, path.throughput.maxCoeff());
+    if (rng.next() >= q) return false;
+    path.throughput /= q;
+  }
+  return true;
+}
+
+}  // namespace drift::render

@@ -1,0 +1,95 @@
+// The light transport of one camera sample (pbrt's Li): a unidirectional path
+// with next-event estimation of the sun and of the importance-sampled sky
+// (render/sky_sampler.h), BSDF-sampled bounces (render/bsdf.h) whose escapes to
+// the sky are weighed against the sky's samples by multiple importance sampling
+// (Veach 1997, eq. 9.13), the air between vertices (aerial perspective and
+// light shafts, render/physical_sky.h, render/light_shafts.h) and Russian
+// roulette. render_image (render/renderer.h) drives it pixel by pixel.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "render/atmosphere.h"
+#include "render/bsdf.h"
+#include "render/light_shafts.h"
+#include "render/physical_sky.h"
+#include "render/random.h"
+#include "render/render_settings.h"
+#include "render/renderer.h"
+#include "render/sky_sampler.h"
+#include "render/terrain_scene.h"
+
+namespace drift::render {
+
+// What one camera sample brings back: radiance and the first hit's AOVs.
+struct PixelSample {
+  Eigen::Vector3f radiance{0, 0, 0};
+  float depth = 0.0f;
+  Eigen::Vector3f normal{0, 0, 0};
+  Eigen::Vector3f albedo{0, 0, 0};
+  Coverage coverage{};  // by TerrainScene::coverage_names()
+  float sky = 0.0f;     // 1 where the camera sees the sky
+};
+
+class PathTracer {
+ public:
+  // The sun, the sky and the air of a frame, precomputed for this camera.
+  PathTracer(const TerrainScene& scene, const SceneInput& input, const CameraRays& camera,
+             const RenderSettings& settings);
+  ~PathTracer();
+  PathTracer(const PathTracer&) = delete;
+  PathTracer& operator=(const PathTracer&) = delete;
+
+  // One sample of pixel (px, py), drawing from `rng`; adds the rays it
+  // traced to `rays`.
+  PixelSample trace(int px, int py, SampleStream& rng, std::uint64_t& rays) const;
+
+ private:
+  // A path under way: the ray leaving its last vertex and what it carries.
+  struct Path {
+    Eigen::Vector3f origin, dir;
+    Eigen::Vector3f throughput{1, 1, 1};
+    RayCone cone;
+    float bounce_pdf = 0.0f;    // density of the BSDF sample that led here
+    float shaft_jitter = 0.0f;  // light shafts' stratum offset for the camera ray
+  };
+
+  Path camera_path(int px, int py, SampleStream& rng) const;
+  Eigen::Vector3f sky_light(const Eigen::Vector3f& dir) const;
+  Eigen::Vector3f shaft_loss(const Path& path, float distance, std::uint64_t& rays) const;
+  // The steps of trace(), each adding its light to `out`.
+  void escape_to_sky(const Path& path, int depth, PixelSample& out, std::uint64_t& rays) const;
+  void cross_air(Path& path, const Hit& hit, int depth, PixelSample& out,
+                 std::uint64_t& rays) const;
+  void sample_sun(const Path& path, const Hit& hit, const Eigen::Vector3f& p,
+                  const GroundBsdf& bsdf, float u1, float u2, PixelSample& out,
+                  std::uint64_t& rays) const;
+  void sample_sky(const Path& path, const Hit& hit, const Eigen::Vector3f& p,
+                  const GroundBsdf& bsdf, float u1, float u2, PixelSample& out,
+                  std::uint64_t& rays) const;
+  // Continues the path by the BSDF from `p`; false when it ends (absorbed or
+  // by Russian roulette).
+  bool bounce(Path& path, const Hit& hit, const Eigen::Vector3f& p, const GroundBsdf& bsdf,
+              int depth, SampleStream& rng) const;
+
+  const TerrainScene& scene_;
+  const SceneInput& input_;
+  const CameraRays& camera_;
+  const RenderSettings& settings_;
+  Eigen::Vector3f sun_dir_;
+  float sun_cos_max_ = 1.0f;
+  Eigen::Vector3f sun_irradiance_;
+  bool sun_up_ = false;
+  std::unique_ptr<Atmosphere> atmosphere_;
+  std::unique_ptr<PhysicalSky> air_;  // none for the simple and the constant sky
+  float base_altitude_ = 0.0f;        // local z 0 in metres above sea level
+  bool shafts_ = false;
+  ShadowSlab shadow_slab_{0.0f, 0.0f};
+  float air_reach_ = 0.0f;
+  std::optional<SkySampler> sky_sampler_;
+};
+
+}  // namespace drift::render

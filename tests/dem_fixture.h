@@ -1,0 +1,21 @@
+// Test terrain from a formula: the one helper the test suites share for it.
+#pragma once
+
+#include "terrain/grid.h"
+
+namespace drift::testing {
+
+// A square DEM of n x n cells of `cell` metres (local georeference, NW corner
+// at (0, 0)) with z = f(x, y) at each cell centre, where x = (col + offset)
+// cell east and y = -(row + offset) cell north: offset 0.5 measures from the
+// NW corner, -(n - 1) / 2 from the grid's centre.
+template <class F>
+terrain::HeightField dem_from(int n, double cell, double offset, F f) {
+  terrain::HeightField dem(n, n, 0.0f, terrain::local_georeference(cell));
+  for (int row = 0; row < n; ++row)
+    for (int x = 0; x < n; ++x)
+      dem(x, row) = static_cast<float>(f((x + offset) * cell, -((row + offset) * cell)));
+  return dem;
+}
+
+}  // namespace drift::testing
