@@ -52,8 +52,14 @@ const std::vector<SandParameter>& sand_parameters() {
 #undef DRIFT_SAND_FIELD
 
 std::string range_text(const SandParameter& p) {
-  return "[" + terrain::format_value(p.lo) + ", " + terrain::format_value(p.hi) + "]" +
-         (*p.unit ? std::string(" ") + p.unit : std::string());
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
+  std::string text = "[";
+  text += terrain::format_value(p.lo);
+  text += ", ";
+  text += terrain::format_value(p.hi);
+  text += "]";
+  if (*p.unit) (text += " ") += p.unit;
+  return text;
 }
 
 }  // namespace drift::dunes

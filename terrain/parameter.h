@@ -45,9 +45,14 @@ inline void require_field(bool ok, const std::string& field, double value,
 // The closed range [lo, hi] (finite values only).
 inline void require_in(const std::string& field, double value, double lo, double hi,
                        const char* unit = "") {
-  require_field(std::isfinite(value) && value >= lo && value <= hi, field, value,
-                "[" + format_value(lo) + ", " + format_value(hi) + "]" +
-                    (*unit ? std::string(" ") + unit : std::string()));
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
+  std::string range = "[";
+  range += format_value(lo);
+  range += ", ";
+  range += format_value(hi);
+  range += "]";
+  if (*unit) (range += " ") += unit;
+  require_field(std::isfinite(value) && value >= lo && value <= hi, field, value, range);
 }
 
 }  // namespace drift::terrain
