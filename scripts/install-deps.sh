@@ -11,6 +11,7 @@ packages=(
   libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev libtinyobjloader-dev
+  libopenvdb-dev libboost-iostreams-dev
   fonts-dejavu-core
 )
 

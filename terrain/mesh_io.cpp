@@ -63,6 +63,46 @@ Mesh read_obj(const fs::path& path, bool y_up) {
   return mesh;
 }
 
+void write_obj(const Mesh& mesh, const fs::path& path, bool y_up) {
+  if (mesh.triangles.empty()) throw Error("cannot write '" + path.string() + "': empty mesh");
+  const bool with_normals = mesh.normals.size() == mesh.positions.size();
+  auto axes = [y_up](const Eigen::Vector3f& v) {
+    return y_up ? Eigen::Vector3f(v.x(), v.z(), -v.y()) : v;
+  };
+  AtomicFile out(path);
+  {
+    std::ofstream f(out.temp_path());
+    char line[160];
+    std::snprintf(line, sizeof line, "# written by Driftscape (%s)\n# origin %.17g %.17g %.17g\n",
+                  y_up ? "y up" : "z up", mesh.origin.x(), mesh.origin.y(), mesh.origin.z());
+    f << line;
+    for (const Eigen::Vector3f& p : mesh.positions) {
+      const Eigen::Vector3f q = axes(p);
+      std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", q.x(), q.y(), q.z());
+      f << line;
+    }
+    if (with_normals) {
+      for (const Eigen::Vector3f& n : mesh.normals) {
+        const Eigen::Vector3f q = axes(n);
+        std::snprintf(line, sizeof line, "vn %.6g %.6g %.6g\n", q.x(), q.y(), q.z());
+        f << line;
+      }
+    }
+    for (const auto& t : mesh.triangles) {
+      if (with_normals) {
+        std::snprintf(line, sizeof line, "f %d//%d %d//%d %d//%d\n", t[0] + 1, t[0] + 1, t[1] + 1,
+                      t[1] + 1, t[2] + 1, t[2] + 1);
+      } else {
+        std::snprintf(line, sizeof line, "f %d %d %d\n", t[0] + 1, t[1] + 1, t[2] + 1);
+      }
+      f << line;
+    }
+    f.flush();
+    if (!f) throw Error("cannot write '" + path.string() + "' (disk full?)");
+  }
+  out.commit();
+}
+
 void write_ply(const Mesh& mesh, const fs::path& path) {
   if (mesh.triangles.empty()) throw Error("cannot write '" + path.string() + "': empty mesh");
   const bool with_normals = mesh.normals.size() == mesh.positions.size();

@@ -1,4 +1,4 @@
-// Reading OBJ meshes (tinyobjloader) and writing PLY meshes (with per-vertex
+// Reading OBJ meshes (tinyobjloader), writing OBJ, and writing PLY meshes (with per-vertex
 // attributes as extra properties, which Blender, MeshLab and CloudCompare read).
 #pragma once
 
@@ -18,6 +18,11 @@ Mesh read_obj(const std::filesystem::path& path, bool y_up = false);
 // Written atomically.
 // The origin is written as a comment "origin X Y Z" (CRS metres).
 void write_ply(const Mesh& mesh, const std::filesystem::path& path);
+
+// Wavefront OBJ: v x y z [vn], triangles as f a//a b//b c//c (1-based),
+// the origin as a comment "# origin X Y Z". z-up as stored, or y-up (the
+// OBJ convention, (x, y, z) -> (x, z, -y)) when `y_up`. Written atomically.
+void write_obj(const Mesh& mesh, const std::filesystem::path& path, bool y_up = false);
 
 // Reads the PLY files write_ply writes (binary little-endian, float vertex
 // properties, triangle faces as "list uchar int"): positions, normals if

@@ -42,7 +42,7 @@ detail::Ranges advect(SoilState& s, double dt) {
       carried, false,
       [&](std::size_t i, const detail::Gathered& r) {
         s.back.rho[i] = r.amount;
-        const float inv = r.amount > 0 ? 1.0f / r.amount : 0.0f;
+        const float inv = detail::weight_inverse(r.amount);
         s.back.ux[i] = r.u[0] * inv;
         s.back.uy[i] = r.u[1] * inv;
         s.back.uz[i] = r.u[2] * inv;
@@ -80,7 +80,7 @@ void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
         if (ex == 0 && carry == 0) continue;
         const float u[3] = {s.ux[i], s.uy[i], s.uz[i]};
         const float kept = r - ex, now = kept + carry;
-        const float inv = now > 0 ? 1.0f / now : 0.0f;
+        const float inv = detail::weight_inverse(now);
         s.ux[i] = (kept * u[0] + carry * cu[0]) * inv;
         s.uy[i] = (kept * u[1] + carry * cu[1]) * inv;
         s.uz[i] = (kept * u[2] + carry * cu[2]) * inv;
@@ -147,7 +147,7 @@ void overflow_weighted_pass(SoilState& s, const std::array<float, 27>& w) {
             iu[2] += q * s.uz[j];
           }
         const float kept = s.rho[i] - excess[i], now = kept + in;
-        const float inv = now > 0 ? 1.0f / now : 0.0f;
+        const float inv = detail::weight_inverse(now);
         s.back.ux[i] = (kept * s.ux[i] + iu[0]) * inv;
         s.back.uy[i] = (kept * s.uy[i] + iu[1]) * inv;
         s.back.uz[i] = (kept * s.uz[i] + iu[2]) * inv;

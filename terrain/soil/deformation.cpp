@@ -76,13 +76,13 @@ detail::Ranges propagate_forces(SoilState& s) {
       g, moving.data(), senders, open, disp, carried, true,
       [&](std::size_t i, const detail::Gathered& r) {
         const float kept = s.rho[i] - moving[i], now = kept + r.amount;
-        const float inv = now > 0 ? 1.0f / now : 0.0f;
+        const float inv = detail::weight_inverse(now);
         s.back.rho[i] = now;
         s.back.ux[i] = (kept * s.ux[i] + r.u[0]) * inv;
         s.back.uy[i] = (kept * s.uy[i] + r.u[1]) * inv;
         s.back.uz[i] = (kept * s.uz[i] + r.u[2]) * inv;
         const bool collided = now + s.psi[i] > 1.0f + kCollided && r.amount > 0;
-        const float fin = collided ? 1.0f / r.amount : 0.0f;  // eq. 35
+        const float fin = collided ? detail::weight_inverse(r.amount) : 0.0f;  // eq. 35
         s.back.fx[i] = r.f[0] * fin;
         s.back.fy[i] = r.f[1] * fin;
         s.back.fz[i] = r.f[2] * fin;

@@ -29,4 +29,24 @@ terrain::HeightField top_surface(const SoilState& s, const terrain::GeoReference
   return out;
 }
 
+terrain::GeoReference grid_georeference(const terrain::Grid3Shape& g) {
+  terrain::GeoReference geo;
+  geo.geotransform = {g.origin.x(), g.voxel_size, 0.0, g.origin.y() + g.ny * g.voxel_size,
+                      0.0,          -g.voxel_size};
+  return geo;
+}
+
+terrain::HeightField ground_raster(const terrain::Grid3Shape& g, const terrain::HeightField& hf,
+                                   int margin) {
+  terrain::GeoReference geo = grid_georeference(g);
+  geo.geotransform[0] -= margin * g.voxel_size;
+  geo.geotransform[3] += margin * g.voxel_size;
+  terrain::HeightField out(g.nx + 2 * margin, g.ny + 2 * margin, static_cast<float>(g.origin.z()),
+                           geo);
+  if (hf.empty()) return out;
+  for (int r = 0; r < out.height(); ++r)
+    for (int x = 0; x < out.width(); ++x) out(x, r) = hf.clamped(x - margin, r - margin);
+  return out;
+}
+
 }  // namespace drift::soil

@@ -17,4 +17,15 @@ float column_top(const SoilState& state, int x, int y);
 // the voxel size when geo is empty).
 terrain::HeightField top_surface(const SoilState& state, const terrain::GeoReference& geo);
 
+// The georeference of the grid's columns in its own metric frame: x east and
+// y north in metres as the soil's meshes (row 0 at y = origin.y + ny h).
+terrain::GeoReference grid_georeference(const terrain::Grid3Shape& shape);
+
+// Ground for rendering around the soil: the height-field terrain under the
+// grid (`terrain`, same columns; empty = the grid's flat floor), widened by
+// `margin` columns on every side (edges repeated), in metres, georeferenced
+// as grid_georeference with the margin.
+terrain::HeightField ground_raster(const terrain::Grid3Shape& shape,
+                                   const terrain::HeightField& terrain, int margin);
+
 }  // namespace drift::soil

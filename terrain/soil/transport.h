@@ -37,6 +37,10 @@ inline float axis_share(int o, float d) {
 
 inline int sign_of(float d) { return d > 0 ? 1 : (d < 0 ? -1 : 0); }
 
+// 1 / w for dividing a w-weighted sum back into a mean; 0 for w so small that
+// 1 / w would overflow a float (a denormal trace of soil: 0 * inf is NaN).
+inline float weight_inverse(float w) { return w > 1e-30f ? 1.0f / w : 0.0f; }
+
 // What one voxel gathered: the amount (stay + backflow + inflows) and the
 // amount-weighted sums of the carried vectors.
 struct Gathered {

@@ -1,0 +1,166 @@
+// drift soil SCENARIO.toml -o OUT.ply: voxel soil that pours, slides, piles
+// and is pushed, dug and lifted (paper 004, terrain/soil/simulation.h).
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "pipeline/cli.h"
+#include "pipeline/progress_bar.h"
+#include "pipeline/soil_scenario_file.h"
+#include "terrain/error.h"
+#include "terrain/mesh_io.h"
+#include "terrain/raster_io.h"
+#include "terrain/soil/surface.h"
+#include "terrain/soil/top_surface.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SoilCommand {
+  std::string scenario, output, vdb, surface, collision, frames, soil_type, terrain, ground;
+  int ground_margin = 32;
+  int steps = -1, frame_every = 10;
+  double phi = NAN, cohesion = NAN, gamma = NAN, moisture = NAN;
+  bool no_ridge_fix = false;
+};
+
+void write_mesh(const terrain::Mesh& mesh, const fs::path& path) {
+  if (path.extension() == ".obj")
+    terrain::write_obj(mesh, path);
+  else
+    terrain::write_ply(mesh, path);
+}
+
+void check_mesh_path(const std::string& path, const char* flag) {
+  const std::string ext = fs::path(path).extension().string();
+  if (ext != ".ply" && ext != ".obj")
+    usage_error(std::string(flag) + " '" + path + "' must end in .ply or .obj");
+}
+
+// The command line's values over the scenario's own.
+void apply_overrides(const SoilCommand& c, soil::SoilScenario& sc) {
+  if (c.steps >= 0) sc.steps = c.steps;
+  soil::SoilType& t = sc.options.soil;
+  if (!c.soil_type.empty()) t = soil::soil_preset(c.soil_type);
+  if (!std::isnan(c.phi)) t.phi_deg = c.phi;
+  if (!std::isnan(c.cohesion)) t.cohesion = c.cohesion;
+  if (!std::isnan(c.gamma)) t.gamma = c.gamma;
+  if (!std::isnan(c.moisture)) t.moisture = c.moisture;
+  try {
+    soil::validate(sc.options);
+  } catch (const Error& e) {
+    usage_error(e.what());
+  }
+}
+
+void run_soil(SoilCommand& c) {
+  check_mesh_path(c.output, "-o");
+  if (!c.collision.empty()) check_mesh_path(c.collision, "--collision");
+  if (c.frame_every < 1) usage_error("--frame-every must be at least 1");
+  soil::SoilScenario sc = read_soil_scenario(c.scenario, c.terrain);
+  apply_overrides(c, sc);
+  if (!c.frames.empty() && !fs::is_directory(c.frames))
+    throw Error("--frames directory '" + c.frames + "' does not exist; create it first");
+
+  soil::SoilSimulation sim = soil::make_simulation(sc);  // checks sizes and memory first
+  const soil::SurfaceOptions surface{
+      c.no_ridge_fix ? soil::RidgeFix::Off : soil::RidgeFix::StraightSlopes, 3, 0.0};
+  const double mass0 = sim.state().mass();
+  const ProgressFn progress = terminal_progress("soil");
+  const auto t0 = std::chrono::steady_clock::now();
+  progress(0.0, "simulating");
+  for (int step = 1; step <= sc.steps; ++step) {
+    sim.step();
+    if (!c.frames.empty() && step % c.frame_every == 0) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05d.ply", step);
+      write_mesh(soil::soil_surface(sim.state(), surface, sc.options.soil.moisture),
+                 fs::path(c.frames) / name);
+    }
+    if (!progress(static_cast<double>(step) / std::max(1, sc.steps), "simulating"))
+      throw Cancelled();
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  progress(1.0, "done");
+
+  const terrain::Mesh mesh = soil::soil_surface(sim.state(), surface, sc.options.soil.moisture);
+  if (mesh.triangles.empty()) throw Error("scenario '" + c.scenario + "' left no soil surface");
+  write_mesh(mesh, c.output);
+  std::printf("soil: wrote %s (%zu triangles)\n", c.output.c_str(), mesh.triangle_count());
+  if (!c.collision.empty()) {
+    const terrain::Mesh bodies = soil::iso_surface(sim.state().shape, sim.state().psi);
+    if (bodies.triangles.empty()) throw Error("--collision: the scenario has no terrain or bodies");
+    write_mesh(bodies, c.collision);
+    std::printf("soil: wrote %s (%zu triangles)\n", c.collision.c_str(), bodies.triangle_count());
+  }
+  if (!c.vdb.empty()) {
+    soil::write_density_vdb(sim.state(), c.vdb);
+    std::printf("soil: wrote %s (grids density, collision)\n", c.vdb.c_str());
+  }
+  if (!c.surface.empty()) {
+    terrain::HeightField top = soil::top_surface(
+        sim.state(),
+        sc.geo.crs_wkt.empty() && sc.terrain.kind != soil::TerrainSource::Kind::HeightField
+            ? terrain::local_georeference(sc.shape.voxel_size)
+            : sc.geo);
+    terrain::write_geotiff(top, c.surface, {"top of soil and ground (m)", "m"});
+    std::printf("soil: wrote %s\n", c.surface.c_str());
+  }
+  if (!c.ground.empty()) {
+    terrain::write_geotiff(soil::ground_raster(sc.shape, sc.terrain.heights, c.ground_margin),
+                           c.ground, {"ground under the soil (m)", "m"});
+    std::printf("soil: wrote %s\n", c.ground.c_str());
+  }
+  const double mass1 = sim.state().mass();
+  std::printf(
+      "soil: %d steps of %dx%dx%d voxels (%.3g m) in %.2f s (%.1f steps/s); soil %.6g -> "
+      "%.6g voxels (relative change %.2g)\n",
+      sc.steps, sc.shape.nx, sc.shape.ny, sc.shape.nz, sc.shape.voxel_size, seconds,
+      sc.steps / std::max(seconds, 1e-9), mass0, mass1, mass0 > 0 ? (mass1 - mass0) / mass0 : 0.0);
+}
+
+}  // namespace
+
+void add_soil_command(CLI::App& root) {
+  auto c = std::make_shared<SoilCommand>();
+  CLI::App* sub = add_subcommand(root, "soil",
+                                 "voxel soil that pours, slides, piles and is pushed, dug and "
+                                 "lifted; writes its surface (paper 004; docs/soil.md)",
+                                 [c] { run_soil(*c); });
+  sub->add_option("scenario", c->scenario, "scenario TOML (see data/soil/, docs/soil.md)")
+      ->required();
+  sub->add_option("-o,--output", c->output, "soil surface mesh, .ply or .obj (metres)")->required();
+  sub->add_option("--terrain", c->terrain,
+                  "metric GeoTIFF replacing the dem the scenario's [terrain] names");
+  sub->add_option("--steps", c->steps, "time steps (overrides the scenario's)");
+  sub->add_option("--soil", c->soil_type, "soil type of the thesis's table 6")
+      ->check(CLI::IsMember({"dry_sand", "sandy_loam", "loam"}));
+  sub->add_option("--phi", c->phi, "angle of internal friction (degrees, [0, 60))");
+  sub->add_option("--cohesion", c->cohesion, "cohesion c (t/m, [0, 20])");
+  sub->add_option("--gamma", c->gamma, "specific weight (t/m^2, (0, 10])");
+  sub->add_option("--moisture", c->moisture,
+                  "moisture (0 dry .. 1 damp): adds cohesion, wets the surface");
+  sub->add_option("--frames", c->frames, "directory for a surface mesh every --frame-every steps");
+  sub->add_option("--frame-every", c->frame_every, "steps between frames")->capture_default_str();
+  sub->add_option("--vdb", c->vdb, "OpenVDB file of the density and collision grids");
+  sub->add_option("--surface", c->surface,
+                  "GeoTIFF of the top of the soil and what it rests on (m), georeferenced");
+  sub->add_option("--collision", c->collision, "mesh of the terrain and bodies (iso-0.5 of psi)");
+  sub->add_option("--ground", c->ground,
+                  "GeoTIFF of the ground under the soil (terrain or the grid's floor), widened by "
+                  "--ground-margin columns, in the meshes' frame: a terrain to render them on");
+  sub->add_option("--ground-margin", c->ground_margin, "columns added around the grid")
+      ->capture_default_str();
+  sub->add_flag("--no-ridge-fix", c->no_ridge_fix,
+                "extract the raw density (shows the thesis's vertical ridges)");
+}
+
+DRIFT_COMMAND(60, add_soil_command);
+
+}  // namespace drift::pipeline

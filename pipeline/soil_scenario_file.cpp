@@ -1,0 +1,240 @@
+#include "pipeline/soil_scenario_file.h"
+
+#include <cmath>
+
+#include "pipeline/object_list.h"
+#include "pipeline/toml_section.h"
+#include "terrain/bilinear.h"
+#include "terrain/raster_io.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+constexpr const char* kDoc = "docs/soil.md";
+constexpr double kBig = 1e7;  // metres: any coordinate a scenario can sensibly hold
+
+soil::Primitive read_primitive(const toml::table* t, const std::filesystem::path& file,
+                               const std::string& owner) {
+  Section s(t, owner + ".primitive", file, kDoc);
+  soil::Primitive p;
+  const std::string shape = s.string("shape").value_or("");
+  p.center = s.vector<3>("center", -kBig, kBig).value_or(Eigen::Vector3d::Zero());
+  auto positive = [&](const char* key) {
+    const double v = s.number(key, NAN, -kBig, kBig);
+    if (!(v > 0)) s.invalid(key, "must be a positive number of metres");
+    return v;
+  };
+  auto positive3 = [&](const char* key) {
+    const auto v = s.vector<3>(key, -kBig, kBig);
+    if (!v || !(v->array() > 0).all()) s.invalid(key, "must be three positive numbers of metres");
+    return *v;
+  };
+  if (shape == "sphere") {
+    p.kind = soil::PrimitiveKind::Sphere;
+    p.size = {positive("radius"), 0, 0};
+  } else if (shape == "ellipsoid") {
+    p.kind = soil::PrimitiveKind::Ellipsoid;
+    p.size = positive3("semi_axes");
+  } else if (shape == "cuboid") {
+    p.kind = soil::PrimitiveKind::Cuboid;
+    p.size = positive3("half_extents");
+  } else if (shape == "cylinder") {
+    p.kind = soil::PrimitiveKind::Cylinder;
+    p.size = {positive("radius"), 0, positive("half_height")};
+  } else if (shape == "cone") {
+    p.kind = soil::PrimitiveKind::Cone;
+    p.size = {positive("radius"), 0, positive("height")};
+  } else {
+    s.invalid("shape", "is '" + shape +
+                           "'; use sphere, ellipsoid, cuboid, cylinder or cone (and its sizes)");
+  }
+  s.finish();
+  return p;
+}
+
+std::vector<soil::Primitive> read_primitives(Section& s, const std::filesystem::path& file,
+                                             const std::string& owner) {
+  std::vector<soil::Primitive> out;
+  for (const toml::table* t : s.tables("primitive")) out.push_back(read_primitive(t, file, owner));
+  if (out.empty()) s.invalid_table("needs at least one [[" + owner + ".primitive]]");
+  return out;
+}
+
+void read_grid(const toml::table& root, const std::filesystem::path& file, soil::SoilScenario& sc) {
+  Section s(root["grid"].as_table(), "grid", file, kDoc);
+  const auto size = s.vector<3>("size", 0, 4096);  // x, y may be 0 under a dem: it sets them
+  if (!size) s.invalid_table("needs size = [nx, ny, nz] (voxels)");
+  for (int a = 0; a < 3; ++a)
+    if ((*size)[a] != std::floor((*size)[a])) s.invalid("size", "must be whole numbers of voxels");
+  sc.shape.nx = static_cast<int>((*size)[0]);
+  sc.shape.ny = static_cast<int>((*size)[1]);
+  sc.shape.nz = static_cast<int>((*size)[2]);
+  sc.shape.voxel_size = s.number("voxel", 0.1, 1e-4, 1e4);
+  sc.shape.origin = s.vector<3>("origin", -kBig, kBig).value_or(Eigen::Vector3d::Zero());
+  s.finish();
+}
+
+void read_soil(const toml::table& root, const std::filesystem::path& file, soil::SoilScenario& sc) {
+  Section s(root["soil"].as_table(), "soil", file, kDoc);
+  const std::string type = s.string("type").value_or("dry_sand");
+  try {
+    sc.options.soil = soil::soil_preset(type);
+  } catch (const Error& e) {
+    s.invalid("type", std::string("is unknown: ") + e.what());
+  }
+  soil::SoilType& t = sc.options.soil;
+  t.phi_deg = s.number("phi", t.phi_deg, 0, 59.9);
+  t.cohesion = s.number("cohesion", t.cohesion, 0, 20);
+  t.gamma = s.number("gamma", t.gamma, 0.01, 10);
+  t.moisture = s.number("moisture", t.moisture, 0, 1);
+  s.finish();
+}
+
+void read_simulation(const toml::table& root, const std::filesystem::path& file,
+                     soil::SoilScenario& sc) {
+  Section s(root["simulation"].as_table(), "simulation", file, kDoc);
+  soil::SoilOptions& o = sc.options;
+  sc.steps = s.integer("steps", sc.steps, 0, 10000000);
+  o.dt = s.number("dt", o.dt, 1e-5, 1);
+  o.gravity = s.number("gravity", o.gravity, 0, 100);
+  o.propagation_iterations = s.integer("propagation_iterations", o.propagation_iterations, 0, 64);
+  o.overflow_passes = s.integer("overflow_passes", o.overflow_passes, 0, 64);
+  const std::string overflow = s.string("overflow").value_or("up");
+  if (overflow == "up")
+    o.overflow = soil::OverflowHeuristic::Up;
+  else if (overflow == "spread")
+    o.overflow = soil::OverflowHeuristic::Spread;
+  else if (overflow == "up_nine")
+    o.overflow = soil::OverflowHeuristic::UpNine;
+  else
+    s.invalid("overflow", "is '" + overflow + "'; use up, spread or up_nine");
+  o.slippage = s.boolean("slippage", o.slippage);
+  s.finish();
+}
+
+// The DEM crop under the grid: `window` pixels of the raster, each cell split
+// into `upsample` x `upsample` columns (bilinear), the grid's floor `depth`
+// metres below the crop's lowest point.
+void read_dem(Section& s, const std::filesystem::path& file,
+              const std::filesystem::path& dem_override, soil::SoilScenario& sc) {
+  const std::string named = *s.string("dem");
+  const std::filesystem::path dem =
+      dem_override.empty() ? file.parent_path() / named : dem_override;
+  const auto w = s.vector<4>("window", 0, 1e6);
+  if (!w) s.invalid_table("with dem needs window = [x_off, y_off, width, height] (pixels)");
+  const int up = s.integer("upsample", 1, 1, 64);
+  const double depth = s.number("depth", 2.0, 0, 1e4);
+  terrain::ReadOptions ro;
+  ro.window = terrain::RasterWindow{static_cast<int>((*w)[0]), static_cast<int>((*w)[1]),
+                                    static_cast<int>((*w)[2]), static_cast<int>((*w)[3])};
+  const terrain::HeightField crop = terrain::read_raster(dem, ro);
+  require_metric_crs(crop, dem);
+  const double cell = crop.geo().cell_size_x();
+  sc.shape.voxel_size = cell / up;
+  sc.shape.nx = crop.width() * up;
+  sc.shape.ny = crop.height() * up;
+  float lo = INFINITY;
+  for (float v : crop.values()) lo = std::min(lo, v);
+  sc.shape.origin = {0, 0, lo - depth};
+  terrain::HeightField heights(sc.shape.nx, sc.shape.ny, 0.0f, crop.geo());
+  auto& gt = heights.geo().geotransform;
+  gt[1] /= up;
+  gt[5] /= up;
+  for (int r = 0; r < heights.height(); ++r)
+    for (int x = 0; x < heights.width(); ++x)
+      heights(x, r) = terrain::bilinear_clamped(crop, (x + 0.5) / up - 0.5, (r + 0.5) / up - 0.5);
+  sc.geo = heights.geo();
+  sc.terrain.kind = soil::TerrainSource::Kind::HeightField;
+  sc.terrain.heights = std::move(heights);
+}
+
+void read_terrain(const toml::table& root, const std::filesystem::path& file,
+                  const std::filesystem::path& dem_override, soil::SoilScenario& sc) {
+  if (!root.contains("terrain")) return;
+  Section s(root["terrain"].as_table(), "terrain", file, kDoc);
+  const std::string kind = s.string("kind").value_or("dem");
+  if (kind == "dem") {
+    if (!s.string("dem"))
+      s.invalid_table("needs dem = \"FILE\" (a metric GeoTIFF) or kind = \"voxel\"");
+    read_dem(s, file, dem_override, sc);
+  } else if (kind == "voxel") {
+    sc.terrain.kind = soil::TerrainSource::Kind::Voxel;
+    sc.terrain.base = s.number("base", 0.5, -kBig, kBig);
+    sc.terrain.seed = static_cast<unsigned long long>(s.integer("seed", 1, 0, 2147483647));
+  } else {
+    s.invalid("kind", "is '" + kind + "'; use dem or voxel");
+  }
+  s.finish();
+}
+
+void read_bodies(const toml::table& root, const std::filesystem::path& file,
+                 soil::SoilScenario& sc) {
+  Section top(&root, "", file, kDoc);
+  for (const toml::table* t : top.tables("soil_body")) {
+    Section s(t, "soil_body", file, kDoc);
+    soil::SoilBody b;
+    b.name = s.string("name").value_or("soil");
+    b.position = s.vector<3>("position", -kBig, kBig).value_or(Eigen::Vector3d::Zero());
+    b.on_ground = s.boolean("on_ground", false);
+    b.primitives = read_primitives(s, file, "soil_body");
+    s.finish();
+    sc.soil.push_back(std::move(b));
+  }
+  for (const toml::table* t : top.tables("body")) {
+    Section s(t, "body", file, kDoc);
+    soil::RigidObject b;
+    b.name = s.string("name").value_or("body");
+    b.primitives = read_primitives(s, file, "body");
+    for (const toml::table* k : s.tables("keyframe")) {
+      Section ks(k, "body.keyframe", file, kDoc);
+      soil::Keyframe f;
+      f.time = ks.number("time", NAN, 0, 1e7);
+      const auto p = ks.vector<3>("position", -kBig, kBig);
+      if (!p) ks.invalid_table("needs position = [x, y, z] (m)");
+      f.position = *p;
+      ks.finish();
+      b.path.push_back(f);
+    }
+    if (b.path.empty()) {
+      b.path.push_back(
+          {0.0, s.vector<3>("position", -kBig, kBig).value_or(Eigen::Vector3d::Zero())});
+    } else if (s.vector<3>("position", -kBig, kBig)) {
+      s.invalid("position", "and [[body.keyframe]] both place the body; use one");
+    }
+    s.finish();
+    soil::validate(b, file.string() + ": body");
+    sc.bodies.push_back(std::move(b));
+  }
+}
+
+}  // namespace
+
+soil::SoilScenario read_soil_scenario(const std::filesystem::path& path,
+                                      const std::filesystem::path& terrain) {
+  const toml::table root = parse_toml_file(path, "soil scenario");
+  soil::SoilScenario sc;
+  sc.name = path.stem().string();
+  for (const auto& [k, node] : root) {
+    const std::string key(k.str());
+    if (key != "grid" && key != "soil" && key != "simulation" && key != "terrain" &&
+        key != "soil_body" && key != "body")
+      throw Error(path.string() + ": unknown table or key '" + key +
+                  "' (a scenario has [grid], [soil], [simulation], [terrain], [[soil_body]], "
+                  "[[body]]; see docs/soil.md)");
+  }
+  if (!root.contains("grid") && !root.contains("terrain"))
+    throw Error(path.string() + ": needs a [grid] (size, voxel) or a [terrain] with a dem");
+  if (root.contains("grid")) read_grid(root, path, sc);
+  read_terrain(root, path, terrain, sc);
+  if (sc.shape.nx < 1 || sc.shape.ny < 1 || sc.shape.nz < 1)
+    throw Error(path.string() +
+                ": [grid] size must be at least 1 voxel on every axis (x and y "
+                "may be 0 only with a [terrain] dem, which sets them)");
+  read_soil(root, path, sc);
+  read_simulation(root, path, sc);
+  read_bodies(root, path, sc);
+  return sc;
+}
+
+}  // namespace drift::pipeline

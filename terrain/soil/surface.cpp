@@ -1,0 +1,58 @@
+#include "terrain/soil/surface.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "terrain/soil/height_spans.h"
+
+namespace drift::soil {
+
+namespace {
+
+// Reshapes one column's piles (see surface.h).
+void straighten_column(const HeightSpan* spans, int count, int nz, int ramp, const float* rho,
+                       float* out) {
+  for (int s = 0; s < count; ++s) {
+    const HeightSpan& p = spans[s];
+    if (p.type != SpanType::Piled) continue;
+    const int floor = std::max(0, static_cast<int>(std::floor(p.bottom)));
+    int ceiling = nz;  // first voxel of the next span
+    if (s + 1 < count) ceiling = std::min(nz, static_cast<int>(std::floor(spans[s + 1].bottom)));
+    const int lo = std::max(floor, static_cast<int>(std::floor(p.top - ramp)));
+    const int hi = std::min(ceiling - 1, static_cast<int>(std::ceil(p.top + ramp)));
+    for (int z = lo; z <= hi; ++z) {
+      const float d = std::clamp(0.5f + (p.top - (z + 0.5f)) / (2.0f * ramp), 0.0f, 1.0f);
+      out[z] = z > p.top_voxel ? std::max(d, rho[z]) : d;
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<float> surface_density(const SoilState& s, const SurfaceOptions& o) {
+  std::vector<float> out = s.rho;
+  if (o.ridges == RidgeFix::Off) return out;
+  const terrain::Grid3Shape& g = s.shape;
+  const int ramp = std::clamp(o.ramp_voxels, 1, 16);
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    HeightSpan spans[HeightSpans::kMaxSpans];
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t c = g.column(x, y);
+      const int n = build_column_spans(s.rho.data() + c, s.psi.data() + c, g.nz, spans,
+                                       HeightSpans::kMaxSpans);
+      straighten_column(spans, n, g.nz, ramp, s.rho.data() + c, out.data() + c);
+    }
+  });
+  return out;
+}
+
+terrain::Mesh soil_surface(const SoilState& s, const SurfaceOptions& o, double moisture) {
+  terrain::Mesh mesh = iso_surface(s.shape, surface_density(s, o));
+  mesh.vertex_attributes.push_back(
+      {"wetness", std::vector<float>(mesh.positions.size(), static_cast<float>(moisture))});
+  return mesh;
+}
+
+}  // namespace drift::soil

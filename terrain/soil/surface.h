@@ -1,0 +1,51 @@
+// Surfaces of the voxel soil (paper 004, sec. 3.3): the iso-0.5 surface of
+// rho extracted with OpenVDB's volumeToMesh (one .cpp holds openvdb.h), and
+// the density written as an OpenVDB grid for Blender and Houdini.
+//
+// Vertical ridges (thesis 3.3, fig. 42-43; fix suggested in 5.3.2, fig. 59):
+// Marching Cubes interpolates between voxel centres, and a column's density
+// (the fraction of its top voxel filled) is not a linear function of its
+// height, so a slope between two columns comes out stepped. Before
+// extraction, StraightSlopes replaces the density around the top T of every
+// pile by the ramp d(z) = clamp(0.5 + (T - z) / (2 R), 0, 1) (z at voxel
+// centres, R = ramp_voxels): linear in z with d = 0.5 exactly at T, and
+// linear between neighbouring columns at the same z, so the 0.5 crossings lie
+// on the straight line joining the column tops for slopes up to R voxels per
+// voxel. Only piles are reshaped (within their own voxels and the air up to
+// the next span); falling soil keeps its density.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "terrain/mesh.h"
+#include "terrain/soil/soil_state.h"
+
+namespace drift::soil {
+
+enum class RidgeFix { Off, StraightSlopes };
+
+struct SurfaceOptions {
+  RidgeFix ridges = RidgeFix::StraightSlopes;
+  int ramp_voxels = 3;      // R, [1, 16]
+  double adaptivity = 0.0;  // volumeToMesh's: 0 keeps every triangle, 1 merges flat areas most
+};
+
+// The density the surface is extracted from (rho, reshaped per `options`).
+std::vector<float> surface_density(const SoilState& state, const SurfaceOptions& options);
+
+// The iso-0.5 surface of `field` (a grid of `state.shape`) in metres,
+// outward-facing, closed where the field meets the grid's sides. Empty if the
+// field is empty.
+terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<float>& field);
+
+// The soil's surface, with a per-vertex "wetness" = moisture (for the
+// renderer's wet coat).
+terrain::Mesh soil_surface(const SoilState& state, const SurfaceOptions& options,
+                           double moisture = 0.0);
+
+// Writes grids "density" (rho) and "collision" (psi) as fog volumes, voxel
+// size and origin in metres, atomically. Throws drift::Error naming the file.
+void write_density_vdb(const SoilState& state, const std::filesystem::path& path);
+
+}  // namespace drift::soil

@@ -1,0 +1,94 @@
+// The one file that includes OpenVDB (a heavy header: docs/DESIGN.md).
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/VolumeToMesh.h>
+
+#include <mutex>
+
+#include "terrain/atomic_file.h"
+#include "terrain/error.h"
+#include "terrain/soil/surface.h"
+
+namespace drift::soil {
+
+namespace {
+
+void init_openvdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+// A sparse grid of `field` * sign (zeros stay background), index space =
+// voxel indices, values at voxel centres.
+openvdb::FloatGrid::Ptr to_grid(const terrain::Grid3Shape& g, const std::vector<float>& field,
+                                float sign) {
+  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+  auto acc = grid->getAccessor();
+  for (int y = 0; y < g.ny; ++y)
+    for (int x = 0; x < g.nx; ++x)
+      for (int z = 0; z < g.nz; ++z) {
+        const float v = field[g.index(x, y, z)];
+        if (v != 0.0f) acc.setValue(openvdb::Coord(x, y, z), sign * v);
+      }
+  return grid;
+}
+
+}  // namespace
+
+terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>& field) {
+  init_openvdb();
+  // Negated so that "inside" is below the iso-value, as for a level set:
+  // volumeToMesh then orients faces outwards; the background (0) is outside.
+  const openvdb::FloatGrid::Ptr grid = to_grid(g, field, -1.0f);
+  std::vector<openvdb::Vec3s> points;
+  std::vector<openvdb::Vec3I> triangles;
+  std::vector<openvdb::Vec4I> quads;
+  openvdb::tools::volumeToMesh(*grid, points, triangles, quads, -0.5, 0.0);
+  terrain::Mesh mesh;
+  mesh.positions.reserve(points.size());
+  const double h = g.voxel_size;
+  for (const auto& p : points)
+    mesh.positions.push_back(
+        (g.origin + h * Eigen::Vector3d(p.x() + 0.5, p.y() + 0.5, p.z() + 0.5)).cast<float>());
+  mesh.triangles.reserve(triangles.size() + 2 * quads.size());
+  // With the negated field OpenVDB's faces are counter-clockwise seen from
+  // outside, as ours (tested: the enclosed volume comes out positive).
+  for (const auto& t : triangles)
+    mesh.triangles.push_back(
+        {static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2])});
+  for (const auto& q : quads) {
+    mesh.triangles.push_back(
+        {static_cast<int>(q[0]), static_cast<int>(q[1]), static_cast<int>(q[2])});
+    mesh.triangles.push_back(
+        {static_cast<int>(q[0]), static_cast<int>(q[2]), static_cast<int>(q[3])});
+  }
+  return mesh;
+}
+
+void write_density_vdb(const SoilState& s, const std::filesystem::path& path) {
+  init_openvdb();
+  const terrain::Grid3Shape& g = s.shape;
+  auto transform = openvdb::math::Transform::createLinearTransform(g.voxel_size);
+  transform->postTranslate(openvdb::Vec3d(g.origin.x() + 0.5 * g.voxel_size,
+                                          g.origin.y() + 0.5 * g.voxel_size,
+                                          g.origin.z() + 0.5 * g.voxel_size));
+  openvdb::GridPtrVec grids;
+  for (auto [name, field] : {std::pair{"density", &s.rho}, std::pair{"collision", &s.psi}}) {
+    openvdb::FloatGrid::Ptr grid = to_grid(g, *field, 1.0f);
+    grid->setName(name);
+    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+    grid->setTransform(transform);
+    grids.push_back(grid);
+  }
+  AtomicFile out(path);
+  try {
+    openvdb::io::File file(out.temp_path().string());
+    file.write(grids);
+    file.close();
+  } catch (const openvdb::Exception& e) {
+    throw Error("cannot write '" + path.string() + "': " + e.what());
+  }
+  out.commit();
+}
+
+}  // namespace drift::soil
