@@ -32,6 +32,7 @@ struct RenderOptions {
   std::string tile;
   std::string sun_time;
   double exposure_ev = 0.0;
+  double compensation_ev = 0.0;
 };
 
 // --sun-time "YYYY-MM-DD HH:MM[:SS] [+HH:MM]" (the offset as in [sun]
@@ -80,6 +81,10 @@ void apply_overrides(const RenderOptions& o, const CLI::App& sub, SceneFile& sce
   if (sub.count("--seed")) scene.settings.seed = o.seed;
   // Placed over the DEM when the terrain is loaded, replacing [sun]'s direction.
   if (!o.sun_time.empty()) scene.sun_time = parse_sun_time(o.sun_time);
+  if (sub.count("--exposure-compensation")) {  // on top of the meter
+    scene.display.exposure_ev = o.compensation_ev;
+    scene.display.auto_exposure = true;
+  }
   if (sub.count("--exposure")) {  // a fixed exposure instead of the meter
     scene.display.exposure_ev = o.exposure_ev;
     scene.display.auto_exposure = false;
@@ -235,6 +240,9 @@ void add_render_command(CLI::App& root) {
          "--exposure", o->exposure_ev,
          "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
          "EXR stays linear)")
+      ->check(CLI::Range(-20.0, 20.0));
+  sub->add_option("--exposure-compensation", o->compensation_ev,
+                  "EV added to the metered exposure (overrides [output] exposure_compensation)")
       ->check(CLI::Range(-20.0, 20.0));
   add_seed_option(*sub, o->seed);
 }

@@ -71,6 +71,7 @@ void read_detail(Section& s, render::MaterialOverride& m) {
   m.detail = d;
 }
 
+
 // The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
 // `material` names a preset (which sets every field), and `color`,
 // `roughness` and `wetness` set (or override) one field each. `preset` gets
@@ -192,6 +193,16 @@ fs::path resolve(const fs::path& scene_path, const std::string& p) {
   return fs::path(p).is_absolute() ? fs::path(p) : scene_path.parent_path() / p;
 }
 
+// [terrain] surround (rasters), surround_reach and surround_blend: the
+// ground beyond the DEM's edge (render/surround.h).
+void read_surround(Section& terrain, const fs::path& path, SceneFile& scene) {
+  for (const std::string& f : terrain.strings("surround"))
+    scene.surround_rasters.push_back(resolve(path, f));
+  render::SurroundOptions& o = scene.input.surround;
+  o.reach = terrain.number("surround_reach", o.reach, 0.0, 1e6);
+  o.blend = terrain.number("surround_blend", o.blend, 0.0, 1e5);
+}
+
 // [terrain]: the DEM, its ground material, rules and layers. Returns the
 // objects file it names, if any.
 std::optional<fs::path> read_terrain(const toml::table& root, const fs::path& path,
@@ -206,6 +217,7 @@ std::optional<fs::path> read_terrain(const toml::table& root, const fs::path& pa
   if (scene.terrain_repeat % 2 == 0)
     terrain.invalid("repeat", "must be odd (the raster stays in the middle)");
   scene.position_radius = terrain.number("position_radius", scene.position_radius, 1.0, 1e5);
+  read_surround(terrain, path, scene);
   if (const auto map = terrain.string("albedo_map")) scene.albedo_map = resolve(path, *map);
   // Objects standing on the terrain from an objects file (as `drift snow fall
   // --objects` reads), in addition to any [[objects]] here.
@@ -238,6 +250,8 @@ void read_snow(const toml::table& root, const fs::path& path, SceneFile& scene) 
       snow.number("forward_scattering", surface.snow.forward_scattering, 0.0, 1.0));
   surface.snow_scattering =
       static_cast<float>(snow.number("scattering", surface.snow_scattering, 1.0, 1e5));
+  surface.snow_cover_outside = static_cast<float>(
+      snow.number("cover_outside", surface.snow_cover_outside, 0.0, 1.0));
   snow.finish();
 }
 
@@ -542,6 +556,8 @@ void load_scene_terrain(SceneFile& scene) {
   }
   for (std::size_t i = 0; i < scene.layer_masks.size(); ++i)
     surface.layers[i].mask = read_metric_raster(scene.layer_masks[i]);
+  for (const fs::path& f : scene.surround_rasters)
+    scene.input.surround.rasters.push_back(read_metric_raster(f));
   if (uses_position(surface))
     surface.position = render::topographic_position(scene.input.terrain, scene.position_radius);
   if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);

@@ -28,6 +28,8 @@ struct SceneFile {
   std::filesystem::path snow_cover, snow_depth, ripples, albedo_map;
   // The masks of input.surface.layers, in order (read by load_scene_terrain).
   std::vector<std::filesystem::path> layer_masks;
+  // [terrain] surround: coarser DEMs around the terrain (render/surround.h).
+  std::vector<std::filesystem::path> surround_rasters;
   // [snow] objects: the scene's objects as drift snow fall left them (a PLY
   // with per-vertex "object" and "snow_coverage"), replacing their meshes.
   std::filesystem::path snow_objects;

@@ -71,9 +71,9 @@ DetailedGround ground_detail(const Material& material, double x, double y,
     // stains against grey lichen, sun-dried against green growth).
     const float f = albedo_factor(d, x, y, footprint);
     const float hue =
-        0.3f * d.variation *
-        filtered_noise(x, y, {64.0, 2.0, kHueSeed}, 1.0f / kNoiseStd, 0.0f, footprint).value /
-        std::sqrt(6.0f);
+        0.12f * d.variation *
+        filtered_noise(x, y, {64.0, 8.0, kHueSeed}, 1.0f / kNoiseStd, 0.0f, footprint).value /
+        2.0f;  // 4 octaves of equal amplitude: a standard deviation of 1
     out.albedo = (material.albedo * f)
                      .cwiseProduct(Eigen::Vector3f(1.0f + hue, 1.0f, 1.0f - hue))
                      .cwiseMax(0.0f)

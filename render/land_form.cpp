@@ -45,13 +45,12 @@ terrain::HeightField topographic_position(const terrain::HeightField& dem, doubl
   return out;
 }
 
-float ragged_altitude(float altitude, float jitter, double x, double y, std::size_t rule) {
-  if (!(jitter > 0.0f)) return altitude;
-  // 6 octaves, Hurst 0.5: a total standard deviation of about `jitter` / 2,
-  // so the bound moves within about +-jitter.
-  const Octaves octaves{800.0, 25.0, 0x7a66ed00u + rule};
-  const float amplitude = 0.5f * jitter / (kNoiseStd * std::sqrt(1.97f));
-  return altitude + filtered_noise(x, y, octaves, amplitude, 0.5f, 0.0).value;
+float raggedness(double x, double y) {
+  // 6 octaves, Hurst 0.5: a standard deviation of 1/2, so a bound moved by
+  // jitter x this stays within about +-jitter.
+  constexpr Octaves octaves{800.0, 25.0, 0x7a66ed00u};
+  constexpr float amplitude = 0.5f / (kNoiseStd * 1.4036f);  // sqrt(1.97)
+  return filtered_noise(x, y, octaves, amplitude, 0.5f, 0.0).value;
 }
 
 }  // namespace drift::render

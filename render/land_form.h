@@ -9,7 +9,7 @@
 // patches lasting into autumn in cirques and gullies (Higuchi & Iozawa 1971,
 // "Atlas of perennial snow patches in central Japan", Nagoya University).
 // Zone edges are ragged in nature: a rule's altitude bounds can be
-// jittered by noise of the ground position (ragged_altitude).
+// jittered by noise of the ground position (raggedness).
 #pragma once
 
 #include <cstddef>
@@ -23,9 +23,11 @@ namespace drift::render {
 // and kept NaN), in the DEM's georeference. Summed-area table, O(cells).
 terrain::HeightField topographic_position(const terrain::HeightField& dem, double radius_metres);
 
-// `altitude` moved by up to about +-`jitter` metres by smooth noise of the
-// ground position (wavelengths 800 m to 25 m), different for each `rule`,
-// so that a tree line or a snow line follows the terrain raggedly.
-float ragged_altitude(float altitude, float jitter, double x, double y, std::size_t rule);
+// Smooth noise of the ground position (wavelengths 800 m to 25 m, standard
+// deviation 1/2, within about +-1): a rule's altitude bounds move by its
+// `altitude_jitter` times this, so that a tree line or a snow line follows
+// the terrain raggedly. One field for all rules, so zones shift together
+// (a warm, sheltered slope lifts the forest line and the meadows alike).
+float raggedness(double x, double y);
 
 }  // namespace drift::render

@@ -32,7 +32,8 @@ PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const
     parameters.aerosol_scale = input.sky.haze;
     atmosphere_ = std::make_unique<Atmosphere>(parameters);
     const double camera_altitude = scene.origin().z() + camera.eye.z();
-    const double reach = camera.eye.head<2>().norm() + scene.extent().norm();
+    const double reach = camera.eye.head<2>().norm() + scene.extent().norm() +
+                           scene.surround_reach();  // the ground beyond the DEM (render/surround.h)
     air_ = std::make_unique<PhysicalSky>(*atmosphere_, camera_altitude, sun_dir_.cast<double>(),
                                          static_cast<float>(sun.irradiance), reach);
   }
@@ -40,7 +41,7 @@ PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const
   // Light shafts: what the terrain's shadow takes from a camera ray's air.
   shafts_ = air_ && input.sky.light_shafts && sun_up_;
   shadow_slab_ = {scene.bottom(), scene.top()};
-  air_reach_ = camera.eye.head<2>().norm() + scene.extent().norm();
+  air_reach_ = camera.eye.head<2>().norm() + scene.extent().norm() + scene.surround_reach();
   // The sky as a light, tabulated once for this camera and sun and
   // importance-sampled at every vertex (render/sky_sampler.h).
   if (settings.sample_sky) sky_sampler_.emplace([this](const Vector3f& d) { return sky_light(d); });

@@ -11,8 +11,10 @@ namespace {
 
 // Lattice value in [-1, 1] of cell (i, j).
 float lattice(std::int64_t i, std::int64_t j, std::uint64_t seed) {
-  const std::uint64_t h = terrain::mix64(terrain::mix64(seed ^ static_cast<std::uint64_t>(i)) ^
-                                (static_cast<std::uint64_t>(j) * 0x9e3779b97f4a7c15ULL));
+  // One SplitMix finalisation of the cell's two odd-constant multiples
+  // (Weyl sequences) and the seed: cheap, and uncorrelated enough for noise.
+  const std::uint64_t h = terrain::mix64(seed ^ (static_cast<std::uint64_t>(i) * 0xd1b54a32d192ed03ULL) ^
+                                         (static_cast<std::uint64_t>(j) * 0x9e3779b97f4a7c15ULL));
   return static_cast<float>(h >> 40) * (2.0f / 16777216.0f) - 1.0f;
 }
 
@@ -48,9 +50,9 @@ FilteredNoise filtered_noise(double x, double y, const Octaves& o, float amplitu
   FilteredNoise out;
   const int count = octave_count(o);
   double wavelength = o.largest;
-  for (int i = 0; i < count; ++i, wavelength *= 0.5) {
-    const float amplitude =
-        amplitude_at_largest * static_cast<float>(std::pow(wavelength / o.largest, hurst));
+  const float ratio = std::exp2(-hurst);  // amplitude from one octave to the next
+  float amplitude = amplitude_at_largest;
+  for (int i = 0; i < count; ++i, wavelength *= 0.5, amplitude *= ratio) {
     // Kept whole above two footprints, gone below one (a mip-map's blend).
     const float keep =
         footprint > 0.0 ? static_cast<float>(std::clamp(wavelength / footprint - 1.0, 0.0, 1.0))

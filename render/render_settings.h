@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "render/surface.h"
+#include "render/surround.h"
 #include "terrain/grid.h"
 #include "terrain/mesh.h"
 
@@ -83,6 +84,7 @@ struct SceneInput {
   terrain::HeightField terrain;  // metric CRS (or local), heights in metres
   double vertical_exaggeration = 1.0;
   TerrainSurface surface;  // materials and the layers that place them
+  SurroundOptions surround;  // the ground beyond the DEM's edge (render/surround.h)
   std::vector<terrain::PlacedMesh> meshes;
   Sun sun;
   Sky sky;

@@ -92,9 +92,13 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
     if (channels) cover(p.coverage, (channels->*entries)[i], w);
   };
   const float position = surface.position ? sample_raster(*surface.position, x, y, 0.0f) : 0.0f;
+  float ragged = NAN;  // raggedness(x, y), evaluated once if a rule asks
   for (std::size_t i = 0; i < surface.rules.size(); ++i) {
     const MaterialRule& rule = surface.rules[i];
-    const float altitude = ragged_altitude(relief.altitude, rule.altitude_jitter, x, y, i);
+    if (rule.altitude_jitter > 0.0f && std::isnan(ragged)) ragged = raggedness(x, y);
+    const float altitude = rule.altitude_jitter > 0.0f
+                               ? relief.altitude + rule.altitude_jitter * ragged
+                               : relief.altitude;
     put_on_top(rule.material, rule.weight(altitude, relief.slope_deg, position),
                &CoverageChannels::rules, i);
   }
@@ -145,7 +149,8 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   SurfacePoint p;
   p.normal = normal;
   p.snow = surface.snow_cover
-               ? std::clamp(sample_raster(*surface.snow_cover, x, y, 0.0f), 0.0f, 1.0f)
+               ? std::clamp(sample_raster(*surface.snow_cover, x, y, surface.snow_cover_outside),
+                            0.0f, 1.0f)
                : 0.0f;
   Material ground = base_material(surface, x, y);
   if (channels) p.coverage[channels->ground] = 1.0f;

@@ -54,6 +54,9 @@ struct TerrainSurface {
   // over black rock then reflects 0.79 where deep snow reflects 0.90.
   float snow_scattering = 400.0f;
   std::optional<terrain::HeightField> snow_cover;  // [0, 1]: snow's share of the surface
+  // The cover where the raster does not reach (beyond a cropped snowfall,
+  // on the ground around the DEM: render/surround.h).
+  float snow_cover_outside = 0.0f;
   std::optional<terrain::HeightField> snow_depth;  // metres, raises the surface
   std::optional<RippleLayer> ripples;
   // The ground's albedo draped from an image in the DEM's CRS (an orthophoto

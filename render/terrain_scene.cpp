@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include "terrain/bilinear.h"
@@ -41,6 +42,7 @@ struct TerrainScene::Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<RTCGrid> grids;
+  std::vector<RTCGrid> surround_grids;
   ~Embree() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -65,6 +67,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   embree_->scene = rtcNewScene(embree_->device);
   rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
   attach_terrain_grids();
+  attach_surround(input.surround);
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
   rtcCommitScene(embree_->scene);
   check_device(embree_->device, "build the scene");
@@ -153,6 +156,30 @@ void TerrainScene::attach_terrain_grids() {
   mesh_snow_triangles_.emplace_back();
 }
 
+void TerrainScene::attach_surround(const SurroundOptions& options) {
+  DemVertices dem{&vertices_, width_, height_, dx_, dy_, origin_, exaggeration_};
+  SurroundGrids ring = build_surround(dem, options);
+  if (ring.grids.empty()) return;
+  surround_vertices_ = std::move(ring.vertices);
+  std::vector<RTCGrid>& grids = embree_->surround_grids;
+  for (const SurroundGrids::Grid& g : ring.grids)
+    grids.push_back({g.start, g.stride, g.width, g.height});
+  RTCGeometry geometry = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_GRID);
+  rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                             surround_vertices_.data(), 0, sizeof(Eigen::Vector3f),
+                             surround_vertices_.size());
+  rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID, grids.data(), 0,
+                             sizeof(RTCGrid), grids.size());
+  rtcCommitGeometry(geometry);
+  surround_geometry_ = rtcAttachGeometry(embree_->scene, geometry);
+  rtcReleaseGeometry(geometry);
+  surround_reach_ = ring.reach;
+  // Keep the per-geometry tables indexed by id.
+  mesh_albedo_.resize(surround_geometry_ + 1, surface_.ground.albedo);
+  mesh_snow_.resize(surround_geometry_ + 1);
+  mesh_snow_triangles_.resize(surround_geometry_ + 1);
+}
+
 void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
   // Triangle geometry with its own (copied, shifted) buffers.
   RTCGeometry geom = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -222,8 +249,11 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;
-  const Eigen::Vector3f n = rh.hit.geomID < terrain_geometries_
-                                ? shade_terrain_hit(hit, cone)
+  const bool surround = rh.hit.geomID == surround_geometry_;
+  std::optional<Eigen::Vector3f> facet;  // beyond the DEM: its facets' normal, facing up
+  if (surround) facet = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+  const Eigen::Vector3f n = rh.hit.geomID < terrain_geometries_ || surround
+                                ? shade_terrain_hit(hit, cone, facet)
                                 : shade_mesh_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v,
                                                  {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, hit);
   // Face the ray: a mesh may be seen from either side, and terrain from below
@@ -232,14 +262,17 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   return true;
 }
 
-Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone) const {
-  // Smooth shading: bilinear vertex normals at the hit's cell position.
+Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
+                                                const std::optional<Eigen::Vector3f>& facet) const {
+  // Smooth shading: bilinear vertex normals at the hit's cell position (on
+  // the DEM), or the facet's normal turned up (beyond it).
   const auto nw = vertices_.front();
   auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
   const Eigen::Vector3f n =
-      terrain::bilinear_clamped(vn, width_, height_, (hit.position.x() - nw.x()) / dx_,
-                                (nw.y() - hit.position.y()) / dy_)
-          .normalized();
+      facet ? (facet->z() < 0.0f ? Eigen::Vector3f(-*facet) : *facet)
+            : terrain::bilinear_clamped(vn, width_, height_, (hit.position.x() - nw.x()) / dx_,
+                                        (nw.y() - hit.position.y()) / dy_)
+                  .normalized();
   const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
   // Material rules see the real relief: heights and slopes without the
   // vertical exaggeration (n ~ (-k Zx, -k Zy, 1)).

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "render/render_settings.h"
@@ -66,6 +67,8 @@ class TerrainScene {
   // The names of Hit::coverage's channels (render/coverage.h).
   const std::vector<std::string>& coverage_names() const { return coverage_.names; }
   float top() const { return top_; }
+  // Metres the ground reaches beyond the DEM's edge (render/surround.h).
+  float surround_reach() const { return surround_reach_; }
 
  private:
   // The constructor's steps: checks the raster's shape and takes its size;
@@ -80,7 +83,8 @@ class TerrainScene {
   // `cone`) or on mesh `geometry`'s `triangle` at barycentrics (u, v) with
   // geometric normal `ng`; each returns the shading normal, not yet facing
   // the ray.
-  Eigen::Vector3f shade_terrain_hit(Hit& hit, const RayCone& cone) const;
+  Eigen::Vector3f shade_terrain_hit(Hit& hit, const RayCone& cone,
+                                    const std::optional<Eigen::Vector3f>& facet = {}) const;
   Eigen::Vector3f shade_mesh_hit(unsigned geometry, unsigned triangle, float u, float v,
                                  const Eigen::Vector3f& ng, Hit& hit) const;
 
@@ -103,6 +107,12 @@ class TerrainScene {
   std::vector<std::vector<float>> mesh_snow_;
   std::vector<std::vector<std::array<int, 3>>> mesh_snow_triangles_;
   unsigned terrain_geometries_ = 0;  // geometry ids [0, n) are terrain grids
+  // The ground beyond the DEM's edge (render/surround.h): its vertex buffer,
+  // grids and Embree geometry id (none: -1).
+  void attach_surround(const SurroundOptions& options);
+  std::vector<Eigen::Vector3f> surround_vertices_;
+  unsigned surround_geometry_ = ~0u;
+  float surround_reach_ = 0.0f;
   Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};
   float bottom_ = 0.0f, top_ = 0.0f;
   Eigen::Vector2f extent_{0, 0};

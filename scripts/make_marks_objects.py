@@ -8,23 +8,13 @@ repository root: python3 scripts/make_marks_objects.py"""
 import math
 import os
 
+import make_objects
+
 OUT = os.path.join(os.path.dirname(__file__), "..", "data", "objects")
 
 
-class Obj:
-    def __init__(self):
-        self.v, self.f = [], []
-
-    def vert(self, p):
-        self.v.append(p)
-        return len(self.v)  # OBJ indices are 1-based
-
-    def tri(self, a, b, c):
-        self.f.append((a, b, c))
-
-    def quad(self, a, b, c, d):
-        self.tri(a, b, c)
-        self.tri(a, c, d)
+class Obj(make_objects.Obj):
+    """make_objects' mesh builder, written at the finer precision marks need."""
 
     def write(self, name, comment):
         path = os.path.join(OUT, name)

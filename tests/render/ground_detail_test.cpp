@@ -48,7 +48,8 @@ void expect_cell_mean_kept(const GroundDetail& d);
 TEST(GroundDetail, CellScaleMeanSlopeIsKept) {
   // The relief's slope averaged over a DEM cell (10 m) is ~0: the mean
   // surface stays the DEM's. Point samples over 40 cells far from the origin.
-  for (const char* name : {"dark_rock", "scree", "meadow", "dwarf_pine", "forest"}) {
+  for (const char* name : {"rock", "dark_rock", "scree", "meadow", "dwarf_pine", "forest", "mud",
+                           "grass", "snow"}) {
     SCOPED_TRACE(name);
     expect_cell_mean_kept(material_preset(name)->detail);
   }
@@ -174,19 +175,19 @@ TEST(LandForm, TopographicPositionOfPlaneAndValley) {
   EXPECT_THROW(topographic_position(plane, 0.0), Error);
 }
 
-TEST(LandForm, RaggedAltitudeStaysNearTheBound) {
+TEST(LandForm, RaggednessIsSmoothBoundedNoise) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0.0, 20000.0);
-  double s = 0, worst = 0;
-  for (int i = 0; i < 20000; ++i) {
-    const double d = ragged_altitude(2500.0f, 100.0f, u(rng), u(rng), 2) - 2500.0;
-    s += d, worst = std::max(worst, std::abs(d));
+  double s = 0, s2 = 0, worst = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const double r = raggedness(u(rng), u(rng));
+    s += r, s2 += r * r, worst = std::max(worst, std::abs(r));
   }
-  EXPECT_NEAR(s / 20000, 0.0, 5.0);
-  EXPECT_LT(worst, 200.0);
-  EXPECT_GT(worst, 40.0);
-  EXPECT_EQ(ragged_altitude(2500.0f, 0.0f, 1.0, 2.0, 0), 2500.0f);
-  EXPECT_EQ(ragged_altitude(2500.0f, 50.0f, 1.0, 2.0, 0), ragged_altitude(2500.0f, 50.0f, 1.0, 2.0, 0));
+  EXPECT_NEAR(s / n, 0.0, 0.05);
+  EXPECT_NEAR(std::sqrt(s2 / n), 0.5, 0.1);
+  EXPECT_LT(worst, 2.0);
+  EXPECT_EQ(raggedness(1.0, 2.0), raggedness(1.0, 2.0));
 }
 
 }  // namespace

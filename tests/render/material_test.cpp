@@ -13,6 +13,11 @@ using namespace drift::render;
 using drift::terrain::HeightField;
 using drift::terrain::local_georeference;
 
+// A footprint so wide that the ground's procedural detail is its mean
+// (albedo factor 1, no relief: render/ground_detail.h), for tests of the
+// material stack itself.
+constexpr double kWholeDetail = 1e6;
+
 TEST(MaterialPresets, KnownNamesWithPlausibleAlbedos) {
   EXPECT_EQ(material_preset_names(),
             "rock, dark_rock, scree, meadow, dwarf_pine, forest, sand, mud, grass, snow");
@@ -27,7 +32,7 @@ TEST(MaterialPresets, KnownNamesWithPlausibleAlbedos) {
   EXPECT_LT(lum(*material_preset("forest")), 0.05f);
   EXPECT_GT(material_preset("dwarf_pine")->albedo.y(), material_preset("dwarf_pine")->albedo.x());
   EXPECT_GT(material_preset("meadow")->albedo.x(), material_preset("meadow")->albedo.z());
-  for (const char* name : {"dark_rock", "scree", "meadow", "dwarf_pine", "forest"}) {
+  for (const char* name : {"rock", "dark_rock", "scree", "meadow", "dwarf_pine", "forest"}) {
     EXPECT_GT(material_preset(name)->detail.variation, 0.0f) << name;
     EXPECT_GT(material_preset(name)->detail.bump, 0.0f) << name;
     EXPECT_LE(material_preset(name)->detail.scale, 10.0f) << name;  // below a 10 m cell
@@ -52,6 +57,7 @@ TEST(MaterialRules, SoftRangesAndLaterRulesWin) {
   // Grass below 2000 m, rock on slopes over 35 degrees (wins where both hold).
   MaterialRule grass, rock;
   grass.material = full_override(*material_preset("grass"));
+  grass.material.detail = GroundDetail{};  // the stack alone, no sub-cell relief
   grass.altitude = {-1e9f, 2000.0f, 100.0f};
   rock.material.albedo = material_preset("rock")->albedo;  // colour only
   rock.slope = {35.0f, 90.0f, 0.0f};
@@ -60,7 +66,7 @@ TEST(MaterialRules, SoftRangesAndLaterRulesWin) {
   surface.rules = {grass, rock};
   const Material& base = surface.ground;
   auto apply_rules = [&](float altitude, float slope) {
-    return shade_terrain(surface, 0.0, 0.0, Eigen::Vector3f(0, 0, 1), 0.0, {altitude, slope})
+    return shade_terrain(surface, 0.0, 0.0, Eigen::Vector3f(0, 0, 1), kWholeDetail, {altitude, slope})
         .material;
   };
   EXPECT_EQ(apply_rules(1500.0f, 10.0f).albedo, material_preset("grass")->albedo);
@@ -118,16 +124,16 @@ TEST(MaterialLayers, MasksBlendInOrderUnderSnow) {
   wet.opacity = 0.6f;
   s.layers = {sand, wet};
   const Eigen::Vector3f up(0, 0, 1);
-  const Material west = shade_terrain(s, 5.0, -15.0, up, 0.0).material;
-  const Material east = shade_terrain(s, 35.0, -15.0, up, 0.0).material;
+  const Material west = shade_terrain(s, 5.0, -15.0, up, kWholeDetail).material;
+  const Material east = shade_terrain(s, 35.0, -15.0, up, kWholeDetail).material;
   EXPECT_EQ(west.albedo, material_preset("sand")->albedo);
   EXPECT_FLOAT_EQ(west.wetness, 0.6f);
   EXPECT_EQ(east.albedo, s.ground.albedo);
   EXPECT_FLOAT_EQ(east.wetness, 0.6f);
-  EXPECT_EQ(shade_terrain(s, 500.0, -15.0, up, 0.0).material.wetness, 0.0f);  // off the masks
+  EXPECT_EQ(shade_terrain(s, 500.0, -15.0, up, kWholeDetail).material.wetness, 0.0f);  // off the masks
   // Snow covers everything.
   s.snow_cover = HeightField(4, 4, 1.0f, local_georeference(10.0));
-  EXPECT_EQ(shade_terrain(s, 5.0, -15.0, up, 0.0).material.albedo, s.snow.albedo);
+  EXPECT_EQ(shade_terrain(s, 5.0, -15.0, up, kWholeDetail).material.albedo, s.snow.albedo);
 }
 
 TEST(Coverage, SharesFollowTheStackAndSumToOne) {
@@ -155,7 +161,7 @@ TEST(Coverage, SharesFollowTheStackAndSumToOne) {
   EXPECT_EQ(c.rules, (std::vector<int>{1, 0}));
   const Eigen::Vector3f up(0, 0, 1);
   auto shares = [&](float altitude, float slope) {
-    return shade_terrain(s, 5.0, -15.0, up, 0.0, {altitude, slope}, &c).coverage;
+    return shade_terrain(s, 5.0, -15.0, up, kWholeDetail, {altitude, slope}, &c).coverage;
   };
   // Low and gentle: grass, then half of it under the wet layer, then 20 % snow.
   const Coverage low = shares(1000.0f, 10.0f);
@@ -210,8 +216,8 @@ TEST(SnowLayer, ADepthRasterMakesThinSnowGrey) {
   s.snow_depth = HeightField(4, 4, 0.002f, drift::terrain::local_georeference(1.0));
   for (int row = 0; row < 4; ++row) (*s.snow_depth)(3, row) = (*s.snow_depth)(2, row) = 0.2f;
   const Eigen::Vector3f up(0, 0, 1);
-  const float thin = shade_terrain(s, 0.5, -1.5, up, 0.1).material.albedo.x();
-  const float deep = shade_terrain(s, 3.5, -1.5, up, 0.1).material.albedo.x();
+  const float thin = shade_terrain(s, 0.5, -1.5, up, kWholeDetail).material.albedo.x();
+  const float deep = shade_terrain(s, 3.5, -1.5, up, kWholeDetail).material.albedo.x();
   EXPECT_NEAR(deep, s.snow.albedo.x(), 1e-3f);
   EXPECT_LT(thin, 0.6f * deep);
   EXPECT_GT(thin, s.ground.albedo.x());

@@ -20,6 +20,11 @@ using namespace drift::render;
 using drift::terrain::HeightField;
 using drift::terrain::local_georeference;
 
+// A footprint so wide that the ground's procedural detail is its mean
+// (albedo factor 1, no relief: render/ground_detail.h), for tests of the
+// material stack itself.
+constexpr double kWholeDetail = 1e6;
+
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -191,6 +196,7 @@ TEST(Snow, CoverBlendsTheMaterialAndDepthRaisesTheSurface) {
     for (int x = 0; x < 16; ++x) cover(x, row) = 1.0f, depth(x, row) = 2.0f;
   in.surface.snow_cover = cover;
   in.surface.snow_depth = depth;
+  in.surface.snow.detail = {};  // the snow's own albedo, without its variation
   in.sky.constant = true;
   const TerrainScene scene(in);
   Hit west, east;
@@ -225,9 +231,9 @@ TEST(AlbedoMap, ADrapedImageColoursTheGroundAndDecodesSrgb) {
   TerrainSurface s;
   s.albedo_map = read_albedo_map(path);
   const Eigen::Vector3f up(0, 0, 1);
-  const Eigen::Vector3f west = shade_terrain(s, 5.0, -15.0, up, 0.0).material.albedo;
-  const Eigen::Vector3f east = shade_terrain(s, 35.0, -15.0, up, 0.0).material.albedo;
-  const Eigen::Vector3f outside = shade_terrain(s, 500.0, -15.0, up, 0.0).material.albedo;
+  const Eigen::Vector3f west = shade_terrain(s, 5.0, -15.0, up, kWholeDetail).material.albedo;
+  const Eigen::Vector3f east = shade_terrain(s, 35.0, -15.0, up, kWholeDetail).material.albedo;
+  const Eigen::Vector3f outside = shade_terrain(s, 500.0, -15.0, up, kWholeDetail).material.albedo;
   EXPECT_NEAR(west.x(), srgb_decode(200.0f / 255.0f), 1e-6f);
   EXPECT_NEAR(west.y(), 0.0f, 1e-6f);
   EXPECT_NEAR(east.y(), srgb_decode(128.0f / 255.0f), 1e-6f);    // 0.216: sRGB decoded
