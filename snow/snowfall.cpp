@@ -177,6 +177,7 @@ void SnowfallOptions::validate() const {
   check(coverage.adhesion_depth > 0, "coverage.adhesion_depth", coverage.adhesion_depth,
         "(0, inf) m");
   check(tolerance > 0, "tolerance", tolerance, "(0, inf) m");
+  check(ground_tolerance > 0, "ground_tolerance", ground_tolerance, "(0, inf) m");
   check(max_iterations >= 1, "max_iterations", max_iterations, "[1, inf)");
 }
 
@@ -218,7 +219,9 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   if (!report(0.65, "snow on objects")) throw Cancelled();
 
   // Ground (paper 2.2(3)).
-  const StabiliseReport gr = stabilise_grid(scene.ground, snow, scene.dx, scene.dy, stabilise,
+  StabiliseOptions ground_rule = stabilise;
+  ground_rule.tolerance = options.ground_tolerance;
+  const StabiliseReport gr = stabilise_grid(scene.ground, snow, scene.dx, scene.dy, ground_rule,
                                             scaled_progress(report, 0.65, 0.95));
   result.ground_iterations = gr.iterations;
   result.converged = result.converged && gr.converged;

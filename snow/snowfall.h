@@ -53,7 +53,10 @@ struct SnowfallOptions {
   double mesh_max_edge = 0.25;
   ProbabilityOptions occlusion;
   CoverageOptions coverage;
-  double tolerance = 1e-6;  // m: stabilisation stops when nothing moves more per pass
+  double tolerance = 1e-6;  // m: object stabilisation stops when nothing moves more per pass
+  // m: on the ground a pair steeper than repose by less than this, or a film
+  // thinner, is stable (stabilise_grid.h)
+  double ground_tolerance = 1e-3;
   int max_iterations = 100000;
 
   // Throws drift::Error naming the parameter, its value and the valid range.

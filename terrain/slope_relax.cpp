@@ -1,195 +1,399 @@
 #include "terrain/slope_relax.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 
 namespace drift::terrain {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kTile = 16;
+// Tiles in a phase below which it runs on the calling thread (marks' small
+// windows): the result is the same either way.
+constexpr std::size_t kParallelTiles = 32;
 
 struct Neighbour {
   int dx, dy;
 };
+// Neighbour k and neighbour 7 - k are opposite.
 constexpr std::array<Neighbour, 8> kNeighbours{
     {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}}};
 
-struct Flow {
-  int from, to;
-  double amount;  // m of height
-};
-
-const SlopeRule& rule_at(const SlopeCells& cells, int index) {
-  if (!cells.rule_of_cell) return cells.rules[0];
-  return cells.rules[cells.rule_of_cell->values()[static_cast<std::size_t>(index)]];
+template <class Fn>
+void for_tiles(const std::vector<int>& tiles, const Fn& fn) {
+  if (tiles.size() < kParallelTiles) {
+    for (int t : tiles) fn(t);
+    return;
+  }
+  tbb::parallel_for(std::size_t{0}, tiles.size(), [&](std::size_t k) { fn(tiles[k]); });
 }
 
-double bound(const Grid<double>* grid, int index, double none) {
-  return grid ? grid->values()[static_cast<std::size_t>(index)] : none;
+template <class Fn>
+void for_each_index(std::size_t count, const Fn& fn) {
+  if (count < kParallelTiles) {
+    for (std::size_t k = 0; k < count; ++k) fn(k);
+    return;
+  }
+  tbb::parallel_for(std::size_t{0}, count, fn);
 }
 
 }  // namespace
 
-void SlopeRelaxWorkspace::fit(std::size_t cells) {
-  if (seen_.size() == cells) return;
-  seen_.assign(cells, 0);
-  in_.assign(cells, 0.0);
-  in_excess_.assign(cells, 0.0);
-  epoch_ = 0;
+void SlopeRelaxWorkspace::fit(int width, int height) {
+  if (width == width_ && height == height_) return;
+  width_ = width, height_ = height;
+  tiles_x_ = (width + kTile - 1) / kTile, tiles_y_ = (height + kTile - 1) / kTile;
+  const std::size_t cells = static_cast<std::size_t>(width) * height;
+  const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
+  give_.assign(cells, 0.0), take_.assign(cells, 0.0), delta_.assign(cells, 0.0);
+  active_.assign(cells, 0), touched_.assign(cells, 0), ever_.assign(cells, 0);
+  tile_active_.assign(tiles, 0), tile_touched_.assign(tiles, 0);
+  tile_ever_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
 }
 
-// One relaxation call's passes over its workspace.
-struct SlopeRelaxPass {
-  Grid<double>& h;
-  const SlopeCells& cells;
-  const SlopeRelaxOptions& o;
-  SlopeRelaxWorkspace& ws;
-  std::array<double, 8> distance{};
-  std::vector<Flow> flows;
-  std::vector<int> receivers;
-
-  SlopeRelaxPass(Grid<double>& heights, const SlopeCells& c, const SlopeRelaxOptions& options,
-                 SlopeRelaxWorkspace& w)
-      : h(heights), cells(c), o(options), ws(w) {
+// One relaxation call: the field, its rules and the phases of a pass.
+class SlopeRelaxer {
+ public:
+  SlopeRelaxer(Grid<double>& heights, const SlopeCells& cells, const SlopeRelaxOptions& options,
+               SlopeRelaxWorkspace& ws, Grid<float>* disturbed, const SlopePassFn& on_pass)
+      : h_(heights.values()),
+        cells_(cells),
+        o_(options),
+        ws_(ws),
+        disturbed_(disturbed),
+        on_pass_(on_pass),
+        w_(heights.width()),
+        hgt_(heights.height()) {
     for (int k = 0; k < 8; ++k)
-      distance[k] = std::hypot(kNeighbours[k].dx * o.dx, kNeighbours[k].dy * o.dy);
+      distance_[k] = std::hypot(kNeighbours[k].dx * o_.dx, kNeighbours[k].dy * o_.dy);
   }
 
-  std::uint32_t next_epoch() {
-    if (++ws.epoch_ == 0) std::fill(ws.seen_.begin(), ws.seen_.end(), 0), ws.epoch_ = 1;
-    return ws.epoch_;
+  void seed(int index) {
+    ws_.active_[static_cast<std::size_t>(index)] = 1;
+    ws_.tile_active_[tile_of(index % w_, index / w_)] = 1;
   }
-  // Appends `index` to `list` unless it is already there this epoch.
-  void list_once(int index, std::vector<int>& list) {
-    std::uint32_t& s = ws.seen_[static_cast<std::size_t>(index)];
-    if (s != ws.epoch_) s = ws.epoch_, list.push_back(index);
+  void seed_all() {
+    std::fill(ws_.active_.begin(), ws_.active_.end(), 1);
+    std::fill(ws_.tile_active_.begin(), ws_.tile_active_.end(), 1);
   }
 
-  void clear_offers() {
-    for (int n : receivers) {
-      ws.in_[static_cast<std::size_t>(n)] = 0.0;
-      ws.in_excess_[static_cast<std::size_t>(n)] = 0.0;
+  SlopeRelaxReport run() {
+    SlopeRelaxReport report;
+    std::vector<int> active = tiles_where(ws_.tile_active_);
+    while (!active.empty() && report.passes < o_.max_passes) {
+      ++report.passes;
+      report.moved += pass(active);
+      active = next_active(active);
+      if (on_pass_)
+        on_pass_(report.passes, static_cast<double>(active.size()) / ws_.tile_active_.size());
     }
+    report.converged = active.empty();
+    for (int t : active) clear_active(t);  // stopped by max_passes
+    return report;
   }
 
-  // The flows out of one cell, scaled so that it gives at most half its largest
-  // excess and never sinks below its floor; a cell at its ceiling is held.
-  void donor_flows(int index) {
-    const SlopeRule& rule = rule_at(cells, index);
-    if (!std::isfinite(rule.tan_repose)) return;
-    const int w = h.width(), x = index % w, y = index / w;
-    const double hc = h.values()[static_cast<std::size_t>(index)];
-    if (hc >= bound(cells.ceiling, index, kInf)) return;
-    const std::size_t first = flows.size();
-    double out = 0.0, largest = 0.0;
+  // The cells that gave or took in any pass, ascending; clears their marks.
+  void collect_moved(std::vector<int>& out) {
+    out.clear();
+    for (int t : tiles_where(ws_.tile_ever_)) {
+      ws_.tile_ever_[static_cast<std::size_t>(t)] = 0;
+      for_cells(t, [&](std::size_t i, int, int) {
+        if (ws_.ever_[i]) out.push_back(static_cast<int>(i)), ws_.ever_[i] = 0;
+      });
+    }
+    std::sort(out.begin(), out.end());
+  }
+
+ private:
+  std::size_t tile_of(int x, int y) const {
+    return static_cast<std::size_t>(y / kTile) * ws_.tiles_x_ + x / kTile;
+  }
+  template <class Fn>
+  void for_cells(int tile, const Fn& fn) const {
+    const int x0 = tile % ws_.tiles_x_ * kTile, y0 = tile / ws_.tiles_x_ * kTile;
+    for (int y = y0; y < std::min(y0 + kTile, hgt_); ++y)
+      for (int x = x0; x < std::min(x0 + kTile, w_); ++x)
+        fn(static_cast<std::size_t>(y) * w_ + x, x, y);
+  }
+  std::vector<int> tiles_where(const std::vector<std::uint8_t>& flag) const {
+    std::vector<int> out;
+    for (std::size_t t = 0; t < flag.size(); ++t)
+      if (flag[t]) out.push_back(static_cast<int>(t));
+    return out;
+  }
+  // The tiles of `tiles` and their 8 neighbours, ascending.
+  std::vector<int> with_neighbours(const std::vector<int>& tiles) {
+    std::vector<int> out;
+    for (int t : tiles) {
+      const int tx = t % ws_.tiles_x_, ty = t / ws_.tiles_x_;
+      for (int j = std::max(ty - 1, 0); j <= std::min(ty + 1, ws_.tiles_y_ - 1); ++j)
+        for (int i = std::max(tx - 1, 0); i <= std::min(tx + 1, ws_.tiles_x_ - 1); ++i) {
+          std::uint8_t& mark = ws_.tile_mark_[static_cast<std::size_t>(j) * ws_.tiles_x_ + i];
+          if (!mark) mark = 1, out.push_back(j * ws_.tiles_x_ + i);
+        }
+    }
+    for (int t : out) ws_.tile_mark_[static_cast<std::size_t>(t)] = 0;
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < w_ && y < hgt_; }
+  const SlopeRule& rule_at(std::size_t i) const {
+    return cells_.rule_of_cell ? cells_.rules[cells_.rule_of_cell->values()[i]] : cells_.rules[0];
+  }
+  double ceiling(std::size_t i) const {
+    return cells_.ceiling ? cells_.ceiling->values()[i] : kInf;
+  }
+  double floor(std::size_t i) const {
+    return std::max(cells_.floor ? cells_.floor->values()[i] : -kInf, cells_.min_value);
+  }
+  double surface(std::size_t i) const {
+    return cells_.base ? static_cast<double>(cells_.base->values()[i]) + h_[i] : h_[i];
+  }
+  // Whether cell i may give this pass (its rule, its ceiling, active).
+  bool giver(std::size_t i) const {
+    return ws_.active_[i] && std::isfinite(rule_at(i).tan_repose) && h_[i] < ceiling(i);
+  }
+  // Excess of the slope from cell i (surface hi) to its neighbour n in direction k,
+  // written once so that giver and taker get the same bits.
+  double excess(double hi, std::size_t n, const SlopeRule& r, int k) const {
+    return hi - surface(n) - r.tan_repose * distance_[k];
+  }
+  std::size_t neighbour(int x, int y, int k) const {
+    return static_cast<std::size_t>(y + kNeighbours[k].dy) * w_ + (x + kNeighbours[k].dx);
+  }
+
+  // Phase 1: a giver's factor. Fraction: the scale keeping its flows within half
+  // its largest excess and its floor; HalfSteepest: min(room, e_max / 2) / sum e.
+  double give_factor(std::size_t i, int x, int y) const {
+    const SlopeRule& r = rule_at(i);
+    const double hi = surface(i), room = std::max(h_[i] - floor(i), 0.0);
+    double sum = 0.0, largest = 0.0;
     for (int k = 0; k < 8; ++k) {
-      const int nx = x + kNeighbours[k].dx, ny = y + kNeighbours[k].dy;
-      if (nx < 0 || ny < 0 || nx >= w || ny >= h.height()) continue;
-      const int n = ny * w + nx;
-      const double e = hc - h.values()[static_cast<std::size_t>(n)] - rule.tan_repose * distance[k];
-      if (e <= o.tolerance) continue;
-      flows.push_back({index, n, rule.fraction * e});
-      out += rule.fraction * e;
+      if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
+      const double e = excess(hi, neighbour(x, y, k), r, k);
+      if (e <= o_.tolerance) continue;
+      sum += r.share == SlopeShare::Fraction ? r.fraction * e : e;
       largest = std::max(largest, e);
-      if (ws.in_[static_cast<std::size_t>(n)] == 0.0) receivers.push_back(n);
-      ws.in_[static_cast<std::size_t>(n)] += rule.fraction * e;  // before the donor's scale
-      double& ex = ws.in_excess_[static_cast<std::size_t>(n)];
-      ex = std::max(ex, e);
     }
-    if (out <= 0.0) return;
-    const double room = hc - bound(cells.floor, index, -kInf);
-    const double scale = std::min({1.0, 0.5 * largest / out, std::max(room, 0.0) / out});
-    if (scale < 1.0)
-      for (std::size_t i = first; i < flows.size(); ++i) flows[i].amount *= scale;
+    if (sum <= 0.0) return 0.0;
+    // Paper 003: a film thinner than the tolerance is as good as bare (it would
+    // trickle on for ever in amounts nobody can see).
+    if (r.share == SlopeShare::HalfSteepest)
+      return room > o_.tolerance ? std::min(room, 0.5 * largest) / sum : 0.0;
+    return std::min({1.0, 0.5 * largest / sum, room / sum});
+  }
+  // What giver n offers for excess e before its scaling, and what flows.
+  double offer(std::size_t n, double e) const {
+    const SlopeRule& r = rule_at(n);
+    return r.share == SlopeShare::Fraction ? r.fraction * e : ws_.give_[n] * e;
+  }
+  double flow(std::size_t n, double e, std::size_t to) const {
+    const SlopeRule& r = rule_at(n);
+    const double given =
+        r.share == SlopeShare::Fraction ? r.fraction * e * ws_.give_[n] : ws_.give_[n] * e;
+    return given * ws_.take_[to];
+  }
+  // Calls fn(n, e) for every giver next to cell i with excess e towards it.
+  template <class Fn>
+  void for_offers(std::size_t i, int x, int y, const Fn& fn) const {
+    for (int k = 0; k < 8; ++k) {
+      if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
+      const std::size_t n = neighbour(x, y, k);
+      if (!giver(n)) continue;
+      const double e = excess(surface(n), i, rule_at(n), 7 - k);
+      if (e > o_.tolerance) fn(n, e);
+    }
+  }
+  // Phase 2: the share of its offers a taker takes (half the largest excess it is
+  // offered from, its ceiling).
+  double take_share(std::size_t i, int x, int y) const {
+    double in = 0.0, largest = 0.0;
+    for_offers(i, x, y, [&](std::size_t n, double e) {
+      in += offer(n, e);
+      largest = std::max(largest, e);
+    });
+    if (!(in > 0.0)) return 0.0;
+    const double room = ceiling(i) - h_[i];
+    return std::min({1.0, 0.5 * largest / in, std::max(room, 0.0) / in});
+  }
+  // Phase 3: the change of cell i (taken - given); returns what it gave.
+  double change(std::size_t i, int x, int y) {
+    double out = 0.0, in = 0.0;
+    bool moved = false;
+    float* disturbed = disturbed_ ? &disturbed_->values()[i] : nullptr;
+    if (ws_.give_[i] > 0.0 && giver(i)) {
+      const SlopeRule& r = rule_at(i);
+      const double hi = surface(i);
+      for (int k = 0; k < 8; ++k) {
+        if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
+        const std::size_t n = neighbour(x, y, k);
+        const double e = excess(hi, n, r, k);
+        if (e <= o_.tolerance) continue;
+        const double f = flow(i, e, n);
+        if (!(f > 0.0)) continue;
+        out += f, moved = true;
+        if (disturbed) *disturbed += static_cast<float>(f);
+      }
+    }
+    if (ws_.take_[i] > 0.0)
+      for_offers(i, x, y, [&](std::size_t n, double e) {
+        const double f = flow(n, e, i);
+        if (!(f > 0.0)) return;
+        in += f, moved = true;
+        if (disturbed) *disturbed += static_cast<float>(f);
+      });
+    ws_.delta_[i] = in - out;
+    ws_.touched_[i] = moved;
+    return out;
   }
 
-  // A receiver takes at most half the largest excess it is offered from and
-  // never rises above its ceiling (offers counted before donors' scaling, so
-  // the cap is conservative).
-  double receiver_scale(int n) const {
-    const std::size_t i = static_cast<std::size_t>(n);
-    const double in = ws.in_[i];
-    if (!(in > 0.0)) return 0.0;
-    const double room = bound(cells.ceiling, n, kInf) - h.values()[i];
-    return std::min({1.0, 0.5 * ws.in_excess_[i] / in, std::max(room, 0.0) / in});
+  // One Jacobi pass over the active tiles; returns the height moved.
+  double pass(const std::vector<int>& active) {
+    for_tiles(active, [&](int t) {
+      for_cells(t, [&](std::size_t i, int x, int y) {
+        if (giver(i)) ws_.give_[i] = give_factor(i, x, y);
+      });
+    });
+    near_ = with_neighbours(active);
+    for_tiles(near_, [&](int t) {
+      for_cells(t, [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
+    });
+    gave_.assign(near_.size(), 0.0);
+    for_each_index(near_.size(), [&](std::size_t k) {
+      double gave = 0.0;
+      bool any = false;
+      for_cells(near_[k], [&](std::size_t i, int x, int y) {
+        gave += change(i, x, y);
+        any = any || ws_.touched_[i];
+      });
+      gave_[k] = gave;
+      ws_.tile_touched_[static_cast<std::size_t>(near_[k])] = any;
+    });
+    for_tiles(near_, [&](int t) {
+      for_cells(t, [&](std::size_t i, int, int) {
+        h_[i] += ws_.delta_[i];
+        ws_.give_[i] = ws_.take_[i] = ws_.delta_[i] = 0.0;
+      });
+    });
+    double moved = 0.0;
+    for (double g : gave_) moved += g;
+    return moved;
   }
+
+  void clear_active(int t) {
+    for_cells(t, [&](std::size_t i, int, int) { ws_.active_[i] = 0; });
+    ws_.tile_active_[static_cast<std::size_t>(t)] = 0;
+  }
+  // After a pass: a cell is active if it or a neighbour gave or took. Returns the
+  // tiles with active cells and clears the pass's marks.
+  std::vector<int> next_active(const std::vector<int>& was_active) {
+    std::vector<int> touched;
+    for (int t : near_)
+      if (ws_.tile_touched_[static_cast<std::size_t>(t)]) touched.push_back(t);
+    std::vector<int> candidates = with_neighbours(touched);
+    for (int t : was_active) ws_.tile_mark_[static_cast<std::size_t>(t)] = 1;
+    for (int t : candidates) ws_.tile_mark_[static_cast<std::size_t>(t)] = 0;
+    for (int t : was_active)  // active before, not a candidate now: clear
+      if (ws_.tile_mark_[static_cast<std::size_t>(t)]) clear_active(t);
+    for (int t : was_active) ws_.tile_mark_[static_cast<std::size_t>(t)] = 0;
+    for_tiles(candidates, [&](int t) { mark_active(t); });
+    for_tiles(touched, [&](int t) {
+      ws_.tile_ever_[static_cast<std::size_t>(t)] = 1;
+      for_cells(t, [&](std::size_t i, int, int) { ws_.ever_[i] |= ws_.touched_[i]; });
+    });
+    for_tiles(touched, [&](int t) {
+      for_cells(t, [&](std::size_t i, int, int) { ws_.touched_[i] = 0; });
+      ws_.tile_touched_[static_cast<std::size_t>(t)] = 0;
+    });
+    std::vector<int> next;
+    for (int t : candidates)
+      if (ws_.tile_active_[static_cast<std::size_t>(t)]) next.push_back(t);
+    return next;
+  }
+  void mark_active(int t) {
+    bool any = false;
+    for_cells(t, [&](std::size_t i, int x, int y) {
+      bool a = ws_.touched_[i] != 0;
+      for (int k = 0; k < 8 && !a; ++k)
+        a = inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy) &&
+            ws_.touched_[neighbour(x, y, k)];
+      ws_.active_[i] = a;
+      any = any || a;
+    });
+    ws_.tile_active_[static_cast<std::size_t>(t)] = any;
+  }
+
+  std::vector<double>& h_;
+  const SlopeCells& cells_;
+  const SlopeRelaxOptions& o_;
+  SlopeRelaxWorkspace& ws_;
+  Grid<float>* disturbed_;
+  const SlopePassFn& on_pass_;
+  int w_, hgt_;
+  std::array<double, 8> distance_{};
+  std::vector<int> near_;     // this pass: active tiles and their neighbours
+  std::vector<double> gave_;  // per tile of near_
 };
 
-SlopeRelaxReport relax_slopes(Grid<double>& heights, std::vector<int> active,
+SlopeRelaxReport relax_slopes(Grid<double>& heights, const std::vector<int>& active,
                               const SlopeCells& cells, const SlopeRelaxOptions& options,
                               std::vector<int>& moved_cells, Grid<float>* disturbed,
                               SlopeRelaxWorkspace* workspace) {
   SlopeRelaxWorkspace local;
   SlopeRelaxWorkspace& ws = workspace ? *workspace : local;
-  ws.fit(heights.size());
-  SlopeRelaxPass pass(heights, cells, options, ws);
-  SlopeRelaxReport report;
-  moved_cells.clear();
-  std::vector<int> next, listed;
-  std::vector<double>& h = heights.values();
-  const int w = heights.width(), hgt = heights.height();
-  pass.next_epoch();
-  for (int c : active) pass.list_once(c, next);
-  active.swap(next);
-  while (!active.empty() && report.passes < options.max_passes) {
-    ++report.passes;
-    pass.flows.clear();
-    pass.receivers.clear();
-    for (int index : active) pass.donor_flows(index);
-    for (Flow& f : pass.flows) {
-      const double s = pass.receiver_scale(f.to);
-      f.amount *= s;
-    }
-    pass.clear_offers();
-    next.clear();
-    pass.next_epoch();
-    for (const Flow& f : pass.flows) {
-      if (!(f.amount > 0.0)) continue;
-      h[static_cast<std::size_t>(f.from)] -= f.amount;
-      h[static_cast<std::size_t>(f.to)] += f.amount;
-      report.moved += f.amount;
-      if (disturbed) {
-        disturbed->values()[static_cast<std::size_t>(f.from)] += static_cast<float>(f.amount);
-        disturbed->values()[static_cast<std::size_t>(f.to)] += static_cast<float>(f.amount);
-      }
-      listed.push_back(f.from), listed.push_back(f.to);
-      for (int end : {f.from, f.to}) {
-        const int x = end % w, y = end / w;
-        pass.list_once(end, next);
-        for (const Neighbour& nb : kNeighbours) {
-          const int nx = x + nb.dx, ny = y + nb.dy;
-          if (nx >= 0 && ny >= 0 && nx < w && ny < hgt) pass.list_once(ny * w + nx, next);
-        }
-      }
-    }
-    active.swap(next);
-  }
-  report.converged = active.empty();
-  pass.next_epoch();
-  for (int c : listed) pass.list_once(c, moved_cells);
+  ws.fit(heights.width(), heights.height());
+  const SlopePassFn none;
+  SlopeRelaxer relaxer(heights, cells, options, ws, disturbed, none);
+  for (int c : active) relaxer.seed(c);
+  const SlopeRelaxReport report = relaxer.run();
+  relaxer.collect_moved(moved_cells);
+  return report;
+}
+
+SlopeRelaxReport relax_slopes_everywhere(Grid<double>& heights, const SlopeCells& cells,
+                                         const SlopeRelaxOptions& options,
+                                         SlopeRelaxWorkspace* workspace,
+                                         const SlopePassFn& on_pass) {
+  SlopeRelaxWorkspace local;
+  SlopeRelaxWorkspace& ws = workspace ? *workspace : local;
+  ws.fit(heights.width(), heights.height());
+  SlopeRelaxer relaxer(heights, cells, options, ws, nullptr, on_pass);
+  relaxer.seed_all();
+  const SlopeRelaxReport report = relaxer.run();
+  std::vector<int> unused;
+  relaxer.collect_moved(unused);
   return report;
 }
 
 double max_slope_excess(const Grid<double>& heights, const SlopeCells& cells,
-                        const SlopeRelaxOptions& options, std::span<const int> only) {
+                        const SlopeRelaxOptions& options, std::span<const int> only,
+                        double min_room) {
   const int w = heights.width(), hgt = heights.height();
+  const auto& h = heights.values();
+  auto surface = [&](std::size_t i) {
+    return cells.base ? static_cast<double>(cells.base->values()[i]) + h[i] : h[i];
+  };
   double worst = 0.0;
   auto visit = [&](int index) {
-    const SlopeRule& rule = rule_at(cells, index);
+    const std::size_t i = static_cast<std::size_t>(index);
+    const SlopeRule& rule =
+        cells.rule_of_cell ? cells.rules[cells.rule_of_cell->values()[i]] : cells.rules[0];
     if (!std::isfinite(rule.tan_repose)) return;
+    const double floor = std::max(cells.floor ? cells.floor->values()[i] : -kInf, cells.min_value);
+    if (!(h[i] - floor > min_room)) return;
     const int x = index % w, y = index / w;
     for (const Neighbour& nb : kNeighbours) {
       const int nx = x + nb.dx, ny = y + nb.dy;
       if (nx < 0 || ny < 0 || nx >= w || ny >= hgt) continue;
-      const int n = ny * w + nx;
-      if (std::isfinite(bound(cells.ceiling, n, kInf))) continue;
+      const std::size_t n = static_cast<std::size_t>(ny) * w + nx;
+      if (cells.ceiling && std::isfinite(cells.ceiling->values()[n])) continue;
       const double d = std::hypot(nb.dx * options.dx, nb.dy * options.dy);
-      worst =
-          std::max(worst, heights.values()[static_cast<std::size_t>(index)] -
-                              heights.values()[static_cast<std::size_t>(n)] - rule.tan_repose * d);
+      worst = std::max(worst, surface(i) - surface(n) - rule.tan_repose * d);
     }
   };
   if (only.empty()) {

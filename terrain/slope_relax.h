@@ -1,27 +1,38 @@
 // Slope relaxation of a height field, local and sparse: where the slope from a
-// cell to one of its 8 neighbours exceeds the material's angle, a fraction of
-// the excess moves from the higher cell to the lower (paper 000, 3.5, after
-// Sumner, O'Brien & Hodgins 1999: delta h = sigma x excess). Shared by the
-// stages that let loose material slide: marks' erosion (terrain/marks) uses it
-// now; snow's stabilisation (snow/stabilise_grid) may move onto it.
+// cell to one of its 8 neighbours exceeds the material's angle, material moves
+// from the higher cell to the lower. One kernel for every stage that lets loose
+// material slide, with the sharing rule as a parameter:
+//  - SlopeShare::Fraction (paper 000, 3.5, after Sumner, O'Brien & Hodgins 1999):
+//    sigma x excess to each steeper neighbour; marks' erosion (terrain/marks);
+//  - SlopeShare::HalfSteepest (paper 003, 2.1(3)): a cell gives min(what it
+//    holds, half its steepest excess), shared among its steeper neighbours in
+//    proportion to their excess (none lower: nothing; one: all to it; several:
+//    shared); snow's stabilisation (snow/stabilise_grid).
+// The excess of a pair is measured against the higher cell's rule:
+// e = (H_c - H_n) - tan(theta) d, d the distance between the cell centres (dx,
+// dy or the diagonal); a pair counts when e > tolerance.
 //
-// Only the cells in the active list are examined, and a pass activates the
-// neighbours of whatever moved, so the work stays around the disturbance.
-// Each pass is Jacobi-style: flows are worked out from the heights before the
-// pass and then applied, so the result does not depend on the order of the
-// list (a symmetric disturbance relaxes symmetrically). The excess of a pair
-// is measured against the higher cell's rule: e = (h_c - h_n) - tan(theta) d,
-// d = the distance between cell centres (dx, dy or the diagonal).
+// Jacobi passes: every flow of a pass is worked out from the heights before it,
+// so the result depends neither on the order of the seeds nor on the thread
+// count (each cell sums what it gives and takes in a fixed neighbour order, and
+// giver and taker compute each flow from the same operands, so mass moves from
+// one cell to another exactly, to double rounding of the heights). A giver's
+// flows are scaled so that it gives at most half its largest excess (the pair
+// would cross) and never sinks below its floor; a taker takes at most half the
+// largest excess it is offered from and never rises above its ceiling (offers
+// counted before the givers' scaling, so the cap is conservative); a cell at its
+// ceiling (held down by an object) gives nothing.
 //
-// Per pass a cell gives sigma x e to each steeper neighbour, scaled down so
-// that it never gives more than half its largest excess (the pair would cross)
-// nor goes below its floor, and a cell never takes more than half the largest
-// excess it receives from nor rises above its ceiling; a cell at its ceiling
-// (held down by an object) gives nothing. Mass moves from one
-// cell to another in double precision, so it is conserved to double rounding.
+// Only active cells may give: the seeds at first, then every cell next to one
+// that gave or took, so the work stays around the disturbance. The grid is cut
+// into 16 x 16 tiles; passes visit only the tiles with active cells and their
+// neighbours, in parallel (TBB) when there are many. Storage: three doubles and
+// two bytes a cell in the workspace, none per flow.
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -29,10 +40,16 @@
 
 namespace drift::terrain {
 
+enum class SlopeShare {
+  Fraction,      // paper 000: fraction x excess to each steeper neighbour
+  HalfSteepest,  // paper 003: min(held, e_max / 2) shared in proportion to excess
+};
+
 // How one class of cells (a material) slides.
 struct SlopeRule {
   double tan_repose = 0.577;  // tan of the steepest stable slope; +inf never slides
-  double fraction = 0.2;      // sigma: share of the excess moved per pass, (0, 0.5]
+  double fraction = 0.2;      // sigma (SlopeShare::Fraction): share of the excess a pass, (0, 0.5]
+  SlopeShare share = SlopeShare::Fraction;
 };
 
 struct SlopeRelaxOptions {
@@ -41,6 +58,10 @@ struct SlopeRelaxOptions {
   int max_passes = 200;
 };
 
+// Called after each pass with the passes so far and the share of the tiles still
+// active (for progress bars; it may throw to cancel).
+using SlopePassFn = std::function<void(int passes, double active_share)>;
+
 // Where each cell's rule comes from and the bounds it must keep. Null pointers
 // mean: every cell follows rules[0], no ceiling, no floor.
 struct SlopeCells {
@@ -48,6 +69,10 @@ struct SlopeCells {
   const Grid<std::uint8_t>* rule_of_cell = nullptr;  // index into rules
   const Grid<double>* ceiling = nullptr;             // a cell never rises above it (+inf: none)
   const Grid<double>* floor = nullptr;               // a cell never sinks below it (-inf: none)
+  // The relaxed field may be a loose layer on a fixed base (snow depth on the
+  // ground): slopes are those of base + field, bounds apply to the field.
+  const Grid<float>* base = nullptr;
+  double min_value = -std::numeric_limits<double>::infinity();  // a floor for every cell
 };
 
 struct SlopeRelaxReport {
@@ -57,31 +82,42 @@ struct SlopeRelaxReport {
 };
 
 // Scratch space sized to a grid, kept between calls so that a call costs what
-// it touches, not the grid's size.
+// it touches, not the grid's size (all of it is back to zero between calls).
 class SlopeRelaxWorkspace {
  public:
-  void fit(std::size_t cells);
+  void fit(int width, int height);
 
  private:
-  friend struct SlopeRelaxPass;
-  std::vector<std::uint32_t> seen_;  // per cell: the last epoch that listed it
-  std::vector<double> in_;           // per cell: material offered to it this pass
-  std::vector<double> in_excess_;    // per cell: the largest excess it is offered from
-  std::uint32_t epoch_ = 0;
+  friend class SlopeRelaxer;
+  int width_ = 0, height_ = 0, tiles_x_ = 0, tiles_y_ = 0;
+  std::vector<double> give_;  // per giver: its factor this pass (0: gives nothing)
+  std::vector<double> take_;  // per taker: the share of its offers it takes
+  std::vector<double> delta_;
+  std::vector<std::uint8_t> active_, touched_, ever_;  // per cell
+  std::vector<std::uint8_t> tile_active_, tile_touched_, tile_ever_, tile_mark_;
 };
 
 // Relaxes `heights` starting from the cells in `active` (flat indices, any order,
-// duplicates allowed). On return `moved_cells` lists, unique, every cell whose
-// height changed. `disturbed` (optional) accumulates |change| per cell.
-SlopeRelaxReport relax_slopes(Grid<double>& heights, std::vector<int> active,
+// duplicates allowed). On return `moved_cells` lists, unique and in ascending
+// order, every cell that gave or took. `disturbed` (optional) accumulates the
+// material moved in and out per cell.
+SlopeRelaxReport relax_slopes(Grid<double>& heights, const std::vector<int>& active,
                               const SlopeCells& cells, const SlopeRelaxOptions& options,
                               std::vector<int>& moved_cells, Grid<float>* disturbed = nullptr,
                               SlopeRelaxWorkspace* workspace = nullptr);
 
+// The same with every cell active at first (a whole field to settle).
+SlopeRelaxReport relax_slopes_everywhere(Grid<double>& heights, const SlopeCells& cells,
+                                         const SlopeRelaxOptions& options,
+                                         SlopeRelaxWorkspace* workspace = nullptr,
+                                         const SlopePassFn& on_pass = {});
+
 // Largest excess of a neighbour slope over its rule, in metres of height, among
 // the pairs whose higher cell is in `cells` (flat indices; empty: the whole grid)
-// and whose lower cell is not capped by a ceiling (for tests and reports).
+// and holds more than `min_room` above its floor, and whose lower cell is not
+// capped by a ceiling (for tests and reports).
 double max_slope_excess(const Grid<double>& heights, const SlopeCells& cells,
-                        const SlopeRelaxOptions& options, std::span<const int> only = {});
+                        const SlopeRelaxOptions& options, std::span<const int> only = {},
+                        double min_room = -std::numeric_limits<double>::infinity());
 
 }  // namespace drift::terrain
