@@ -173,9 +173,8 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
 
 // The scene file's sections, each read by its own function below; the order
 // here is the order `unknown section` lists them in.
-constexpr std::array<const char*, 10> kSections = {"terrain", "snow",   "ripples", "sun",
-                                                   "sky",     "clouds", "camera",  "objects",
-                                                   "render",  "output"};
+constexpr std::array<const char*, 10> kSections = {
+    "terrain", "snow", "ripples", "sun", "sky", "clouds", "camera", "objects", "render", "output"};
 
 // Every top-level key must be a known section.
 void check_sections(const toml::table& root, const fs::path& path) {

@@ -93,7 +93,9 @@ float cloud_phase(float cos_theta) {
          (1.0f - kForwardWeight) * henyey_greenstein(cos_theta, kBackwardG);
 }
 
-float cloud_asymmetry() { return kForwardWeight * kForwardG + (1.0f - kForwardWeight) * kBackwardG; }
+float cloud_asymmetry() {
+  return kForwardWeight * kForwardG + (1.0f - kForwardWeight) * kBackwardG;
+}
 
 float slab_reflectance(float tau, float mu0, float g) {
   // Delta-Eddington scaling (Joseph, Wiscombe & Weinman 1976): the forward
@@ -135,7 +137,8 @@ float CloudLayer::optical_depth(double x, double y, double footprint) const {
   float lost_std = 0.0f;
   const float a = field(x, y, footprint, lost_std) - threshold_;
   // density x clamp(a / ramp, 0, 1), in expectation over the dropped octaves.
-  const float ramp = smoothed_positive_part(a, lost_std) - smoothed_positive_part(a - ramp_, lost_std);
+  const float ramp =
+      smoothed_positive_part(a, lost_std) - smoothed_positive_part(a - ramp_, lost_std);
   return static_cast<float>(options_.density) * std::clamp(ramp / ramp_, 0.0f, 1.0f);
 }
 
@@ -204,8 +207,8 @@ CloudLook cloud_look(const CloudLayer& layer, const CloudCrossing& c, const Eige
   // Self-shadowing: the sun's way in passes over the layer towards the sun
   // (half a thickness up, horizontally thickness / 2 / tan(elevation)).
   const Eigen::Vector3f towards = light.sun_dir - mu0 * c.up;
-  const float reach = std::min(0.5f * static_cast<float>(o.thickness) / mu0,
-                               static_cast<float>(o.scale));
+  const float reach =
+      std::min(0.5f * static_cast<float>(o.thickness) / mu0, static_cast<float>(o.scale));
   const Eigen::Vector3f q = c.point + towards * reach;
   const float tau_sun = 0.5f * (tau + layer.optical_depth(q.x(), q.y(), footprint));
   const float r = slab_reflectance(tau_sun, mu0, g);

@@ -32,11 +32,11 @@ namespace drift::render {
 
 struct CloudOptions {
   bool enabled = false;
-  double altitude = 4500.0;   // metres above sea level of the layer's middle
-  double thickness = 400.0;   // metres (the self-shadowing's reach)
-  double coverage = 0.4;      // fraction of the sky's area under cloud, [0, 1]
-  double density = 12.0;      // vertical optical depth where the cloud is thickest
-  double scale = 2500.0;      // metres: the wavelength of the largest octave
+  double altitude = 4500.0;  // metres above sea level of the layer's middle
+  double thickness = 400.0;  // metres (the self-shadowing's reach)
+  double coverage = 0.4;     // fraction of the sky's area under cloud, [0, 1]
+  double density = 12.0;     // vertical optical depth where the cloud is thickest
+  double scale = 2500.0;     // metres: the wavelength of the largest octave
   std::uint64_t seed = 1;
 };
 

@@ -5,8 +5,8 @@
 #include <numbers>
 
 #include "render/sampling.h"
-#include "terrain/error.h"
 #include "terrain/direction.h"
+#include "terrain/error.h"
 
 namespace drift::render {
 
@@ -40,7 +40,7 @@ PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const
     const double camera_altitude = scene.origin().z() + camera.eye.z();
     double reach = camera.eye.head<2>().norm() + scene.extent().norm() +
                    scene.surround_reach();  // the ground beyond the DEM (render/surround.h)
-    if (input.clouds.enabled) {  // the aerial perspective reaches the clouds too
+    if (input.clouds.enabled) {             // the aerial perspective reaches the clouds too
       clouds_.emplace(input.clouds, scene.origin());
       reach = std::max(reach, std::min(clouds_->horizon_distance(camera.eye.z()), 3e5));
     }
@@ -91,8 +91,8 @@ Vector3f PathTracer::shaft_loss(const Path& path, float distance, std::uint64_t&
                            input_.sky.shaft_steps, path.shaft_jitter, in_shadow);
 }
 
-Vector3f PathTracer::cloudy_sky(const Vector3f& origin, const Vector3f& dir,
-                                const Vector3f& behind, bool from_camera, const RayCone& cone) const {
+Vector3f PathTracer::cloudy_sky(const Vector3f& origin, const Vector3f& dir, const Vector3f& behind,
+                                bool from_camera, const RayCone& cone) const {
   CloudCrossing c;
   if (!clouds_ || !clouds_->cross(origin, dir, 1e30f, c)) return behind;
   const float footprint = cone.width + cone.spread * c.distance;
@@ -101,9 +101,9 @@ Vector3f PathTracer::cloudy_sky(const Vector3f& origin, const Vector3f& dir,
   // The sky's light is the air before the layer, the layer, and what lies
   // beyond: L = T_c L_sky + (1 - T_c) L_air(0, d) + T_air(0, d) L_cloud.
   const AirSegment air =
-      from_camera ? air_->from_camera(dir, c.distance)
-                  : air_->segment(base_altitude_ + 0.5f * (origin.z() + c.point.z()), dir,
-                                  c.distance);
+      from_camera
+          ? air_->from_camera(dir, c.distance)
+          : air_->segment(base_altitude_ + 0.5f * (origin.z() + c.point.z()), dir, c.distance);
   return look.transmittance * behind + (1.0f - look.transmittance) * air.inscatter +
          air.transmittance.cwiseProduct(look.radiance);
 }

@@ -450,7 +450,8 @@ TEST(SceneFile, CloudsAreReadAndChecked) {
   EXPECT_EQ(c.seed, 9u);
   for (const char* bad : {"coverage = nan", "coverage = 1.5", "density = -1", "density = inf",
                           "altitude = 30000", "thickness = 0", "scale = 10", "seed = -3"}) {
-    const std::string key = std::string("clouds.") + std::string(bad).substr(0, std::string(bad).find(' '));
+    const std::string key =
+        std::string("clouds.") + std::string(bad).substr(0, std::string(bad).find(' '));
     const std::string e = error_of(std::string(kTerrain) + "[clouds]\n" + bad + "\n");
     EXPECT_NE(e.find(key), std::string::npos) << bad << ": " << e;
     EXPECT_NE(e.find("s.toml"), std::string::npos) << e;

@@ -172,7 +172,8 @@ TEST(Clouds, ShadowDarkensTheGroundUnderCloudAndNowhereElse) {
       // Away from edges: the pixel's ground and the sun's penumbra (10 m).
       const float tau = layer.optical_depth(hit.position.x(), hit.position.y(), 40.0);
       const double change = cloudy.at(x, y, 1) - clear.at(x, y, 1);
-      if (tau < 0.01f * s.clouds.density) open_clear += clear.at(x, y, 1), open_change += change, ++open;
+      if (tau < 0.01f * s.clouds.density)
+        open_clear += clear.at(x, y, 1), open_change += change, ++open;
       if (tau > 0.8f * s.clouds.density) shade_change += change, ++shade;
     }
   }
