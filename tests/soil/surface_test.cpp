@@ -86,5 +86,34 @@ TEST(SoilSurface, StraightSlopesRemoveVerticalRidges) {
   std::printf("slope normals' x spread: %.4f without the fix, %.6f with it\n", before, after);
 }
 
+// Soil thinner than half a voxel on the floor (a pile's foot): its first
+// voxel centre lies above its top, so without the row under the floor the
+// surface ended in a half-voxel step where it thinned below 0.5 (the
+// renders' steps at the pile foot). With it the top stays at the soil's
+// height, the bottom lies on the floor and the layer reaches past the centres
+// of its outermost columns (by under half a voxel: the foot tapers).
+TEST(SoilSurface, ThinSoilAtAPileFootKeepsItsHeight) {
+  SoilState s(terrain::Grid3Shape{16, 16, 8, 1.0, {0, 0, 0}});
+  for (int y = 4; y < 12; ++y)
+    for (int x = 4; x < 12; ++x) s.rho[s.shape.index(x, y, 0)] = 0.3f;
+  const terrain::Mesh m = soil_surface(s, {RidgeFix::StraightSlopes, 3, 0.0});
+  ASSERT_FALSE(m.triangles.empty());
+  EXPECT_TRUE(watertight(m));
+  Eigen::Vector3f lo = m.positions.front(), hi = lo;
+  for (const auto& p : m.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  EXPECT_EQ(lo.z(), 0.0f);
+  EXPECT_NEAR(hi.z(), 0.3f, 1e-4f);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_GE(lo[k], 3.5f);
+    EXPECT_LE(lo[k], 4.5f);
+    EXPECT_GE(hi[k], 11.5f);
+    EXPECT_LE(hi[k], 12.5f);
+  }
+  EXPECT_GT(signed_volume(m), 0.0);
+}
+
 }  // namespace
 }  // namespace drift::soil
