@@ -40,7 +40,7 @@ constexpr double kFlakeRadius = 0.004;
 constexpr float kFlakeClumping = 0.7f;
 // Largest wavelength of the clumps (metres); octaves down to a quarter of it.
 constexpr double kClumpScale = 0.32;
-// Where flakes lie their snow is at least this deep (metres) for its
+// Where flakes lie (coverage below 1) their snow is at least this deep (metres) for its
 // translucency (render/surface.h: 1 cm over black rock reflects 0.79 where
 // deep snow reflects 0.90), so stuck flakes on a wall with no depth read white.
 constexpr float kFlakeDepth = 0.01f;

@@ -159,10 +159,10 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   Material snow = surface.snow;
   if (surface.snow_depth && p.snow > 0.0f) {
     // Thin snow lets the ground show through (translucency). Where it lies
-    // it is depth / coverage deep (the coverage is its share of the ground),
-    // at least a flake's depth.
+    // it is depth / coverage deep (the coverage is its share of the ground);
+    // flakes (coverage below 1) are at least a flake deep.
     const float depth = std::max(sample_raster(*surface.snow_depth, x, y, 0.0f), 0.0f);
-    const float lying = std::max(depth / p.snow, kFlakeDepth);
+    const float lying = p.snow < 1.0f ? std::max(depth / p.snow, kFlakeDepth) : depth;
     snow.albedo = layer_albedo(snow.albedo, ground.albedo, surface.snow_scattering * lying);
   }
   // Coverage below full shows as flakes (render/snow_flakes.h).
