@@ -129,13 +129,18 @@ void Slippage::slide_pile(int x, int y, int pile, const HeightSpan& p, const Sli
 
 void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d,
                            const SliceConstants& k, Out& o, float& v) const {
-  float low_top;
+  float low_top, ceiling;
   const int q = lower_pile(p, n, ncount);
   if (q >= 0) {
     low_top = n[q].top;
+    // Eq. 32's B_next is the bottom of the span right above the low pile: a
+    // body resting on the pile caps it even where its partial bottom voxel
+    // lies below T_low, so soil never slides into a pile under a body.
+    ceiling = q + 1 < ncount ? n[q + 1].bottom : k.grid_top;
     o.target = static_cast<std::int16_t>(q);
   } else if (p.bottom > 0 && !holds_height(n, ncount, p.bottom)) {
     low_top = p.bottom;  // edge span (fig. 35)
+    ceiling = ceiling_above(n, ncount, low_top, k.grid_top);
     o.edge_voxel =
         static_cast<std::int16_t>(std::min<int>(shape_.nz - 1, static_cast<int>(p.bottom)));
   } else {
@@ -143,7 +148,7 @@ void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount,
     return;
   }
   const double h = k.voxel;
-  const float rise = std::min(p.top, ceiling_above(n, ncount, low_top, k.grid_top)) - low_top;
+  const float rise = std::min(p.top, ceiling) - low_top;
   const double dx = h * ((d < 4) ? 1.0 : M_SQRT2);
   const auto theta = failure_plane(rise * h, dx, k.cohesion, k.phi, k.gamma);
   if (!theta) {
