@@ -2,7 +2,7 @@
 # Fuzzes every reader of outside input (tests/fuzz/fuzz_targets.h) with libFuzzer:
 # builds the targets with clang, AddressSanitizer and UndefinedBehaviorSanitizer
 # into build-fuzz/ and runs each for SECONDS (default 60), niced.
-#   scripts/fuzz.sh [SECONDS] [TARGET...]   targets: raster scene objects track obj ply image
+#   scripts/fuzz.sh [SECONDS] [TARGET...]   targets: raster scene objects track scenario obj ply image
 # New inputs collect in build-fuzz/corpus/<target>/; a crash, leak or hang is
 # written to build-fuzz/findings/<target>/ and stops that target. Keep each
 # finding as a regression input under tests/fuzz/regressions/<target>/ (the
@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(raster scene objects track obj ply image); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(raster scene objects track scenario obj ply image); fi
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRIFT_FUZZ=ON \
   -DDRIFT_BUILD_BENCHMARKS=OFF >/dev/null
