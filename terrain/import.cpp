@@ -186,6 +186,24 @@ void require_warp_memory(const RasterHeader& h, const ImportOptions& o, const Wa
   require_memory(static_cast<std::uint64_t>(bytes), what, fix);
 }
 
+// The DEM is band 1; GDALWarp would warp every band into memory (GDAL 3.6 has
+// no -b for warps), and a 400-byte TIFF declaring 65535 samples per pixel kept
+// it busy for minutes growing a band list (found by fuzz_raster). A VRT of
+// band 1 over the open file is warped instead.
+GDALDatasetH first_band(GDALDatasetH file, const fs::path& path) {
+  if (GDALGetRasterCount(file) <= 1) return file;
+  const char* args[] = {"-of", "VRT", "-b", "1", nullptr};
+  std::unique_ptr<GDALTranslateOptions, decltype(&GDALTranslateOptionsFree)> topts(
+      GDALTranslateOptionsNew(const_cast<char**>(args), nullptr), GDALTranslateOptionsFree);
+  int usage_error = 0;
+  GDALDatasetH band1 = topts ? GDALTranslate("", file, topts.get(), &usage_error) : nullptr;
+  if (!band1) {
+    GDALClose(file);
+    throw Error("cannot read band 1 of '" + path.string() + "': " + last_gdal_message());
+  }
+  return band1;
+}
+
 // Runs the warp into memory and reads the grid from it.
 HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const ImportOptions& o) {
   ensure_gdal();
@@ -197,11 +215,13 @@ HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const Impor
   std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopts(
       GDALWarpAppOptionsNew(argv.data(), nullptr), GDALWarpAppOptionsFree);
   if (!wopts) throw Error("internal: bad warp options for '" + path.string() + "'");
-  GDALDatasetH src = GDALOpen(path.c_str(), GA_ReadOnly);
-  if (!src) throw Error("cannot open '" + path.string() + "': " + last_gdal_message());
+  GDALDatasetH file = GDALOpen(path.c_str(), GA_ReadOnly);
+  if (!file) throw Error("cannot open '" + path.string() + "': " + last_gdal_message());
+  GDALDatasetH src = first_band(file, path);
   int usage_error = 0;
   GDALDatasetH dst = GDALWarp("", nullptr, 1, &src, wopts.get(), &usage_error);
-  GDALClose(src);
+  if (src != file) GDALClose(src);
+  GDALClose(file);
   if (!dst) {
     throw Error("cannot warp '" + path.string() + "': " + last_gdal_message() +
                 (o.crop || o.crop_lonlat ? " (does the crop box overlap the DEM?)" : ""));
