@@ -16,7 +16,8 @@ namespace drift::pipeline {
 namespace {
 
 struct CoverCommand {
-  std::string dem, output, accessibility, descriptor, hemisphere = "auto";
+  std::string dem, output, accessibility, descriptor, hemisphere = "auto",
+                                                      sun_step = "per-triangle";
   double snow_line = 0.0;
   snow::CoverOptions options;
 };
@@ -26,6 +27,10 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
   if (sub.count("--radius") && sub.count("--radius-cells")) {
     usage_error("give --radius (metres) or --radius-cells, not both");
   }
+  if (sub.count("--region") && sub.count("--region-cells")) {
+    usage_error("give --region (the paper's 50 m cells) or --region-cells, not both");
+  }
+  o.sun_step = c.sun_step == "mean" ? snow::SunStep::Mean : snow::SunStep::PerTriangle;
   if (sub.count("--snow-line")) o.snow_line_m = c.snow_line;
   if (sub.count("--band") && !sub.count("--snow-line")) usage_error("--band needs --snow-line");
   o.hemisphere = c.hemisphere == "north"   ? snow::Hemisphere::North
@@ -33,6 +38,7 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
                                            : snow::Hemisphere::Auto;
   // The ranges live in CoverOptions::validate(); checked before reading the DEM.
   validate_flags([&o] { o.validate(); }, {{"region", "--region"},
+                                          {"region_cells", "--region-cells"},
                                           {"iterations", "--iterations"},
                                           {"floor", "--floor"},
                                           {"sun_range_deg", "--sun-range"},
@@ -58,10 +64,13 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
   outputs.commit();
   double mean = 0;
   for (float v : cover.values()) mean += v;
-  std::printf("snow cover: %d x %d cells, mean cover %.3f, sun from the %s -> %s\n", cover.width(),
-              cover.height(), mean / static_cast<double>(cover.size()),
-              r.southern ? "north (southern hemisphere)" : "south (northern hemisphere)",
-              c.output.c_str());
+  const double cell = dem.geo().cell_size_x();
+  std::printf(
+      "snow cover: %d x %d cells of %g m, region %d cells, probe radius %g m, mean cover %.3f, "
+      "sun from the %s -> %s\n",
+      cover.width(), cover.height(), cell, snow::region_in_cells(o, cell),
+      snow::radius_in_metres(o, cell), mean / static_cast<double>(cover.size()),
+      r.southern ? "north (southern hemisphere)" : "south (northern hemisphere)", c.output.c_str());
 }
 
 }  // namespace
@@ -76,17 +85,27 @@ void add_snow_cover_command(CLI::App& root) {
   snow::CoverOptions& o = c->options;
   sub->add_option("dem", c->dem, "DEM GeoTIFF in metres (drift import)")->required();
   sub->add_option("-o,--output", c->output, "snow cover GeoTIFF, 1 - t in [0, 1]")->required();
-  sub->add_option("--region", o.region, "smoothing region n, cells (diamond of 4n + 2n(n-1))")
+  sub->add_option("--region", o.region,
+                  "smoothing region n in the paper's 50 m cells (diamond of 4n + 2n(n-1)), "
+                  "widened to n x 50 m / cell size on this DEM")
       ->capture_default_str();
+  sub->add_option("--region-cells", o.region_cells,
+                  "smoothing region n in this DEM's cells instead of --region");
   sub->add_option("--iterations", o.iterations, "smoothing passes k")->capture_default_str();
-  sub->add_option("--radius", o.radius_m, "probe radius r in metres (default: 55 cells)");
-  sub->add_option("--radius-cells", o.radius_cells,
-                  "probe radius in cells (the paper's 5.5 at its 0.1 spacing = 55)")
+  sub->add_option("--radius", o.radius_m,
+                  "probe radius r in metres (the paper's 5.5 at its 0.1 per 50 m cell = 2750)")
       ->capture_default_str();
+  sub->add_option("--radius-cells", o.radius_cells,
+                  "probe radius in this DEM's cells instead of --radius (the paper's 5.5 = 55)");
   sub->add_option("--floor", o.floor, "b: rock showing where TSA is 0, [0, 1]")
       ->capture_default_str();
   sub->add_option("--sun-range", o.sun_range_deg,
                   "theta1: slopes facing within this many degrees of the sun lose snow (0: off)")
+      ->capture_default_str();
+  sub->add_option("--sun-step", c->sun_step,
+                  "per-triangle (the paper: t = t phi + 1 - phi for each facing triangle) or mean "
+                  "(phi averaged over the 12 triangles, applied once)")
+      ->check(CLI::IsMember({"per-triangle", "mean"}))
       ->capture_default_str();
   sub->add_option("--snow-line", c->snow_line,
                   "snow line in metres: no snow below, full above (default: (z/zmax)^2)");

@@ -19,12 +19,22 @@ namespace drift::pipeline {
 namespace {
 
 struct SnowfallCommand {
-  std::string ground, objects, output, cover, mesh_out;
+  std::string ground, objects, output, cover, surface, mesh_out;
   std::vector<double> direction{0.0, 90.0};
   std::string occlusion = "sweep";
   unsigned long long seed = 1;
   snow::SnowfallOptions options;
 };
+
+// SPEC 3a's third output: the height of the snow's top, for stages that press
+// into it (marks). NaN where the ground has no data.
+terrain::HeightField snow_surface(const terrain::HeightField& ground,
+                                  const terrain::HeightField& depth) {
+  terrain::HeightField top = depth;
+  for (std::size_t i = 0; i < top.size(); ++i)
+    top.values()[i] = ground.values()[i] + depth.values()[i];
+  return top;
+}
 
 void run_snowfall(SnowfallCommand& c) {
   if (c.direction.size() != 2) usage_error("--direction takes AZ,EL (degrees)");
@@ -50,7 +60,7 @@ void run_snowfall(SnowfallCommand& c) {
                                           {"coverage.adhesion", "--adhesion"},
                                           {"max_iterations", "--max-iterations"}});
 
-  OutputSet outputs({c.output, c.cover, c.mesh_out}, {c.ground, c.objects});
+  OutputSet outputs({c.output, c.cover, c.surface, c.mesh_out}, {c.ground, c.objects});
   const terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);
   const std::vector<terrain::PlacedMesh> objects =
@@ -60,10 +70,14 @@ void run_snowfall(SnowfallCommand& c) {
 
   terrain::write_geotiff(r.depth, c.output, {"snow depth (m)", "m"});
   if (!c.cover.empty()) terrain::write_geotiff(r.coverage, c.cover, {"snow coverage (0..1)", ""});
+  if (!c.surface.empty())
+    terrain::write_geotiff(snow_surface(ground, r.depth), c.surface,
+                           {"snow surface height, ground + depth (m)", "m"});
   if (!c.mesh_out.empty()) terrain::write_ply(r.objects, c.mesh_out);
   outputs.commit();
   std::printf("snow fall: wrote %s\n", c.output.c_str());
   if (!c.cover.empty()) std::printf("snow fall: wrote %s\n", c.cover.c_str());
+  if (!c.surface.empty()) std::printf("snow fall: wrote %s\n", c.surface.c_str());
   if (!c.mesh_out.empty()) {
     std::printf("snow fall: wrote %s (%zu triangles; place it at position = [%.0f, %.0f, 0])\n",
                 c.mesh_out.c_str(), r.objects.triangle_count(), r.mesh_origin.x(),
@@ -94,6 +108,8 @@ void add_snowfall_command(CLI::App& root) {
   sub->add_option("--objects", c->objects, "TOML file of [[objects]] (mesh, position, ...)");
   sub->add_option("-o,--output", c->output, "snow depth GeoTIFF (m)")->required();
   sub->add_option("--cover", c->cover, "snow coverage GeoTIFF (0..1)");
+  sub->add_option("--surface", c->surface,
+                  "snow surface GeoTIFF: ground + snow depth (m), e.g. for drift marks");
   sub->add_option("--mesh-out", c->mesh_out,
                   "PLY of the objects raised by their snow, with per-vertex snow_depth, "
                   "snow_probability, snow_coverage, snow_adhesion");

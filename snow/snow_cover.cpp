@@ -77,32 +77,49 @@ void require(bool ok, const std::string& message) {
 
 int smoothing_neighbour_count(int region) { return 4 * region + 2 * region * (region - 1); }
 
-HeightField smooth(const HeightField& dem, int region) {
-  const int w = dem.width(), h = dem.height(), n = region;
-  // Padded copy (edge cells repeated) so that the diamond's rows are plain
-  // shifted spans and the inner loop vectorises.
-  const int pw = w + 2 * n;
-  std::vector<float> padded(static_cast<std::size_t>(pw) * (h + 2 * n));
+int region_in_cells(const CoverOptions& o, double cell_m) {
+  if (o.region_cells > 0) return o.region_cells;
+  return std::max(1, static_cast<int>(std::lround(o.region * kPaperCellM / cell_m)));
+}
+
+double radius_in_metres(const CoverOptions& o, double cell_m) {
+  return o.radius_cells > 0.0 ? o.radius_cells * cell_m : o.radius_m;
+}
+
+namespace {
+
+// Row prefix sums (double) of the DEM padded by n cells on every side (edge
+// cells repeated): row pr holds sum[px] = the first px padded heights.
+std::vector<double> padded_row_sums(const HeightField& dem, int n) {
+  const int w = dem.width(), h = dem.height(), pw = w + 2 * n + 1;
+  std::vector<double> sums(static_cast<std::size_t>(pw) * (h + 2 * n));
   for_rows(h + 2 * n, [&](int pr) {
     const int row = std::clamp(pr - n, 0, h - 1);
-    for (int px = 0; px < pw; ++px)
-      padded[static_cast<std::size_t>(pr) * pw + px] = dem(std::clamp(px - n, 0, w - 1), row);
+    double* line = &sums[static_cast<std::size_t>(pr) * pw];
+    line[0] = 0.0;
+    for (int px = 0; px + 1 < pw; ++px)
+      line[px + 1] = line[px] + dem(std::clamp(px - n, 0, w - 1), row);
   });
+  return sums;
+}
+
+}  // namespace
+
+HeightField smooth(const HeightField& dem, int region) {
+  const int w = dem.width(), h = dem.height(), n = region, pw = w + 2 * n + 1;
+  const std::vector<double> sums = padded_row_sums(dem, n);
   HeightField out(w, h, 0.0f, dem.geo());
-  const float inv_count = 1.0f / static_cast<float>(smoothing_neighbour_count(n));
+  const double inv_count = 1.0 / smoothing_neighbour_count(n);
   for_rows(h, [&](int row) {
-    thread_local std::vector<float> sum;
-    sum.assign(w, 0.0f);
-    for (int dr = -n; dr <= n; ++dr) {
-      const int reach = n - std::abs(dr);
-      const float* line = &padded[static_cast<std::size_t>(row + n + dr) * pw + n];
-      for (int dx = -reach; dx <= reach; ++dx) {
-        if (dr == 0 && dx == 0) continue;
-        const float* src = line + dx;
-        for (int x = 0; x < w; ++x) sum[x] += src[x];
+    for (int x = 0; x < w; ++x) {
+      double sum = -static_cast<double>(dem(x, row));  // the diamond without its centre
+      for (int dr = -n; dr <= n; ++dr) {
+        const int reach = n - std::abs(dr);
+        const double* line = &sums[static_cast<std::size_t>(row + n + dr) * pw];
+        sum += line[x + n + reach + 1] - line[x + n - reach];
       }
+      out(x, row) = static_cast<float>(0.5 * (dem(x, row) + sum * inv_count));
     }
-    for (int x = 0; x < w; ++x) out(x, row) = 0.5f * (dem(x, row) + sum[x] * inv_count);
   });
   return out;
 }
@@ -144,13 +161,16 @@ HeightField tangent_sphere_accessibility(const HeightField& dem) {
 
 namespace {
 
-void check_cover_input(const HeightField& dem, const CoverOptions& o) {
+void validate(const HeightField& dem, const CoverOptions& o) {
   o.validate();
   require(dem.width() >= 3 && dem.height() >= 3, "the DEM must be at least 3 x 3 cells");
   require(dem.geo().north_up() && dem.geo().cell_size_x() > 0 && dem.geo().cell_size_y() > 0,
           "the DEM must be north-up with positive cell sizes; warp it with drift import");
   require(!terrain::is_geographic(dem.geo().crs_wkt),
           "the DEM is in degrees; the descriptor needs metres: run drift import first");
+  const int n = region_in_cells(o, dem.geo().cell_size_x());
+  require(n <= 256, "the smoothing region is " + std::to_string(n) +
+                        " cells on this DEM (over 256): lower --region or resample the DEM");
   std::size_t nodata = 0;
   for (float v : dem.values()) nodata += std::isnan(v) ? 1 : 0;
   require(nodata == 0, "the DEM has " + std::to_string(nodata) +
@@ -162,23 +182,17 @@ void check_cover_input(const HeightField& dem, const CoverOptions& o) {
                  "crop or resample the DEM first (drift import --crop, --resample)");
 }
 
-bool southern_hemisphere(const HeightField& dem, Hemisphere hemisphere) {
-  if (hemisphere == Hemisphere::South) return true;
-  if (hemisphere == Hemisphere::Auto && !dem.geo().crs_wkt.empty())
-    return terrain::centre_lonlat(dem.geo(), dem.width(), dem.height())[1] < 0.0;
-  return false;
+bool in_southern_hemisphere(const HeightField& dem, Hemisphere hemisphere) {
+  if (hemisphere != Hemisphere::Auto) return hemisphere == Hemisphere::South;
+  if (dem.geo().crs_wkt.empty()) return false;
+  return terrain::centre_lonlat(dem.geo(), dem.width(), dem.height())[1] < 0.0;
 }
 
-// Steps 3-4: the transfer g (paper eq. 4) of the accessibility and the
-// altitude factor (SPEC 3b.4: on the snow amount); t = 1 - snow.
-HeightField transfer(const HeightField& dem, const HeightField& accessibility,
-                     const CoverOptions& o) {
-  const double cell = dem.geo().cell_size_x();
-  const float r = static_cast<float>(o.radius_m > 0.0 ? o.radius_m : o.radius_cells * cell);
-  const float b = static_cast<float>(o.floor);
-  float z_max = -kInfinity;
-  for (float v : dem.values()) z_max = std::max(z_max, v);
-  auto altitude_factor = [&](float z) {
+// Altitude factor a(z) (SPEC 3b.4): (z / z_max)^2, or a smooth step across a snow line.
+struct Altitude {
+  float z_max;
+  const CoverOptions& o;
+  float operator()(float z) const {
     if (o.snow_line_m) {
       const float line = static_cast<float>(*o.snow_line_m),
                   half = 0.5f * static_cast<float>(o.band_m);
@@ -186,60 +200,73 @@ HeightField transfer(const HeightField& dem, const HeightField& accessibility,
     }
     const float a = z_max > 0.0f ? std::clamp(z / z_max, 0.0f, 1.0f) : 0.0f;
     return a * a;
-  };
+  }
+};
+
+// Steps 3-4: transfer g (eq. 4) and altitude on the snow amount; t = 1 - snow.
+HeightField descriptor_from_accessibility(const HeightField& dem, const HeightField& tsa,
+                                          const CoverOptions& o) {
+  const float r = static_cast<float>(radius_in_metres(o, dem.geo().cell_size_x()));
+  const float b = static_cast<float>(o.floor);
+  float z_max = -kInfinity;
+  for (float v : dem.values()) z_max = std::max(z_max, v);
+  const Altitude altitude{z_max, o};
   HeightField t(dem.width(), dem.height(), 0.0f, dem.geo());
   t.geo().nodata = std::nullopt;
   for_rows(dem.height(), [&](int row) {
     for (int x = 0; x < dem.width(); ++x) {
-      const float tsa = accessibility(x, row);
-      const float g = tsa >= r ? 1.0f : (1.0f - b) * tsa / r + b;
-      const float snow = (1.0f - g) * altitude_factor(dem(x, row));
-      t(x, row) = 1.0f - snow;
+      const float a = tsa(x, row);
+      const float g = a >= r ? 1.0f : (1.0f - b) * a / r + b;
+      t(x, row) = 1.0f - (1.0f - g) * altitude(dem(x, row));
     }
   });
   return t;
 }
 
-// phi of one cell (paper lines 10-15): triangles facing within theta1 of the
-// sun's side (sun_y: +1 north, -1 south) count by their angle from it,
-// averaged over the 12 triangles; 1 is no effect.
-float sun_phi(const HeightField& smoothed, int x, int row, float dx, float dy, float sun_y,
-              float theta1) {
-  const float cos_theta1 = std::cos(theta1);
-  const Vector3f X = position(smoothed, x, row, dx, dy);
-  float phi_sum = 0.0f;
-  for (const auto& tri : kTriangles) {
-    const Vector3f a = position(smoothed, x + tri[0], row + tri[1], dx, dy) - X;
-    const Vector3f c = position(smoothed, x + tri[2], row + tri[3], dx, dy) - X;
-    const Vector3f m = a.cross(c);  // the face normal, up or down (sign below)
-    const float h2 = m.x() * m.x() + m.y() * m.y();
-    float phi = 1.0f;  // 1: no effect (outside the range, or flat)
-    if (h2 > 1e-12f * m.squaredNorm()) {
-      // Cosine of the angle between the face's aspect and the sun's side.
-      const float sign = m.z() < 0.0f ? -1.0f : 1.0f;
-      const float cos_off = sign * m.y() * sun_y / std::sqrt(h2);
-      if (cos_off >= cos_theta1) phi = std::acos(std::min(cos_off, 1.0f)) / theta1;
-    }
-    phi_sum += phi;
-  }
-  return phi_sum / static_cast<float>(kTriangles.size());
-}
-
-// Step 6: triangles facing the sun's side lose snow, the more the closer to it.
-HeightField sun_correction(const HeightField& smoothed, const HeightField& t, double range_deg,
-                           bool southern) {
+// phi of one triangle (offsets of its two other vertices) around X for the sun
+// step: its aspect's angle from the sun's side over theta1, or 1 (no effect)
+// when it faces farther away than theta1 or is flat.
+float triangle_phi(const HeightField& smoothed, int x, int row, const std::array<int, 4>& tri,
+                   float sun_y, float theta1) {
   const float dx = static_cast<float>(smoothed.geo().cell_size_x());
   const float dy = static_cast<float>(smoothed.geo().cell_size_y());
-  // Horizontal unit vector towards the sun's side: south (0, -1) in the
-  // northern hemisphere, north (0, 1) in the southern.
+  const Vector3f X = position(smoothed, x, row, dx, dy);
+  const Vector3f a = position(smoothed, x + tri[0], row + tri[1], dx, dy) - X;
+  const Vector3f c = position(smoothed, x + tri[2], row + tri[3], dx, dy) - X;
+  const Vector3f m = a.cross(c);  // the face normal, up or down (sign below)
+  const float h2 = m.x() * m.x() + m.y() * m.y();
+  if (h2 <= 1e-12f * m.squaredNorm()) return 1.0f;
+  // Cosine of the angle between the face's aspect and the sun's side.
+  const float sign = m.z() < 0.0f ? -1.0f : 1.0f;
+  const float cos_off = sign * m.y() * sun_y / std::sqrt(h2);
+  if (cos_off < std::cos(theta1)) return 1.0f;
+  return std::acos(std::min(cos_off, 1.0f)) / theta1;
+}
+
+// Step 6 at one point. The paper (lines 10-15) updates t = t phi + (1 - phi)
+// once per facing triangle: the snow 1 - t is multiplied by each triangle's
+// phi. The mean variant applies the average phi of the 12 once.
+float sun_corrected(float t, const HeightField& smoothed, int x, int row, float sun_y, float theta1,
+                    SunStep step) {
+  float product = 1.0f, sum = 0.0f;
+  for (const auto& tri : kTriangles) {
+    const float phi = triangle_phi(smoothed, x, row, tri, sun_y, theta1);
+    product *= phi;
+    sum += phi;
+  }
+  const float phi = step == SunStep::PerTriangle ? product : sum / kTriangles.size();
+  return t * phi + (1.0f - phi);
+}
+
+// Step 6 over the grid: sun_y is +1 (north) in the southern hemisphere, -1 (south) otherwise.
+HeightField apply_sun(const HeightField& t, const HeightField& smoothed, const CoverOptions& o,
+                      bool southern) {
   const float sun_y = southern ? 1.0f : -1.0f;
-  const float theta1 = static_cast<float>(range_deg * std::numbers::pi / 180.0);
+  const float theta1 = static_cast<float>(o.sun_range_deg * std::numbers::pi / 180.0);
   HeightField corrected = t;
   for_rows(t.height(), [&](int row) {
-    for (int x = 0; x < t.width(); ++x) {
-      const float phi = sun_phi(smoothed, x, row, dx, dy, sun_y, theta1);
-      corrected(x, row) = t(x, row) * phi + (1.0f - phi);
-    }
+    for (int x = 0; x < t.width(); ++x)
+      corrected(x, row) = sun_corrected(t(x, row), smoothed, x, row, sun_y, theta1, o.sun_step);
   });
   return corrected;
 }
@@ -247,38 +274,38 @@ HeightField sun_correction(const HeightField& smoothed, const HeightField& t, do
 }  // namespace
 
 void CoverOptions::validate() const {
-  terrain::require_in("region", region, 1, 32, "cells");
+  terrain::require_field(region > 0.0 && region <= 32.0, "region", region,
+                         "(0, 32] (the paper's 50 m cells)");
+  terrain::require_in("region_cells", region_cells, 0, 256, "cells (0: from region)");
   terrain::require_in("iterations", iterations, 0, 100);
   terrain::require_in("floor", floor, 0.0, 1.0);
   terrain::require_in("sun_range_deg", sun_range_deg, 0.0, 90.0, "degrees");
-  terrain::require_field(radius_m >= 0.0 && std::isfinite(radius_m), "radius_m", radius_m,
-                         "[0, inf) m (0: radius_cells)");
-  terrain::require_field(radius_cells > 0.0 && std::isfinite(radius_cells), "radius_cells",
-                         radius_cells, "(0, inf)");
+  terrain::require_field(radius_m > 0.0 && std::isfinite(radius_m), "radius_m", radius_m,
+                         "(0, inf) m");
+  terrain::require_field(radius_cells >= 0.0 && std::isfinite(radius_cells), "radius_cells",
+                         radius_cells, "[0, inf) (0: radius_m)");
   terrain::require_field(band_m > 0.0 && std::isfinite(band_m), "band_m", band_m, "(0, inf) m");
 }
 
 CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {
-  check_cover_input(dem, o);
+  validate(dem, o);
   CoverResult result;
-  result.southern = southern_hemisphere(dem, o.hemisphere);
-
-  // 1. Smoothing (paper sec. 4.1 lines 1-3), k times.
+  result.southern = in_southern_hemisphere(dem, o.hemisphere);
+  // 1. Smoothing (paper sec. 4.1 lines 1-3), k times over the region in cells.
   progress(0.0, "smoothing");
+  const int n = region_in_cells(o, dem.geo().cell_size_x());
   HeightField smoothed = dem;
   for (int i = 0; i < o.iterations; ++i) {
-    smoothed = smooth(smoothed, o.region);
+    smoothed = smooth(smoothed, n);
     if (!progress(0.4 * (i + 1) / std::max(o.iterations, 1), "")) throw Cancelled();
   }
   // 2. TSA of the smoothed surface (lines 4-5).
   result.accessibility = tangent_sphere_accessibility(smoothed);
   if (!progress(0.7, "accessibility")) throw Cancelled();
-  // 3-4. Transfer and altitude.
-  HeightField t = transfer(dem, result.accessibility, o);
-  // 5. Smooth t once (its locality makes colours blotchy otherwise).
-  t = smooth(t, 1);
+  // 3-4. Transfer and altitude (lines 6-7, SPEC 3b.4); 5. smooth t once (line 9).
+  HeightField t = smooth(descriptor_from_accessibility(dem, result.accessibility, o), 1);
   // 6. Sun (lines 10-15).
-  if (o.sun_range_deg > 0.0) t = sun_correction(smoothed, t, o.sun_range_deg, result.southern);
+  if (o.sun_range_deg > 0.0) t = apply_sun(t, smoothed, o, result.southern);
   progress(1.0, "");
   result.descriptor = std::move(t);
   return result;

@@ -1,13 +1,21 @@
-// The snow-cover descriptor of paper 001 (Ogawa, Dobashi, Nishita et al.,
-// after Miller 1994's Tangent Sphere Accessibility), with the decisions of
-// SPEC 3b: per grid point a value t in [0, 1], 0 = snow, 1 = bare rock.
+// The snow-cover descriptor of paper 001 (Nakatani, Fujishiro and Ohno, "Design
+// of Surface Descriptor for Rendering Snow-Covered Terrain", after Miller 1994's
+// Tangent Sphere Accessibility), with the decisions of SPEC 3b: per grid point a
+// value t in [0, 1], 0 = snow, 1 = bare rock.
 //
 //   1. smooth the DEM k times over the diamond of region n;
 //   2. TSA of the smoothed surface at each point (paper eq. 3);
 //   3. transfer g(TSA) with probe radius r and floor b (paper eq. 4);
 //   4. altitude: snow = (1 - g) a(z), a = (z / z_max)^2 or a snow line;
 //   5. smooth t once;
-//   6. sun: faces within theta1 of the sun-facing direction lose snow.
+//   6. sun (paper 3.4.2, lines 10-15): each triangle around the point that faces
+//      within theta1 of the sun's side updates t = t phi + (1 - phi), phi its
+//      normalised angle, one triangle after the other.
+//
+// Lengths are metric by default (SPEC 3b.3): the probe radius in metres and the
+// smoothing region in units of the paper's 50 m grid spacing, widened to as many
+// cells as that is on a finer DEM, so that a DEM and the same ground sampled
+// finer give the same descriptor. Cells can be asked for explicitly.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,12 +26,17 @@
 
 namespace drift::snow {
 
+// The paper's grid spacing (its Hodaka DEM, 50 m mesh, section 5): the unit of its
+// smoothing region and, at 0.1 per cell, of its probe radius.
+constexpr double kPaperCellM = 50.0;
+
 // Neighbours within L1 distance n of a point, itself excluded: the paper's
 // 4n + 2n(n - 1) (fig. 8).
 int smoothing_neighbour_count(int region);
 
 // One smoothing pass: new height = (own + mean of the region-n diamond) / 2.
 // Beyond the border the nearest edge cell stands in. NaN must not occur.
+// Sums along rows by prefix sums (double), so a wide region costs O(n) a cell.
 terrain::HeightField smooth(const terrain::HeightField& dem, int region);
 
 // Tangent Sphere Accessibility (metres) of every grid point, +infinity where
@@ -41,20 +54,33 @@ float tsa_at(const terrain::HeightField& dem, const terrain::Grid<Eigen::Vector3
 
 enum class Hemisphere { Auto, North, South };
 
+// How the sun step combines the triangles around a point.
+enum class SunStep {
+  PerTriangle,  // the paper's rule: t = t phi + (1 - phi) for each facing triangle
+  Mean,         // phi averaged over all 12 (1 for those not facing), applied once
+};
+
 struct CoverOptions {
-  int region = 3;                     // smoothing region n, cells [1, 32]
-  int iterations = 5;                 // smoothing passes k [0, 100]
-  double radius_m = 0.0;              // probe radius r in metres; 0: radius_cells x cell size
-  double radius_cells = 55.0;         // the paper's 5.5 at its 0.1 grid spacing
-  double floor = 0.0;                 // b in [0, 1]: how much rock shows at TSA 0
-  double sun_range_deg = 60.0;        // theta1 in [0, 90]; 0 turns the sun off
-  std::optional<double> snow_line_m;  // altitude factor: a snow line instead of (z/zmax)^2
-  double band_m = 200.0;              // ... with a transition band this wide
+  double region = 3.0;          // smoothing region n in the paper's 50 m cells, (0, 32]
+  int region_cells = 0;         // > 0: region n in this DEM's cells instead [1, 256]
+  int iterations = 5;           // smoothing passes k [0, 100]
+  double radius_m = 2750.0;     // probe radius r in metres: the paper's 5.5 (55 x 50 m)
+  double radius_cells = 0.0;    // > 0: probe radius in this DEM's cells instead
+  double floor = 0.0;           // b in [0, 1]: how much rock shows at TSA 0
+  double sun_range_deg = 60.0;  // theta1 in [0, 90]; 0 turns the sun off
+  SunStep sun_step = SunStep::PerTriangle;
+  std::optional<double> snow_line_m;         // altitude factor: a snow line instead of (z/zmax)^2
+  double band_m = 200.0;                     // ... with a transition band this wide
   Hemisphere hemisphere = Hemisphere::Auto;  // Auto: from the DEM's CRS (north if none)
 
   // Throws terrain::ParameterError naming the field out of its range.
   void validate() const;
 };
+
+// The region n in cells and the probe radius in metres that `o` gives on a DEM
+// with cells of `cell_m` metres.
+int region_in_cells(const CoverOptions& o, double cell_m);
+double radius_in_metres(const CoverOptions& o, double cell_m);
 
 struct CoverResult {
   terrain::HeightField descriptor;     // t in [0, 1], the DEM's georeference

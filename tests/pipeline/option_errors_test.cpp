@@ -63,7 +63,7 @@ TEST(OptionErrors, CommandLineSpeaksOfFlags) {
   const std::string out = (fs::temp_directory_path() / "drift_option_errors.tif").string();
   std::string err;
   EXPECT_EQ(run_drift("snow cover missing.tif -o " + out + " --region 40", err), 2);
-  EXPECT_NE(err.find("--region is 40; it must lie in [1, 32]"), std::string::npos) << err;
+  EXPECT_NE(err.find("--region is 40; it must lie in (0, 32]"), std::string::npos) << err;
   EXPECT_EQ(run_drift("snow fall missing.tif -o " + out + " --spread 40", err), 2);
   EXPECT_NE(err.find("--spread is 40"), std::string::npos) << err;
   EXPECT_EQ(run_drift("import missing.tif -o " + out + " --exaggerate 0", err), 1);

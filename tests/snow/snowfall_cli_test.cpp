@@ -1,5 +1,5 @@
-// drift snow fall: writes the rasters and the snowy mesh; bad input exits 2
-// (usage) or 1 (files), naming what was wrong, and writes nothing.
+// drift snow fall: writes the rasters (depth, cover, snow surface) and the snowy mesh; bad input
+// exits 2 (usage) or 1 (files), naming what was wrong, and writes nothing.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -42,12 +42,13 @@ std::string output(const fs::path& d) {
   return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
-TEST(SnowfallCli, WritesDepthCoverAndMesh) {
+TEST(SnowfallCli, WritesDepthCoverSurfaceAndMesh) {
   const fs::path d = dir(), ground = setup(d);
   ASSERT_EQ(run(ground.string() + " --objects " + (d / "objects.toml").string() +
                     " --direction 45,70 --spread 5 --maps 4 --rate 0.01 --hours 20 -o " +
                     (d / "depth.tif").string() + " --cover " + (d / "cover.tif").string() +
-                    " --mesh-out " + (d / "snowy.ply").string() + " --threads 1",
+                    " --surface " + (d / "surface.tif").string() + " --mesh-out " +
+                    (d / "snowy.ply").string() + " --threads 1",
                 d),
             0)
       << output(d);
@@ -55,6 +56,12 @@ TEST(SnowfallCli, WritesDepthCoverAndMesh) {
   EXPECT_EQ(depth.geo().geotransform[0], 600000.0);
   EXPECT_EQ(depth(2, 2), 0.2f);  // open flat ground: rate x hours
   EXPECT_TRUE(fs::exists(d / "cover.tif"));
+  // The snow surface (SPEC 3a): ground + depth, same georeference.
+  const auto surface = drift::terrain::read_raster(d / "surface.tif");
+  EXPECT_EQ(surface.geo().geotransform, depth.geo().geotransform);
+  for (int row = 0; row < depth.height(); ++row)
+    for (int x = 0; x < depth.width(); ++x)
+      EXPECT_EQ(surface(x, row), 1500.0f + depth(x, row)) << x << "," << row;
   EXPECT_GT(fs::file_size(d / "snowy.ply"), 1000u);
   // The mesh is relative to the raster's central cell, in whole metres.
   EXPECT_NE(output(d).find("position = [600010, 3999990, 0]"), std::string::npos) << output(d);
