@@ -77,9 +77,13 @@ void Slippage::step(SoilState& state, const SoilType& soil, double gravity, doub
 }
 
 void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
-  const double h = shape_.voxel_size;
-  const double phi = soil.phi_deg * M_PI / 180.0, c = soil.effective_cohesion();
-  const float grid_top = static_cast<float>(shape_.nz);
+  const SliceConstants k{shape_.voxel_size,
+                         soil.phi_deg * M_PI / 180.0,
+                         soil.effective_cohesion(),
+                         soil.gamma,
+                         gravity,
+                         dt,
+                         static_cast<float>(shape_.nz)};
   tbb::parallel_for(0, shape_.ny, [&](int y) {
     for (int x = 0; x < shape_.nx; ++x) {
       const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
@@ -88,51 +92,7 @@ void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
       int pile = 0;
       for (int s = 0; s < count && pile < kMaxPiles; ++s) {
         if (spans[s].type != SpanType::Piled) continue;
-        const HeightSpan& p = spans[s];
-        double total = 0;
-        for (int d = 0; d < kDirections; ++d) {
-          Out& o = out_[slot(col, pile, d)];
-          float& v = speed_[slot(col, pile, d)];
-          o = Out{};
-          const int nx = x + kDx[d], ny = y + kDy[d];
-          if (nx < 0 || ny < 0 || nx >= shape_.nx || ny >= shape_.ny) {
-            v = 0;
-            continue;
-          }
-          const std::size_t ncol = static_cast<std::size_t>(ny) * shape_.nx + nx;
-          const HeightSpan* n = spans_.column(ncol);
-          const int ncount = spans_.count[ncol];
-          float low_top;
-          const int q = lower_pile(p, n, ncount);
-          if (q >= 0) {
-            low_top = n[q].top;
-            o.target = static_cast<std::int16_t>(q);
-          } else if (p.bottom > 0 && !holds_height(n, ncount, p.bottom)) {
-            low_top = p.bottom;  // edge span (fig. 35)
-            o.edge_voxel =
-                static_cast<std::int16_t>(std::min<int>(shape_.nz - 1, static_cast<int>(p.bottom)));
-          } else {
-            v = 0;
-            continue;
-          }
-          const float rise = std::min(p.top, ceiling_above(n, ncount, low_top, grid_top)) - low_top;
-          const double dx = h * ((d < 4) ? 1.0 : M_SQRT2);
-          const auto theta = failure_plane(rise * h, dx, c, phi, soil.gamma);
-          if (!theta) {
-            v = 0;
-            continue;
-          }
-          const double w = wedge_weight(rise * h, dx, *theta, soil.gamma);
-          v += static_cast<float>(gravity * net_force(rise * h, dx, *theta, soil.gamma) / w * dt);
-          const double share = std::min(kMaxShare, v * dt / dx);  // eq. 10's v dt / dx
-          o.dh = static_cast<float>((rise * h - std::tan(*theta) * dx) * share / h);
-          total += o.dh;
-        }
-        // A pile cannot give more soil than it holds.
-        if (total > p.soil && total > 0) {
-          const float k = static_cast<float>(p.soil / total * (1.0 - 1e-6));
-          for (int d = 0; d < kDirections; ++d) out_[slot(col, pile, d)].dh *= k;
-        }
+        slide_pile(x, y, pile, spans[s], k);
         ++pile;
       }
       for (; pile < kMaxPiles; ++pile)
@@ -142,6 +102,63 @@ void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
         }
     }
   });
+}
+
+void Slippage::slide_pile(int x, int y, int pile, const HeightSpan& p, const SliceConstants& k) {
+  const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
+  double total = 0;
+  for (int d = 0; d < kDirections; ++d) {
+    Out& o = out_[slot(col, pile, d)];
+    float& v = speed_[slot(col, pile, d)];
+    o = Out{};
+    const int nx = x + kDx[d], ny = y + kDy[d];
+    if (nx < 0 || ny < 0 || nx >= shape_.nx || ny >= shape_.ny) {
+      v = 0;
+      continue;
+    }
+    const std::size_t ncol = static_cast<std::size_t>(ny) * shape_.nx + nx;
+    slide_slice(p, spans_.column(ncol), spans_.count[ncol], d, k, o, v);
+    total += o.dh;
+  }
+  // A pile cannot give more soil than it holds.
+  if (total > p.soil && total > 0) {
+    const float scale = static_cast<float>(p.soil / total * (1.0 - 1e-6));
+    for (int d = 0; d < kDirections; ++d) out_[slot(col, pile, d)].dh *= scale;
+  }
+}
+
+void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d,
+                           const SliceConstants& k, Out& o, float& v) const {
+  float low_top, ceiling;
+  const int q = lower_pile(p, n, ncount);
+  if (q >= 0) {
+    low_top = n[q].top;
+    // Eq. 32's B_next is the bottom of the span right above the low pile: a
+    // body resting on the pile caps it even where its partial bottom voxel
+    // lies below T_low, so soil never slides into a pile under a body.
+    ceiling = q + 1 < ncount ? n[q + 1].bottom : k.grid_top;
+    o.target = static_cast<std::int16_t>(q);
+  } else if (p.bottom > 0 && !holds_height(n, ncount, p.bottom)) {
+    low_top = p.bottom;  // edge span (fig. 35)
+    ceiling = ceiling_above(n, ncount, low_top, k.grid_top);
+    o.edge_voxel =
+        static_cast<std::int16_t>(std::min<int>(shape_.nz - 1, static_cast<int>(p.bottom)));
+  } else {
+    v = 0;
+    return;
+  }
+  const double h = k.voxel;
+  const float rise = std::min(p.top, ceiling) - low_top;
+  const double dx = h * ((d < 4) ? 1.0 : M_SQRT2);
+  const auto theta = failure_plane(rise * h, dx, k.cohesion, k.phi, k.gamma);
+  if (!theta) {
+    v = 0;
+    return;
+  }
+  const double w = wedge_weight(rise * h, dx, *theta, k.gamma);
+  v += static_cast<float>(k.gravity * net_force(rise * h, dx, *theta, k.gamma) / w * k.dt);
+  const double share = std::min(kMaxShare, v * k.dt / dx);  // eq. 10's v dt / dx
+  o.dh = static_cast<float>((rise * h - std::tan(*theta) * dx) * share / h);
 }
 
 void Slippage::apply(SoilState& state) const {

@@ -48,7 +48,18 @@ class Slippage {
     std::int16_t target = -1;  // span index in the neighbour column; -1 edge span
     std::int16_t edge_voxel = -1;
   };
+  // What every slice of a step shares: voxel size (m), friction angle (rad),
+  // effective cohesion, unit weight, gravity, time step and the grid's top.
+  struct SliceConstants {
+    double voxel, phi, cohesion, gamma, gravity, dt;
+    float grid_top;
+  };
   void compute_slices(const SoilType& soil, double gravity, double dt);
+  // The slices of pile `pile` (span p) of column (x, y) towards its 8 neighbours.
+  void slide_pile(int x, int y, int pile, const HeightSpan& p, const SliceConstants& k);
+  // One slice from pile p to the column n along direction d: o.dh and the speed v.
+  void slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d,
+                   const SliceConstants& k, Out& o, float& v) const;
   void apply(SoilState& state) const;
 
   terrain::Grid3Shape shape_;

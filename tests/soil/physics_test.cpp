@@ -60,6 +60,39 @@ TEST(SoilPhysics, NoSoilInsideRigidBodies) {
   EXPECT_GT(highest, 0.25f * 32 + 2.0f);
 }
 
+// Highest voxel holding soil (rho > 1e-3), -1 if none.
+int highest_soil_voxel(const SoilState& s) {
+  const terrain::Grid3Shape& g = s.shape;
+  int top = -1;
+  for (int y = 0; y < g.ny; ++y)
+    for (int x = 0; x < g.nx; ++x)
+      for (int z = g.nz - 1; z > top; --z)
+        if (s.rho[g.index(x, y, z)] > 1e-3f) {
+          top = z;
+          break;
+        }
+  return top;
+}
+
+// Soil beside a body never slides into the pile under it and up through it
+// (eq. 32's ceiling is the body's bottom), so nothing pumps soil up the
+// blade's columns: once the blade stops, the highest soil only falls, and it
+// stays within a few voxels of the blade's top (it was carried to the grid's
+// top before the fix).
+TEST(SoilPhysics, PushedSoilNeverClimbsAboveTheBlade) {
+  const int n = 40;
+  SoilSimulation sim = make_simulation(fixtures::push_scenario(n));
+  const double stop = sim.bodies().front().path.back().time;
+  while (sim.time() < stop) sim.step();
+  const int blade_top = static_cast<int>(std::ceil(0.47 * n));
+  const int at_stop = highest_soil_voxel(sim.state());
+  EXPECT_LE(at_stop, blade_top + 4);
+  for (int step = 0; step < 240; ++step) {
+    sim.step();
+    ASSERT_LE(highest_soil_voxel(sim.state()), at_stop) << "step " << step << " after the stop";
+  }
+}
+
 // A locked voxel (eq. 24: rho + psi >= 1) takes no inflow: neighbours moving
 // into it keep their soil (backflow). Unlocked, the same voxel receives it.
 TEST(SoilPhysics, LockedVoxelTakesNoInflow) {
