@@ -173,8 +173,8 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
 
 // The scene file's sections, each read by its own function below; the order
 // here is the order `unknown section` lists them in.
-constexpr std::array<const char*, 9> kSections = {"terrain", "snow",    "ripples", "sun",   "sky",
-                                                  "camera",  "objects", "render",  "output"};
+constexpr std::array<const char*, 10> kSections = {
+    "terrain", "snow", "ripples", "sun", "sky", "clouds", "camera", "objects", "render", "output"};
 
 // Every top-level key must be a known section.
 void check_sections(const toml::table& root, const fs::path& path) {
@@ -343,6 +343,28 @@ void read_sky(const toml::table& root, const fs::path& path, render::Sky& sky_ou
   sky.finish();
 }
 
+// [clouds]: a cloud layer (render/clouds.h), there when the section is; it
+// needs the physical sky.
+void read_clouds(const toml::table& root, const fs::path& path, render::SceneInput& in) {
+  const toml::table* table = subtable(root, "clouds", path);
+  if (!table) return;
+  Section c(table, "clouds", path);
+  render::CloudOptions& o = in.clouds;
+  o.enabled = true;
+  o.coverage = c.number("coverage", o.coverage, 0.0, 1.0);
+  o.density = c.number("density", o.density, 0.0, 500.0);
+  o.altitude = c.number("altitude", o.altitude, 0.0, 20000.0);
+  o.thickness = c.number("thickness", o.thickness, 1.0, 5000.0);
+  o.scale = c.number("scale", o.scale, 50.0, 1e5);
+  o.seed = c.seed("seed", o.seed);
+  c.finish();
+  if (in.sky.model != render::SkyModel::Physical || in.sky.constant) {
+    c.invalid_table(
+        "needs the physical sky, which lights the clouds: remove [sky] model = \"simple\" and "
+        "constant = true, or remove [clouds]");
+  }
+}
+
 // [camera]'s lens: a field of view, or a focal length with an optional
 // aperture for depth of field.
 void read_lens(Section& cam, render::Camera& camera) {
@@ -447,6 +469,7 @@ SceneFile read_scene_file(const fs::path& path) {
   read_ripples(root, path, scene);
   read_sun(root, path, scene);
   read_sky(root, path, scene.input.sky);
+  read_clouds(root, path, scene.input);
   read_camera(root, path, scene);
   scene.input.meshes = read_objects(root, path);
   if (objects_file) {

@@ -6,6 +6,7 @@
 
 #include "render/sampling.h"
 #include "terrain/direction.h"
+#include "terrain/error.h"
 
 namespace drift::render {
 
@@ -14,6 +15,11 @@ namespace {
 using Eigen::Vector3f;
 
 float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCoeff()); }
+
+// Clouds lighting a vertex (its sky samples and the escapes of its bounces,
+// both one function for MIS) are seen through a footprint widening by this
+// per metre: light averages over them, so the finest octaves are not needed.
+constexpr float kCloudLightingSpread = 0.05f;
 
 }  // namespace
 
@@ -32,12 +38,17 @@ PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const
     parameters.aerosol_scale = input.sky.haze;
     atmosphere_ = std::make_unique<Atmosphere>(parameters);
     const double camera_altitude = scene.origin().z() + camera.eye.z();
-    const double reach = camera.eye.head<2>().norm() + scene.extent().norm() +
-                           scene.surround_reach();  // the ground beyond the DEM (render/surround.h)
+    double reach = camera.eye.head<2>().norm() + scene.extent().norm() +
+                   scene.surround_reach();  // the ground beyond the DEM (render/surround.h)
+    if (input.clouds.enabled) {             // the aerial perspective reaches the clouds too
+      clouds_.emplace(input.clouds, scene.origin());
+      reach = std::max(reach, std::min(clouds_->horizon_distance(camera.eye.z()), 3e5));
+    }
     air_ = std::make_unique<PhysicalSky>(*atmosphere_, camera_altitude, sun_dir_.cast<double>(),
                                          static_cast<float>(sun.irradiance), reach);
   }
   base_altitude_ = static_cast<float>(scene.origin().z());
+  if (input.clouds.enabled) init_clouds(input);
   // Light shafts: what the terrain's shadow takes from a camera ray's air.
   shafts_ = air_ && input.sky.light_shafts && sun_up_;
   shadow_slab_ = {scene.bottom(), scene.top()};
@@ -49,6 +60,26 @@ PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const
 
 PathTracer::~PathTracer() = default;
 
+void PathTracer::init_clouds(const SceneInput& input) {
+  if (!air_) {
+    throw Error(
+        "clouds need the physical sky: set [sky] model = \"physical\" (and constant = false) or "
+        "remove [clouds]");
+  }
+  // The layer's light: the sun at its altitude, through the same atmosphere,
+  // and the diffuse light of the sky above and of the ground below (a mean
+  // mountain albedo of 0.15).
+  const float altitude = static_cast<float>(input.clouds.altitude);
+  cloud_light_.sun = sun_up_ ? air_->sun_irradiance(altitude) : Vector3f::Zero();
+  cloud_light_.sun_dir = sun_dir_;
+  sun_penumbra_ = static_cast<float>(input.sun.angular_diameter_deg * std::numbers::pi / 180.0);
+  const Vector3f level = air_->level_irradiance();
+  const float camera_altitude = base_altitude_ + camera_.eye.z();
+  cloud_light_.sky_down =
+      (level - air_->sun_irradiance(camera_altitude) * std::max(sun_dir_.z(), 0.0f)).cwiseMax(0.0f);
+  cloud_light_.ground_up = 0.15f * level;
+}
+
 Vector3f PathTracer::sky_light(const Vector3f& dir) const {
   return air_ ? air_->sky(dir) : sky_radiance(input_.sky, dir);
 }
@@ -58,6 +89,40 @@ Vector3f PathTracer::shaft_loss(const Path& path, float distance, std::uint64_t&
   const auto in_shadow = [&](const Vector3f& p) { return scene_.occluded(p, sun_dir_, 1e30f); };
   return shaft_shadow_loss(*air_, base_altitude_, {path.origin, path.dir, distance}, shadow_slab_,
                            input_.sky.shaft_steps, path.shaft_jitter, in_shadow);
+}
+
+Vector3f PathTracer::cloudy_sky(const Vector3f& origin, const Vector3f& dir, const Vector3f& behind,
+                                bool from_camera, const RayCone& cone) const {
+  CloudCrossing c;
+  if (!clouds_ || !clouds_->cross(origin, dir, 1e30f, c)) return behind;
+  const float footprint = cone.width + cone.spread * c.distance;
+  const CloudLook look = cloud_look(*clouds_, c, dir, cloud_light_, footprint);
+  if (look.transmittance >= 1.0f) return behind;
+  // The sky's light is the air before the layer, the layer, and what lies
+  // beyond: L = T_c L_sky + (1 - T_c) L_air(0, d) + T_air(0, d) L_cloud.
+  const AirSegment air =
+      from_camera
+          ? air_->from_camera(dir, c.distance)
+          : air_->segment(base_altitude_ + 0.5f * (origin.z() + c.point.z()), dir, c.distance);
+  return look.transmittance * behind + (1.0f - look.transmittance) * air.inscatter +
+         air.transmittance.cwiseProduct(look.radiance);
+}
+
+void PathTracer::cross_clouds(Path& path, float distance, int depth, PixelSample& out) const {
+  // Ground seen through the layer: the same composition as cloudy_sky's,
+  // with the air and ground behind added by cross_air through the throughput.
+  CloudCrossing c;
+  if (!clouds_->cross(path.origin, path.dir, distance, c)) return;
+  const float footprint = path.cone.width + path.cone.spread * c.distance;
+  const CloudLook look = cloud_look(*clouds_, c, path.dir, cloud_light_, footprint);
+  if (look.transmittance >= 1.0f) return;
+  const AirSegment air =
+      depth == 0 ? air_->from_camera(path.dir, c.distance)
+                 : air_->segment(base_altitude_ + 0.5f * (path.origin.z() + c.point.z()), path.dir,
+                                 c.distance);
+  out.radiance += path.throughput.cwiseProduct((1.0f - look.transmittance) * air.inscatter +
+                                               air.transmittance.cwiseProduct(look.radiance));
+  path.throughput *= look.transmittance;
 }
 
 PathTracer::Path PathTracer::camera_path(int px, int py, SampleStream& rng) const {
@@ -87,6 +152,7 @@ PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& 
       escape_to_sky(path, depth, out, rays);
       break;
     }
+    if (clouds_) cross_clouds(path, hit.distance, depth, out);
     if (air_) cross_air(path, hit, depth, out, rays);
     if (depth == settings_.max_depth) break;
     if (depth == 0) {
@@ -117,6 +183,10 @@ void PathTracer::escape_to_sky(const Path& path, int depth, PixelSample& out,
   if (depth == 0 && shafts_) {
     light -= shaft_loss(path, air_reach_, rays);
     light = light.cwiseMax(0.0f);
+  }
+  if (clouds_) {
+    const RayCone cone{path.cone.width, depth == 0 ? path.cone.spread : kCloudLightingSpread};
+    light = cloudy_sky(path.origin, path.dir, light, depth == 0, cone);
   }
   const float w = depth > 0 && sky_sampler_
                       ? power_heuristic(path.bounce_pdf, sky_sampler_->pdf(path.dir))
@@ -149,8 +219,12 @@ void PathTracer::sample_sun(const Path& path, const Hit& hit, const Vector3f& p,
   const Vector3f l = cone_sample(sun_dir_, sun_cos_max_, u1, u2);
   const float cos_l = hit.normal.dot(l);
   if (cos_l > 0.0f && l.z() > -0.2f && (++rays, !scene_.occluded(p, l, 1e30f))) {
-    const Vector3f e =
-        air_ ? air_->sun_irradiance(base_altitude_ + hit.position.z()) : sun_irradiance_;
+    Vector3f e = air_ ? air_->sun_irradiance(base_altitude_ + hit.position.z()) : sun_irradiance_;
+    // Cloud shadow, blurred as the sun's disc blurs it (its penumbra).
+    if (clouds_) {
+      const float width = path.cone.width + path.cone.spread * hit.distance;
+      e *= clouds_->transmittance(p, l, width, sun_penumbra_);
+    }
     out.radiance += path.throughput.cwiseProduct(bsdf.eval(l)).cwiseProduct(e) * cos_l;
   }
 }
@@ -166,8 +240,12 @@ void PathTracer::sample_sky(const Path& path, const Hit& hit, const Vector3f& p,
   const Vector3f f = cos_l > 0.0f ? bsdf.eval(light.dir) : Vector3f::Zero();
   if (f.maxCoeff() > 0.0f && (++rays, !scene_.occluded(p, light.dir, 1e30f))) {
     const float w = power_heuristic(light.pdf, bsdf.pdf(light.dir));
-    out.radiance += path.throughput.cwiseProduct(f).cwiseProduct(sky_light(light.dir)) *
-                    (cos_l * w / light.pdf);
+    Vector3f sky = sky_light(light.dir);
+    if (clouds_) {
+      const RayCone cone{path.cone.width + path.cone.spread * hit.distance, kCloudLightingSpread};
+      sky = cloudy_sky(p, light.dir, sky, false, cone);
+    }
+    out.radiance += path.throughput.cwiseProduct(f).cwiseProduct(sky) * (cos_l * w / light.pdf);
   }
 }
 

@@ -14,6 +14,7 @@
 
 #include "render/atmosphere.h"
 #include "render/bsdf.h"
+#include "render/clouds.h"
 #include "render/light_shafts.h"
 #include "render/physical_sky.h"
 #include "render/random.h"
@@ -60,6 +61,14 @@ class PathTracer {
   Path camera_path(int px, int py, SampleStream& rng) const;
   Eigen::Vector3f sky_light(const Eigen::Vector3f& dir) const;
   Eigen::Vector3f shaft_loss(const Path& path, float distance, std::uint64_t& rays) const;
+  // The cloud layer (render/clouds.h): what a ray from `origin` sees of the
+  // sky `behind` the layer, and the layer's light and loss on a path that
+  // crosses it before reaching `distance`.
+  Eigen::Vector3f cloudy_sky(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
+                             const Eigen::Vector3f& behind, bool from_camera,
+                             const RayCone& cone) const;
+  void cross_clouds(Path& path, float distance, int depth, PixelSample& out) const;
+  void init_clouds(const SceneInput& input);
   // The steps of trace(), each adding its light to `out`.
   void escape_to_sky(const Path& path, int depth, PixelSample& out, std::uint64_t& rays) const;
   void cross_air(Path& path, const Hit& hit, int depth, PixelSample& out,
@@ -90,6 +99,9 @@ class PathTracer {
   ShadowSlab shadow_slab_{0.0f, 0.0f};
   float air_reach_ = 0.0f;
   std::optional<SkySampler> sky_sampler_;
+  std::optional<CloudLayer> clouds_;
+  CloudLight cloud_light_;
+  float sun_penumbra_ = 0.0f;  // the sun disc's angular diameter (radians)
 };
 
 }  // namespace drift::render

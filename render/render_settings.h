@@ -7,6 +7,7 @@
 #include <optional>
 #include <vector>
 
+#include "render/clouds.h"
 #include "render/surface.h"
 #include "render/surround.h"
 #include "terrain/grid.h"
@@ -88,6 +89,7 @@ struct SceneInput {
   std::vector<terrain::PlacedMesh> meshes;
   Sun sun;
   Sky sky;
+  CloudOptions clouds;  // a cloud layer (render/clouds.h); physical sky only
   std::optional<Camera> camera;  // none: the default view of the terrain
 };
 

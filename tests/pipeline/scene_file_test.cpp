@@ -432,3 +432,34 @@ TEST(SceneFile, BadMaterialKeysNameKeyAndFile) {
   EXPECT_NE(empty.find("s.toml"), std::string::npos) << empty;
   EXPECT_NE(error_of(t + "rule = 3\n").find("[[terrain.rule]]"), std::string::npos);
 }
+
+TEST(SceneFile, CloudsAreReadAndChecked) {
+  // No [clouds]: none (the default scenes stay clear and their bits unchanged).
+  const fs::path clear = write_scene("clear.toml", std::string(kTerrain));
+  EXPECT_FALSE(drift::pipeline::read_scene_file(clear).input.clouds.enabled);
+  const fs::path p = write_scene(
+      "clouds.toml", std::string(kTerrain) +
+                         "[clouds]\ncoverage = 0.3\ndensity = 20\naltitude = 5200\nthickness = "
+                         "600\nscale = 3000\nseed = 9\n");
+  const drift::render::CloudOptions c = drift::pipeline::read_scene_file(p).input.clouds;
+  EXPECT_TRUE(c.enabled);
+  EXPECT_DOUBLE_EQ(c.coverage, 0.3);
+  EXPECT_DOUBLE_EQ(c.density, 20.0);
+  EXPECT_DOUBLE_EQ(c.altitude, 5200.0);
+  EXPECT_DOUBLE_EQ(c.thickness, 600.0);
+  EXPECT_DOUBLE_EQ(c.scale, 3000.0);
+  EXPECT_EQ(c.seed, 9u);
+  for (const char* bad : {"coverage = nan", "coverage = 1.5", "density = -1", "density = inf",
+                          "altitude = 30000", "thickness = 0", "scale = 10", "seed = -3"}) {
+    const std::string key =
+        std::string("clouds.") + std::string(bad).substr(0, std::string(bad).find(' '));
+    const std::string e = error_of(std::string(kTerrain) + "[clouds]\n" + bad + "\n");
+    EXPECT_NE(e.find(key), std::string::npos) << bad << ": " << e;
+    EXPECT_NE(e.find("s.toml"), std::string::npos) << e;
+  }
+  EXPECT_NE(error_of(std::string(kTerrain) + "[clouds]\ncover = 0.5\n").find("cover"),
+            std::string::npos);
+  const std::string simple =
+      error_of(std::string(kTerrain) + "[sky]\nmodel = \"simple\"\n[clouds]\ncoverage = 0.5\n");
+  EXPECT_NE(simple.find("physical sky"), std::string::npos) << simple;
+}
