@@ -96,7 +96,7 @@ void track(const std::uint8_t* data, std::size_t size) {
     double t0 = 1e300, t1 = -1e300;
     for (const marks::MarkObject& o : t.objects)
       t0 = std::min(t0, o.trajectory.start()), t1 = std::max(t1, o.trajectory.end());
-    if ((t1 - t0) / t.step > 20) return;
+    if ((t1 - t0) / t.step > 8) return;  // a few steps: many inputs a second
     const Eigen::Vector3d at = t.objects.front().trajectory.keys.front().position;
     terrain::GeoReference geo = terrain::local_georeference(0.02);
     geo.geotransform[0] = at.x() - 0.32, geo.geotransform[3] = at.y() + 0.32;
@@ -117,7 +117,7 @@ void scenario(const std::uint8_t* data, std::size_t size) {
   refusals_allowed([&] {
     const soil::SoilScenario sc = pipeline::read_soil_scenario(file);
     const double voxels = double(sc.shape.nx) * sc.shape.ny * sc.shape.nz;
-    if (voxels > 40.0 * 40 * 40) return;
+    if (voxels > 24.0 * 24 * 24) return;  // small: many inputs a second
     soil::SoilSimulation sim = soil::make_simulation(sc);
     sim.step();
     sim.step();
