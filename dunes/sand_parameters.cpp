@@ -52,14 +52,7 @@ const std::vector<SandParameter>& sand_parameters() {
 #undef DRIFT_SAND_FIELD
 
 std::string range_text(const SandParameter& p) {
-  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
-  std::string text = "[";
-  text += terrain::format_value(p.lo);
-  text += ", ";
-  text += terrain::format_value(p.hi);
-  text += "]";
-  if (*p.unit) (text += " ") += p.unit;
-  return text;
+  return terrain::range_text(p.lo, p.hi, false, p.unit);
 }
 
 }  // namespace drift::dunes

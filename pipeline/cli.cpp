@@ -89,6 +89,12 @@ void validate_flags(const std::function<void()>& validate, const FlagNames& flag
   }
 }
 
+std::string whole_number(const std::string& text) {
+  return !text.empty() && text.find_first_not_of("0123456789") == std::string::npos
+             ? std::string()
+             : std::string("must be a whole number");
+}
+
 void usage_error(const std::string& message) { throw CLI::ValidationError(message); }
 
 std::vector<CommandRegistration>& command_registry() {

@@ -45,6 +45,10 @@ using FlagNames = std::vector<std::pair<std::string, std::string>>;
 void validate_flags(const std::function<void()>& validate, const FlagNames& flags,
                     bool usage = true);
 
+// A CLI11 check for the integer rows of a parameter table: "" for a whole
+// number (digits only), else the problem.
+std::string whole_number(const std::string& text);
+
 // Throws a usage error (exit 2) with `message`, e.g. for incompatible options.
 [[noreturn]] void usage_error(const std::string& message);
 

@@ -98,17 +98,10 @@ void add_dunes_command(CLI::App& root) {
       ->check(CLI::IsMember({"ripples", "dunes"}))
       ->capture_default_str();
   sub->add_option("-o,--output", c->output, "output GeoTIFF (heights in metres)")->required();
-  const CLI::Validator whole(
-      [](const std::string& text) {
-        return text.find_first_not_of("0123456789") == std::string::npos
-                   ? std::string()
-                   : std::string("must be a whole number");
-      },
-      "WHOLE");
   for (std::size_t i = 0; i < dunes::sand_parameters().size(); ++i) {
     const dunes::SandParameter& p = dunes::sand_parameters()[i];
     CLI::Option* opt = sub->add_option(p.flag, c->values[i], parameter_help(p));
-    if (p.integer) opt->check(whole);
+    if (p.integer) opt->check(CLI::Validator(whole_number, "WHOLE"));
   }
   sub->add_option("--snapshot-every", c->snapshot_every,
                   "also write OUT_<step>.tif every K steps (for animations)")

@@ -6,9 +6,11 @@
 
 #include "pipeline/cli.h"
 #include "pipeline/progress_bar.h"
+#include "snow/cover_parameters.h"
 #include "snow/snow_cover.h"
 #include "terrain/error.h"
 #include "terrain/output_set.h"
+#include "terrain/parameter.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -19,11 +21,25 @@ struct CoverCommand {
   std::string dem, output, accessibility, descriptor, hemisphere = "auto",
                                                       sun_step = "per-triangle";
   double snow_line = 0.0;
-  snow::CoverOptions options;
+  // The table's flags as parsed (snow/cover_parameters.h); only those given
+  // override CoverOptions{}'s defaults.
+  std::vector<double> values = std::vector<double>(snow::cover_parameters().size(), 0.0);
 };
 
+// A flag's help: its meaning, range and default, from the table.
+std::string parameter_help(const snow::CoverParameter& p) {
+  return std::string(p.meaning) + " " + p.range() +
+         " (default: " + terrain::format_value(p.get(snow::CoverOptions{})) + ")";
+}
+
 void run_cover(CoverCommand& c, const CLI::App& sub) {
-  snow::CoverOptions o = c.options;
+  snow::CoverOptions o;
+  FlagNames flags;
+  for (std::size_t i = 0; i < snow::cover_parameters().size(); ++i) {
+    const snow::CoverParameter& p = snow::cover_parameters()[i];
+    if (sub.count(p.flag)) p.set(o, c.values[i]);
+    flags.emplace_back(p.field, p.flag);
+  }
   if (sub.count("--radius") && sub.count("--radius-cells")) {
     usage_error("give --radius (metres) or --radius-cells, not both");
   }
@@ -36,15 +52,9 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
   o.hemisphere = c.hemisphere == "north"   ? snow::Hemisphere::North
                  : c.hemisphere == "south" ? snow::Hemisphere::South
                                            : snow::Hemisphere::Auto;
-  // The ranges live in CoverOptions::validate(); checked before reading the DEM.
-  validate_flags([&o] { o.validate(); }, {{"region", "--region"},
-                                          {"region_cells", "--region-cells"},
-                                          {"iterations", "--iterations"},
-                                          {"floor", "--floor"},
-                                          {"sun_range_deg", "--sun-range"},
-                                          {"radius_m", "--radius"},
-                                          {"radius_cells", "--radius-cells"},
-                                          {"band_m", "--band"}});
+  // The ranges live in the table; checked before reading the DEM.
+  flags.emplace_back("snow_line_m", "--snow-line");
+  validate_flags([&o] { o.validate(); }, flags);
   OutputSet outputs({c.output, c.descriptor, c.accessibility}, {c.dem});
   const terrain::HeightField dem = terrain::read_raster(c.dem);
   snow::CoverResult r;
@@ -82,26 +92,13 @@ void add_snow_cover_command(CLI::App& root) {
                                  "snow-cover descriptor of a DEM (tangent sphere accessibility, "
                                  "altitude, sun aspect; paper 001)",
                                  [c](const CLI::App& self) { run_cover(*c, self); });
-  snow::CoverOptions& o = c->options;
   sub->add_option("dem", c->dem, "DEM GeoTIFF in metres (drift import)")->required();
   sub->add_option("-o,--output", c->output, "snow cover GeoTIFF, 1 - t in [0, 1]")->required();
-  sub->add_option("--region", o.region,
-                  "smoothing region n in the paper's 50 m cells (diamond of 4n + 2n(n-1)), "
-                  "widened to n x 50 m / cell size on this DEM")
-      ->capture_default_str();
-  sub->add_option("--region-cells", o.region_cells,
-                  "smoothing region n in this DEM's cells instead of --region");
-  sub->add_option("--iterations", o.iterations, "smoothing passes k")->capture_default_str();
-  sub->add_option("--radius", o.radius_m,
-                  "probe radius r in metres (the paper's 5.5 at its 0.1 per 50 m cell = 2750)")
-      ->capture_default_str();
-  sub->add_option("--radius-cells", o.radius_cells,
-                  "probe radius in this DEM's cells instead of --radius (the paper's 5.5 = 55)");
-  sub->add_option("--floor", o.floor, "b: rock showing where TSA is 0, [0, 1]")
-      ->capture_default_str();
-  sub->add_option("--sun-range", o.sun_range_deg,
-                  "theta1: slopes facing within this many degrees of the sun lose snow (0: off)")
-      ->capture_default_str();
+  for (std::size_t i = 0; i < snow::cover_parameters().size(); ++i) {
+    const snow::CoverParameter& p = snow::cover_parameters()[i];
+    CLI::Option* opt = sub->add_option(p.flag, c->values[i], parameter_help(p));
+    if (p.integer) opt->check(CLI::Validator(whole_number, "WHOLE"));
+  }
   sub->add_option("--sun-step", c->sun_step,
                   "per-triangle (the paper: t = t phi + 1 - phi for each facing triangle) or mean "
                   "(phi averaged over the 12 triangles, applied once)")
@@ -109,8 +106,6 @@ void add_snow_cover_command(CLI::App& root) {
       ->capture_default_str();
   sub->add_option("--snow-line", c->snow_line,
                   "snow line in metres: no snow below, full above (default: (z/zmax)^2)");
-  sub->add_option("--band", o.band_m, "width of the snow line's transition, metres")
-      ->capture_default_str();
   sub->add_option("--hemisphere", c->hemisphere,
                   "where the sun stands: auto (from the DEM's CRS), north or south")
       ->check(CLI::IsMember({"auto", "north", "south"}))

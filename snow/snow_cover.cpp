@@ -11,6 +11,7 @@
 #include <numbers>
 #include <vector>
 
+#include "snow/cover_parameters.h"
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
@@ -274,17 +275,10 @@ HeightField apply_sun(const HeightField& t, const HeightField& smoothed, const C
 }  // namespace
 
 void CoverOptions::validate() const {
-  terrain::require_field(region > 0.0 && region <= 32.0, "region", region,
-                         "(0, 32] (the paper's 50 m cells)");
-  terrain::require_in("region_cells", region_cells, 0, 256, "cells (0: from region)");
-  terrain::require_in("iterations", iterations, 0, 100);
-  terrain::require_in("floor", floor, 0.0, 1.0);
-  terrain::require_in("sun_range_deg", sun_range_deg, 0.0, 90.0, "degrees");
-  terrain::require_field(radius_m > 0.0 && std::isfinite(radius_m), "radius_m", radius_m,
-                         "(0, inf) m");
-  terrain::require_field(radius_cells >= 0.0 && std::isfinite(radius_cells), "radius_cells",
-                         radius_cells, "[0, inf) (0: radius_m)");
-  terrain::require_field(band_m > 0.0 && std::isfinite(band_m), "band_m", band_m, "(0, inf) m");
+  for (const CoverParameter& p : cover_parameters()) p.require(*this);
+  if (snow_line_m)
+    terrain::require_field(std::isfinite(*snow_line_m), "snow_line_m", *snow_line_m,
+                           "(-inf, inf) m");
 }
 
 CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {

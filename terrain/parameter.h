@@ -42,17 +42,55 @@ inline void require_field(bool ok, const std::string& field, double value,
   if (!ok) throw ParameterError(field, "is " + format_value(value) + "; it must lie in " + range);
 }
 
+// A range as messages, help and docs give it: "[lo, hi]", "(lo, hi]" with an
+// open lower end, "inf" for an unbounded upper one, then the unit if any.
+inline std::string range_text(double lo, double hi, bool lo_open = false, const char* unit = "") {
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
+  std::string range = lo_open ? "(" : "[";
+  range += format_value(lo);
+  range += ", ";
+  range += std::isinf(hi) ? std::string("inf)") : format_value(hi) + "]";
+  if (*unit) (range += " ") += unit;
+  return range;
+}
+
 // The closed range [lo, hi] (finite values only).
 inline void require_in(const std::string& field, double value, double lo, double hi,
                        const char* unit = "") {
-  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
-  std::string range = "[";
-  range += format_value(lo);
-  range += ", ";
-  range += format_value(hi);
-  range += "]";
-  if (*unit) (range += " ") += unit;
-  require_field(std::isfinite(value) && value >= lo && value <= hi, field, value, range);
+  require_field(std::isfinite(value) && value >= lo && value <= hi, field, value,
+                range_text(lo, hi, false, unit));
 }
+
+// One row of an options struct's parameter table (Mitsuba's parameter tables
+// are the model): the field as library errors name it, the command line's
+// flag, the range, the unit and what it means. The struct's validate(), the
+// command line's flags and help, and the docs' table all come from the rows;
+// the defaults are the struct's own (Options{}).
+template <class Options>
+struct Parameter {
+  const char* field;
+  const char* flag;
+  double lo, hi;  // hi may be +inf
+  bool lo_open;   // (lo, hi] rather than [lo, hi]
+  bool integer;   // a whole number
+  const char* unit;
+  const char* meaning;
+  double (*get)(const Options&);
+  void (*set)(Options&, double);
+
+  std::string range() const { return range_text(lo, hi, lo_open, unit); }
+  // Finite, in range and, for an integer, whole (NaN fails every comparison).
+  bool admits(double v) const {
+    return std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi &&
+           (!integer || v == std::floor(v));
+  }
+  // Throws ParameterError naming the field unless `o`'s value is admitted.
+  void require(const Options& o) const { require_field(admits(get(o)), field, get(o), range()); }
+};
+
+// A row's get and set for member `m` of an options struct (int or double).
+#define DRIFT_PARAMETER_FIELD(Options, m)                    \
+  [](const Options& o) { return static_cast<double>(o.m); }, \
+      [](Options& o, double v) { o.m = static_cast<decltype(o.m)>(v); }
 
 }  // namespace drift::terrain

@@ -6,48 +6,27 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "terrain/parameter.h"
+#include "tests/markdown_table.h"
 
 using namespace drift::dunes;
 using drift::terrain::format_value;
 
 namespace {
 
-std::vector<std::string> cells_of(const std::string& row) {
-  std::vector<std::string> out;
-  std::stringstream in(row);
-  std::string cell;
-  std::getline(in, cell, '|');  // before the first bar
-  while (std::getline(in, cell, '|')) {
-    const auto a = cell.find_first_not_of(' '), b = cell.find_last_not_of(' ');
-    out.push_back(a == std::string::npos ? "" : cell.substr(a, b - a + 1));
-  }
-  if (!out.empty() && out.back().empty()) out.pop_back();
-  return out;
-}
-
 // docs/dunes.md's rows by flag: ripples, dunes, range, unit, meaning.
 std::map<std::string, std::vector<std::string>> documented() {
-  std::ifstream f(DRIFT_SOURCE_DIR "/docs/dunes.md");
   std::map<std::string, std::vector<std::string>> rows;
-  std::string line;
-  bool in_table = false;
-  while (std::getline(f, line)) {
-    if (line.rfind("| option | ripples | dunes | range | unit | meaning |", 0) == 0)
-      in_table = true;
-    if (!in_table) continue;
-    if (line.empty()) break;
-    const auto cells = cells_of(line);
+  for (const auto& cells :
+       drift::testing::markdown_table(DRIFT_SOURCE_DIR "/docs/dunes.md",
+                                      "| option | ripples | dunes | range | unit | meaning |"))
     if (cells.size() == 6 && cells[0].rfind("`--", 0) == 0)
       rows[cells[0].substr(1, cells[0].size() - 2)] = {cells[1], cells[2], cells[3], cells[4],
                                                        cells[5]};
-  }
   return rows;
 }
 
