@@ -27,7 +27,7 @@ struct ColumnScan {
       push(SpanType::Piled, b, static_cast<float>(nz), soil, nz - 1);
       return nz;
     }
-    if (solid(j)) {  // runs into a body right above: the top meets the body's bottom
+    if (solid(j)) {  // runs into a body right above: top z + rho (table 2), the body's bottom
       const float capped =
           j > z && psi[j - 1] > 0 ? static_cast<float>(j) - psi[j - 1] : static_cast<float>(j);
       push(SpanType::Piled, b, capped, soil, j - 1);

@@ -48,8 +48,85 @@ std::vector<float> surface_density(const SoilState& s, const SurfaceOptions& o) 
   return out;
 }
 
+namespace {
+
+// Height (voxels) of the soil a column's floor pile holds; 0 for bare
+// ground, -1 where the column stands on a body (no floor pile).
+float floor_pile_top(const float* rho, const float* psi, int nz) {
+  HeightSpan spans[HeightSpans::kMaxSpans];
+  const int n = build_column_spans(rho, psi, nz, spans, HeightSpans::kMaxSpans);
+  if (n == 0 || psi[0] > 0 || spans[0].type != SpanType::Piled) return -1.0f;
+  return spans[0].bottom == 0.0f ? std::max(0.0f, spans[0].top) : -1.0f;
+}
+
+// The pad row under the floor: the ramp of surface.h carried on half a voxel
+// below the floor, for columns holding soil on the floor and for the bare
+// columns beside them (as if their top lay a quarter voxel under the floor,
+// so the soil's surface runs on down into the ground instead of ending in a
+// rim); 0 elsewhere.
+std::vector<float> floor_pads(const SoilState& s, int ramp) {
+  const terrain::Grid3Shape& g = s.shape;
+  std::vector<float> top(g.columns());
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t c = g.column(x, y);
+      top[static_cast<std::size_t>(y) * g.nx + x] =
+          floor_pile_top(s.rho.data() + c, s.psi.data() + c, g.nz);
+    }
+  });
+  auto ramp_at = [ramp](float t) {
+    return std::clamp(0.5f + (t + 0.5f) / (2.0f * ramp), 0.f, 1.f);
+  };
+  std::vector<float> pad(g.columns(), 0.0f);
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) {
+      const float t = top[static_cast<std::size_t>(y) * g.nx + x];
+      float& out = pad[static_cast<std::size_t>(y) * g.nx + x];
+      if (t > 0) out = ramp_at(t);
+      if (t != 0) continue;  // soil, or a body on the floor
+      for (int ny = std::max(0, y - 1); ny <= std::min(g.ny - 1, y + 1); ++ny)
+        for (int nx = std::max(0, x - 1); nx <= std::min(g.nx - 1, x + 1); ++nx)
+          if (top[static_cast<std::size_t>(ny) * g.nx + nx] > 0) out = ramp_at(-0.25f);
+    }
+  });
+  return pad;
+}
+
+// The straightened density over a grid one voxel deeper, the pad row under
+// the floor, so a pile's foot thinner than half a voxel (whose first voxel
+// centre lies above its top) still has its 0.5 crossing at its top instead of
+// ending in a half-voxel step at the floor.
+terrain::Mesh floor_padded_surface(const SoilState& s, const std::vector<float>& field, int ramp) {
+  const terrain::Grid3Shape& g = s.shape;
+  terrain::Grid3Shape padded = g;
+  padded.nz = g.nz + 1;
+  padded.origin.z() -= g.voxel_size;
+  const std::vector<float> pad = floor_pads(s, ramp);
+  std::vector<float> out(padded.count());
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t c = g.column(x, y), pc = padded.column(x, y);
+      out[pc] = pad[static_cast<std::size_t>(y) * g.nx + x];
+      std::copy(field.begin() + c, field.begin() + c + g.nz, out.begin() + pc + 1);
+    }
+  });
+  terrain::Mesh mesh = iso_surface(padded, out);
+  // What lies under the floor is hidden by the ground: flatten it just under
+  // the floor (a hundredth of a voxel, so the ground, not a sheet of soil
+  // level with it, is what a ray sees there). The surface stays closed and
+  // encloses the soil's volume.
+  const float floor = static_cast<float>(g.origin.z() - 0.01 * g.voxel_size);
+  for (auto& p : mesh.positions) p.z() = std::max(p.z(), floor);
+  return mesh;
+}
+
+}  // namespace
+
 terrain::Mesh soil_surface(const SoilState& s, const SurfaceOptions& o, double moisture) {
-  terrain::Mesh mesh = iso_surface(s.shape, surface_density(s, o));
+  terrain::Mesh mesh =
+      o.ridges == RidgeFix::Off
+          ? iso_surface(s.shape, surface_density(s, o))
+          : floor_padded_surface(s, surface_density(s, o), std::clamp(o.ramp_voxels, 1, 16));
   mesh.vertex_attributes.push_back(
       {"wetness", std::vector<float>(mesh.positions.size(), static_cast<float>(moisture))});
   return mesh;

@@ -38,7 +38,10 @@ terrain::GeoReference grid_georeference(const terrain::Grid3Shape& g) {
 
 terrain::HeightField ground_raster(const terrain::Grid3Shape& g, const terrain::HeightField& hf,
                                    int margin) {
-  terrain::GeoReference geo = grid_georeference(g);
+  // A DEM's crop keeps the DEM's georeference (so the renderer can set the
+  // whole DEM around it as its surround); else the grid's own frame.
+  terrain::GeoReference geo = hf.geo().crs_wkt.empty() ? grid_georeference(g) : hf.geo();
+  geo.nodata.reset();
   geo.geotransform[0] -= margin * g.voxel_size;
   geo.geotransform[3] += margin * g.voxel_size;
   terrain::HeightField out(g.nx + 2 * margin, g.ny + 2 * margin, static_cast<float>(g.origin.z()),

@@ -24,7 +24,9 @@ terrain::GeoReference grid_georeference(const terrain::Grid3Shape& shape);
 // Ground for rendering around the soil: the height-field terrain under the
 // grid (`terrain`, same columns; empty = the grid's flat floor), widened by
 // `margin` columns on every side (edges repeated), in metres, georeferenced
-// as grid_georeference with the margin.
+// as the terrain if it has a CRS (a DEM's crop: the meshes' local x, y are
+// then metres east and north of the crop's south-west corner), else as
+// grid_georeference; widened by the margin.
 terrain::HeightField ground_raster(const terrain::Grid3Shape& shape,
                                    const terrain::HeightField& terrain, int margin);
 

@@ -86,5 +86,42 @@ TEST(SoilSurface, StraightSlopesRemoveVerticalRidges) {
   std::printf("slope normals' x spread: %.4f without the fix, %.6f with it\n", before, after);
 }
 
+// Soil thinner than half a voxel on the floor (a pile's foot): its first
+// voxel centre lies above its top, so without the row under the floor the
+// surface ended in a half-voxel step where it thinned below 0.5 (the
+// renders' steps at the pile foot). With it the top stays at the soil's
+// height, the bottom lies on the floor and the layer reaches past the centres
+// of its outermost columns (by under half a voxel: the foot tapers).
+TEST(SoilSurface, ThinSoilAtAPileFootKeepsItsHeight) {
+  SoilState s(terrain::Grid3Shape{16, 16, 8, 1.0, {0, 0, 0}});
+  for (int y = 4; y < 12; ++y)
+    for (int x = 4; x < 12; ++x) s.rho[s.shape.index(x, y, 0)] = 0.3f;
+  const terrain::Mesh m = soil_surface(s, {RidgeFix::StraightSlopes, 3, 0.0});
+  ASSERT_FALSE(m.triangles.empty());
+  EXPECT_TRUE(watertight(m));
+  EXPECT_GT(signed_volume(m), 0.0);
+  Eigen::Vector3f lo = m.positions.front(), hi = lo;           // all of it
+  Eigen::Vector3f top_lo(1e9f, 1e9f, 1e9f), top_hi = -top_lo;  // above the floor
+  for (const auto& p : m.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+    if (p.z() <= 0) continue;
+    top_lo = top_lo.cwiseMin(p);
+    top_hi = top_hi.cwiseMax(p);
+  }
+  EXPECT_NEAR(lo.z(), -0.01f, 1e-6f);  // flattened just under the floor
+  EXPECT_NEAR(hi.z(), 0.3f, 1e-4f);
+  for (int k = 0; k < 2; ++k) {
+    // The top covers the layer's columns (centres 4.5 to 11.5) and no more
+    // than half a voxel past them; it tapers into the ground within a voxel.
+    EXPECT_LE(top_lo[k], 4.5f + 1e-4f);
+    EXPECT_GE(top_lo[k], 4.0f);
+    EXPECT_GE(top_hi[k], 11.5f - 1e-4f);
+    EXPECT_LE(top_hi[k], 12.0f);
+    EXPECT_GE(lo[k], 3.0f);
+    EXPECT_LE(hi[k], 13.0f);
+  }
+}
+
 }  // namespace
 }  // namespace drift::soil
