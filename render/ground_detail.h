@@ -33,9 +33,12 @@ struct DetailedGround {
   float roughness;
 };
 
-// `material` at ground point (x, y) (CRS metres) with smooth unit normal
-// `normal` (z up), seen by a footprint `footprint` metres wide.
-DetailedGround ground_detail(const Material& material, double x, double y,
+// `material` at ground point (x, y, z) (CRS metres, z the altitude) with
+// smooth unit normal `normal` (z up), seen by a footprint `footprint` metres
+// wide. Faces steeper than ~24-34 degrees read their detail triplanar (from
+// the vertical planes too, see ground_detail.cpp), so it is not stretched
+// down their fall line; gentler ground reads the map's plane alone.
+DetailedGround ground_detail(const Material& material, double x, double y, double z,
                              const Eigen::Vector3f& normal, double footprint);
 
 // The relief's slope (dh/dx, dh/dy) and the slope variance the footprint

@@ -39,9 +39,8 @@ void PhysicalSky::coordinates(const Eigen::Vector3f& dir, int elevations, int az
   fe = elevation_to_v(l) * (elevations - 1);
   // Azimuth relative to the sun's, folded (the sky is symmetric about the
   // sun's vertical plane).
-  const float sun_az = static_cast<float>(std::atan2(sun_.x(), sun_.y()));
   float rel = std::abs(
-      std::remainder(std::atan2(dir.x(), dir.y()) - sun_az, 2.0f * static_cast<float>(kPi)));
+      std::remainder(std::atan2(dir.x(), dir.y()) - sun_azimuth_, 2.0f * static_cast<float>(kPi)));
   fa = rel / static_cast<float>(kPi) * (azimuths - 1);
 }
 
@@ -62,7 +61,8 @@ PhysicalSky::PhysicalSky(const Atmosphere& atmosphere, double camera_altitude,
       sun_(sun.normalized()),
       sun_scale_(sun_scale),
       camera_altitude_(std::max(camera_altitude, 0.0)),
-      max_distance_(std::max(max_distance, 1.0)) {
+      max_distance_(std::max(max_distance, 1.0)),
+      sun_azimuth_(static_cast<float>(std::atan2(sun_.x(), sun_.y()))) {
   // Sky view (background and bounce rays that leave the scene).
   sky_table_.resize(static_cast<std::size_t>(kSkyElevations) * kSkyAzimuths);
   tbb::parallel_for(0, kSkyElevations, [&](int e) {

@@ -55,6 +55,7 @@ class PhysicalSky {
   Eigen::Vector3d sun_;
   float sun_scale_;
   double camera_altitude_, max_distance_;
+  float sun_azimuth_;  // atan2(x, y) of the sun, once (every sky lookup needs it)
   std::vector<Eigen::Vector3f> sky_table_;
   std::vector<AirSegment> ap_table_;
   // Per altitude: spectra for short segments and the sun's colour.

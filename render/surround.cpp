@@ -1,5 +1,6 @@
 #include "render/surround.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -14,8 +15,8 @@ namespace drift::render {
 namespace {
 
 constexpr double kEarthRadius = 6371000.0;
-constexpr int kOutwardSteps = 64;     // rows of a strip from the edge to the reach
-constexpr int kMaxGridSide = 32767;   // Embree's RTCGrid sides are 16-bit
+constexpr int kOutwardSteps = 64;    // rows of a strip from the edge to the reach
+constexpr int kMaxGridSide = 32767;  // Embree's RTCGrid sides are 16-bit
 constexpr std::uint64_t kRidgeSeed = 0x5a77a0d;
 constexpr double kRidgeLargest = 9000.0, kRidgeSmallest = 150.0;  // metres
 constexpr float kRidgeHurst = 0.8f;
@@ -104,24 +105,32 @@ float SurroundHeight::edge_mean(float x, float y, float half_width) const {
   // Perimeter position t of the edge point (x, y), clockwise from the NW corner.
   const float w = x1_ - x0_, h = y0_ - y1_, perimeter = 2 * (w + h);
   float t;
-  if (y >= y0_) t = x - x0_;
-  else if (x >= x1_) t = w + (y0_ - y);
-  else if (y <= y1_) t = w + h + (x1_ - x);
-  else t = 2 * w + h + (y - y1_);
+  if (y >= y0_)
+    t = x - x0_;
+  else if (x >= x1_)
+    t = w + (y0_ - y);
+  else if (y <= y1_)
+    t = w + h + (x1_ - x);
+  else
+    t = 2 * w + h + (y - y1_);
   // The integral of the heights up to perimeter position u (wrapping).
   const std::size_t n = sat_.size();
-  const double total = sat_.back() + 0.5 * dem_.dy * ((*dem_.vertices)[0].z() +
-                                                       (*dem_.vertices)[dem_.width].z());
+  const double total =
+      sat_.back() + 0.5 * dem_.dy * ((*dem_.vertices)[0].z() + (*dem_.vertices)[dem_.width].z());
   auto integral = [&](double u) {
     const double laps = std::floor(u / perimeter);
     u -= laps * perimeter;
     // Vertex index along the loop: binary search on the cumulative lengths
     // is avoided by the fixed spacing of each side.
     double i;
-    if (u <= w) i = u / dem_.dx;
-    else if (u <= w + h) i = (dem_.width - 1) + (u - w) / dem_.dy;
-    else if (u <= 2 * w + h) i = (dem_.width - 1) + (dem_.height - 1) + (u - w - h) / dem_.dx;
-    else i = 2.0 * (dem_.width - 1) + (dem_.height - 1) + (u - 2 * w - h) / dem_.dy;
+    if (u <= w)
+      i = u / dem_.dx;
+    else if (u <= w + h)
+      i = (dem_.width - 1) + (u - w) / dem_.dy;
+    else if (u <= 2 * w + h)
+      i = (dem_.width - 1) + (dem_.height - 1) + (u - w - h) / dem_.dx;
+    else
+      i = 2.0 * (dem_.width - 1) + (dem_.height - 1) + (u - 2 * w - h) / dem_.dy;
     const std::size_t a = std::min(static_cast<std::size_t>(i), n - 1);
     const double next = a + 1 < n ? sat_[a + 1] : total;
     return laps * total + sat_[a] + (i - a) * (next - sat_[a]);
@@ -141,8 +150,7 @@ float SurroundHeight::raster_height(float x, float y, float& weight, float d) co
     if (!finest || r.geo().cell_size_x() < finest->geo().cell_size_x()) finest = &r, value = v;
   }
   if (!finest) return 0.0f;
-  const double blend =
-      options_->blend > 0.0 ? options_->blend : 10.0 * finest->geo().cell_size_x();
+  const double blend = options_->blend > 0.0 ? options_->blend : 10.0 * finest->geo().cell_size_x();
   weight = smoothstep(0.0f, static_cast<float>(blend), d);
   return static_cast<float>(value * dem_.exaggeration - dem_.origin.z());
 }
@@ -168,28 +176,57 @@ float SurroundHeight::operator()(float x, float y, float spacing) const {
   return z - static_cast<float>(double(d) * d / (2.0 * kEarthRadius)) * dem_.exaggeration;
 }
 
+namespace {
+
+// Vertex normals of a block of nx x ny vertices from `start` (row-major):
+// the cross product of the central differences along its two directions
+// (one-sided at its borders), turned up.
+void add_normals(SurroundGrids& out, unsigned start, int nx, int ny) {
+  out.normals.resize(out.vertices.size());
+  auto at = [&](int i, int j) -> const Eigen::Vector3f& {
+    return out.vertices[start + static_cast<std::size_t>(j) * nx + i];
+  };
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const Eigen::Vector3f du = at(std::min(i + 1, nx - 1), j) - at(std::max(i - 1, 0), j);
+      const Eigen::Vector3f dv = at(i, std::min(j + 1, ny - 1)) - at(i, std::max(j - 1, 0));
+      Eigen::Vector3f n = du.cross(dv);
+      if (n.z() < 0.0f) n = -n;
+      const float length = n.norm();
+      out.normals[start + static_cast<std::size_t>(j) * nx + i] =
+          length > 0.0f ? Eigen::Vector3f(n / length) : Eigen::Vector3f(0, 0, 1);
+    }
+  }
+}
+
+}  // namespace
+
 SurroundGrids build_surround(const DemVertices& dem, const SurroundOptions& options) {
   SurroundGrids out;
   if (!(options.reach > 0.0)) return out;
   const SurroundHeight height(dem, options);
   const std::vector<double> d = outward_distances(std::min(dem.dx, dem.dy), options.reach);
   const int k = kOutwardSteps + 1;
-  const std::size_t count =
-      2 * static_cast<std::size_t>(k) * (dem.width + dem.height) + 4 * static_cast<std::size_t>(k) * k;
-  require_memory(count * sizeof(Eigen::Vector3f), "the ground around the DEM",
+  const std::size_t count = 2 * static_cast<std::size_t>(k) * (dem.width + dem.height) +
+                            4 * static_cast<std::size_t>(k) * k;
+  require_memory(2 * count * sizeof(Eigen::Vector3f), "the ground around the DEM",
                  "set [terrain] surround_reach = 0");
   out.vertices.reserve(count);
+  out.normals.reserve(count);
   out.reach = static_cast<float>(options.reach);
   const auto& v = *dem.vertices;
   const float x0 = v.front().x(), y0 = v.front().y();
   const float x1 = x0 + (dem.width - 1) * dem.dx, y1 = y0 - (dem.height - 1) * dem.dy;
-  auto spacing = [&](int i) { return static_cast<float>(d[std::min(i + 1, k - 1)] - d[std::max(i - 1, 0)]) * 0.5f; };
+  auto spacing = [&](int i) {
+    return static_cast<float>(d[std::min(i + 1, k - 1)] - d[std::max(i - 1, 0)]) * 0.5f;
+  };
   // A block of nx x ny vertices at position(i, j), cut into Embree grids
   // that share their edge rows.
   auto add_block = [&](int nx, int ny, auto position) {
     const unsigned start = static_cast<unsigned>(out.vertices.size());
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) out.vertices.push_back(position(i, j));
+    add_normals(out, start, nx, ny);
     for (int gy = 0; gy < ny - 1; gy += kMaxGridSide - 1)
       for (int gx = 0; gx < nx - 1; gx += kMaxGridSide - 1)
         out.grids.push_back({start + static_cast<unsigned>(gy * nx + gx), static_cast<unsigned>(nx),

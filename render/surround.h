@@ -47,6 +47,10 @@ struct DemVertices {
 
 struct SurroundGrids {
   std::vector<Eigen::Vector3f> vertices;  // local coordinates
+  // Smooth shading normals at the vertices (unit, facing up): central
+  // differences over each block of vertices, so far ridges are shaded as
+  // the slopes they stand for instead of flat facets.
+  std::vector<Eigen::Vector3f> normals;
   struct Grid {
     unsigned start = 0, stride = 0;
     unsigned short width = 0, height = 0;

@@ -161,6 +161,7 @@ void TerrainScene::attach_surround(const SurroundOptions& options) {
   SurroundGrids ring = build_surround(dem, options);
   if (ring.grids.empty()) return;
   surround_vertices_ = std::move(ring.vertices);
+  surround_normals_ = std::move(ring.normals);
   std::vector<RTCGrid>& grids = embree_->surround_grids;
   for (const SurroundGrids::Grid& g : ring.grids)
     grids.push_back({g.start, g.stride, g.width, g.height});
@@ -234,6 +235,20 @@ Eigen::Vector3f TerrainScene::vertex_normal(int x, int row) const {
   return Eigen::Vector3f(-g.dzdx, -g.dzdy, 1.0f).normalized();
 }
 
+Eigen::Vector3f TerrainScene::surround_normal(unsigned grid, float u, float v) const {
+  // Embree's u, v run over the whole grid in [0, 1] (columns, rows).
+  const RTCGrid& g = embree_->surround_grids[grid];
+  const float fu = std::clamp(u, 0.0f, 1.0f) * static_cast<float>(g.width - 1);
+  const float fv = std::clamp(v, 0.0f, 1.0f) * static_cast<float>(g.height - 1);
+  const int i = std::min(static_cast<int>(fu), g.width - 2);
+  const int j = std::min(static_cast<int>(fv), g.height - 2);
+  auto n = [&](int a, int b) {
+    return surround_normals_[g.startVertexID + static_cast<std::size_t>(j + b) * g.stride + i + a];
+  };
+  const float tu = fu - static_cast<float>(i), tv = fv - static_cast<float>(j);
+  return terrain::bilinear_blend(n(0, 0), n(1, 0), n(0, 1), n(1, 1), tu, tv).normalized();
+}
+
 bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
                              const RayCone& cone) const {
   RTCIntersectContext context;
@@ -250,8 +265,8 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;
   const bool surround = rh.hit.geomID == surround_geometry_;
-  std::optional<Eigen::Vector3f> facet;  // beyond the DEM: its facets' normal, facing up
-  if (surround) facet = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+  std::optional<Eigen::Vector3f> facet;  // beyond the DEM: its smooth normal, facing up
+  if (surround) facet = surround_normal(rh.hit.primID, rh.hit.u, rh.hit.v);
   const Eigen::Vector3f n = rh.hit.geomID < terrain_geometries_ || surround
                                 ? shade_terrain_hit(hit, cone, facet)
                                 : shade_mesh_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v,

@@ -111,6 +111,10 @@ class TerrainScene {
   // grids and Embree geometry id (none: -1).
   void attach_surround(const SurroundOptions& options);
   std::vector<Eigen::Vector3f> surround_vertices_;
+  std::vector<Eigen::Vector3f> surround_normals_;  // smooth shading (render/surround.h)
+  // The smooth normal at (u, v) of surround grid `grid` (Embree's grid-local
+  // hit coordinates).
+  Eigen::Vector3f surround_normal(unsigned grid, float u, float v) const;
   unsigned surround_geometry_ = ~0u;
   float surround_reach_ = 0.0f;
   Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};
