@@ -6,6 +6,7 @@
 
 #include "render/ground_detail.h"
 #include "render/land_form.h"
+#include "render/snow_flakes.h"
 #include "render/tonemap.h"
 #include "terrain/bilinear.h"
 #include "terrain/error.h"
@@ -157,10 +158,15 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   stack_layers(surface, x, y, relief, channels, ground, p);
   Material snow = surface.snow;
   if (surface.snow_depth && p.snow > 0.0f) {
-    // Thin snow lets the ground show through (translucency).
+    // Thin snow lets the ground show through (translucency). Where it lies
+    // it is depth / coverage deep (the coverage is its share of the ground);
+    // flakes (coverage below 1) are at least a flake deep.
     const float depth = std::max(sample_raster(*surface.snow_depth, x, y, 0.0f), 0.0f);
-    snow.albedo = layer_albedo(snow.albedo, ground.albedo, surface.snow_scattering * depth);
+    const float lying = p.snow < 1.0f ? std::max(depth / p.snow, kFlakeDepth) : depth;
+    snow.albedo = layer_albedo(snow.albedo, ground.albedo, surface.snow_scattering * lying);
   }
+  // Coverage below full shows as flakes (render/snow_flakes.h).
+  p.snow = flake_cover({x, y, relief.z}, normal, p.snow, footprint);
   p.material = mix(ground, snow, p.snow);
   if (channels) cover(p.coverage, channels->snow, p.snow);
   if (surface.ripples && normal.z() > 1e-3f)

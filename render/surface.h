@@ -96,6 +96,9 @@ terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
 struct Relief {
   float altitude = 0.0f;
   float slope_deg = 0.0f;
+  // The point's rendered height (CRS metres, exaggerated): with (x, y) it
+  // places world-space patterns (render/snow_flakes.h).
+  double z = 0.0;
 };
 
 // Evaluates the layers at CRS point (x, y) with the smooth terrain normal

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "render/snow_flakes.h"
 #include "terrain/bilinear.h"
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
@@ -35,6 +36,11 @@ void check_device(RTCDevice device, const char* what) {
 
 // Embree grids are at most 32767 vertices a side (RTCGrid::width is 16-bit).
 constexpr int kMaxGridSide = 32767;
+
+// The ray's footprint (metres) where it hit.
+double footprint(const RayCone& cone, const Hit& hit) {
+  return cone.width + cone.spread * hit.distance;
+}
 
 }  // namespace
 
@@ -270,7 +276,8 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   const Eigen::Vector3f n = rh.hit.geomID < terrain_geometries_ || surround
                                 ? shade_terrain_hit(hit, cone, facet)
                                 : shade_mesh_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v,
-                                                 {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, hit);
+                                                 {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, hit,
+                                                 footprint(cone, hit));
   // Face the ray: a mesh may be seen from either side, and terrain from below
   // at the edges. (Embree's Ng of our grids points down: rows run south.)
   hit.normal = n.dot(d) > 0 ? Eigen::Vector3f(-n) : n;
@@ -295,9 +302,9 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
   relief.altitude = static_cast<float>(world.z() / exaggeration_);
   relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
                      static_cast<float>(180.0 / std::numbers::pi);
+  relief.z = world.z();
   const SurfacePoint surface =
-      shade_terrain(surface_, world.x(), world.y(), n, cone.width + cone.spread * hit.distance,
-                    relief, &coverage_);
+      shade_terrain(surface_, world.x(), world.y(), n, footprint(cone, hit), relief, &coverage_);
   hit.material = surface.material;
   hit.snow = surface.snow;
   hit.coverage = surface.coverage;
@@ -305,7 +312,8 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
 }
 
 Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangle, float u, float v,
-                                             const Eigen::Vector3f& ng, Hit& hit) const {
+                                             const Eigen::Vector3f& ng, Hit& hit,
+                                             double footprint) const {
   hit.material = Material{mesh_albedo_[geometry]};
   hit.snow = 0.0f;
   hit.coverage = {};
@@ -313,8 +321,11 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
     // Snow coverage interpolated over the triangle (Embree's barycentrics).
     const std::vector<float>& cover = mesh_snow_[geometry];
     const std::array<int, 3>& tri = mesh_snow_triangles_[geometry][triangle];
-    const float c = std::clamp(
+    const float mean = std::clamp(
         (1.0f - u - v) * cover[tri[0]] + u * cover[tri[1]] + v * cover[tri[2]], 0.0f, 1.0f);
+    // Below full coverage, flakes (render/snow_flakes.h).
+    const float c = flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean,
+                                footprint);
     hit.material = mix(hit.material, surface_.snow, c);
     hit.snow = c;
     hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel

@@ -81,12 +81,12 @@ class TerrainScene {
 
   // The hit's material, snow and coverage on the terrain (a footprint from
   // `cone`) or on mesh `geometry`'s `triangle` at barycentrics (u, v) with
-  // geometric normal `ng`; each returns the shading normal, not yet facing
-  // the ray.
+  // geometric normal `ng` (seen by a footprint `footprint` metres wide);
+  // each returns the shading normal, not yet facing the ray.
   Eigen::Vector3f shade_terrain_hit(Hit& hit, const RayCone& cone,
                                     const std::optional<Eigen::Vector3f>& facet = {}) const;
   Eigen::Vector3f shade_mesh_hit(unsigned geometry, unsigned triangle, float u, float v,
-                                 const Eigen::Vector3f& ng, Hit& hit) const;
+                                 const Eigen::Vector3f& ng, Hit& hit, double footprint) const;
 
   // The unit shading normal at vertex (x, row), from the vertex buffer.
   Eigen::Vector3f vertex_normal(int x, int row) const;

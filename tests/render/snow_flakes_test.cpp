@@ -1,0 +1,246 @@
+// Flakes of thin snow and stuck flakes (render/snow_flakes.h): the covered
+// area fraction is the coverage up close, the footprint-filtered value
+// averages to it further away and is it exactly far away, the pattern grows
+// with the coverage and is a pure function of the world position.
+#include "render/snow_flakes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "render/surface.h"
+
+namespace drift::render {
+namespace {
+
+const Eigen::Vector3f kUp(0, 0, 1);
+
+// Mean and standard deviation of flake_cover over n points drawn uniformly
+// in a 200 m square far from the origin (UTM-sized coordinates), on a surface
+// of normal `normal` (the square lies in the plane the pattern uses).
+struct Moments {
+  double mean = 0, std = 0;
+};
+Moments sample(float coverage, double footprint, const Eigen::Vector3f& normal, int n,
+               unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 200.0);
+  double s = 0, s2 = 0;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d p(746000.0 + u(rng), 4030000.0 + u(rng), 2000.0 + u(rng));
+    const double f = flake_cover(p, normal, coverage, footprint);
+    s += f, s2 += f * f;
+  }
+  Moments m;
+  m.mean = s / n;
+  m.std = std::sqrt(std::max(0.0, s2 / n - m.mean * m.mean));
+  return m;
+}
+
+const float kCoverages[] = {0.02f, 0.1f, 0.3f, 0.5f, 0.7f, 0.9f, 0.98f};
+
+TEST(SnowFlakes, CloseUpTheCoveredAreaIsTheCoverage) {
+  // Point samples (footprint 0): every value is 0 or 1 and the covered
+  // fraction is the coverage, on flat ground and on walls facing east and
+  // north (overhanging). 10^5 points: sampling error <= 1.6e-3.
+  for (const Eigen::Vector3f& normal :
+       {kUp, Eigen::Vector3f(0.95f, 0.1f, 0.3f), Eigen::Vector3f(0.1f, -0.9f, -0.4f)}) {
+    for (const float c : kCoverages) {
+      SCOPED_TRACE(testing::Message() << "coverage " << c << " normal " << normal.transpose());
+      const Moments m = sample(c, 0.0, normal, 100000, 11);
+      EXPECT_NEAR(m.mean, c, 0.006);
+      // Binary: the standard deviation of a 0/1 variable of mean c.
+      EXPECT_NEAR(m.std, std::sqrt(c * (1.0 - c)), 0.01);
+    }
+  }
+}
+
+TEST(SnowFlakes, WithoutClumpingTheBooleanModelCoversExactly) {
+  // The flakes alone (no clumps): area fraction 1 - exp(-tau(c)) = c.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 500.0);
+  for (const float c : kCoverages) {
+    int covered = 0;
+    const int n = 100000;
+    for (int i = 0; i < n; ++i) covered += flake_covers(746000.0 + u(rng), u(rng), c, 5) ? 1 : 0;
+    EXPECT_NEAR(static_cast<double>(covered) / n, c, 0.005) << "coverage " << c;
+  }
+}
+
+TEST(SnowFlakes, AtDistanceTheAverageIsTheCoverage) {
+  // Footprints from a flake's size to past the clumps: the mean stays the
+  // coverage, the spread from point to point falls as the footprint grows
+  // (what a pixel would see shimmer is filtered away), and from the clumps'
+  // scale on every point is the coverage exactly.
+  for (const float c : {0.05f, 0.3f, 0.6f, 0.95f}) {
+    SCOPED_TRACE(testing::Message() << "coverage " << c);
+    double previous_std = 1.0;
+    for (const double footprint : {0.01, 0.02, 0.03, 0.06, 0.1, 0.2}) {
+      const Moments m = sample(c, footprint, kUp, 50000, 17);
+      EXPECT_NEAR(m.mean, c, 0.004) << "footprint " << footprint;
+      EXPECT_LE(m.std, previous_std + 1e-3) << "footprint " << footprint;
+      previous_std = m.std;
+    }
+    // At 0.2 m only the largest clumps are left, half faded.
+    EXPECT_LT(previous_std, 0.35 * std::sqrt(c * (1.0 - c)));
+    std::mt19937_64 rng(19);
+    std::uniform_real_distribution<double> u(0.0, 200.0);
+    for (const double footprint : {kClumpScale, 1.0, 50.0})
+      for (int i = 0; i < 1000; ++i) {
+        const Eigen::Vector3d p(746000.0 + u(rng), 4030000.0 + u(rng), 2000.0);
+        ASSERT_EQ(flake_cover(p, kUp, c, footprint), c) << "footprint " << footprint;
+      }
+  }
+}
+
+// A pixel some 20 m away whose footprint (4 cm) spans a few dozen flakes:
+// its true value is the covered fraction of the footprint. 4 samples with the
+// footprint filter must be far closer to it than 4 point samples (which
+// alias: the flakes would shimmer from pixel to pixel and frame to frame).
+TEST(SnowFlakes, FilteredFlakesDoNotAlias) {
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double footprint = 0.04;
+  double err_filtered = 0, err_point = 0;
+  const int pixels = 200;
+  for (int p = 0; p < pixels; ++p) {
+    const Eigen::Vector3d corner(746000.0 + 0.37 * p, 4030000.0, 2000.0);
+    auto at = [&]() -> Eigen::Vector3d {
+      return corner + Eigen::Vector3d(footprint * u(rng), footprint * u(rng), 0);
+    };
+    double reference = 0, filtered = 0, point = 0;
+    for (int i = 0; i < 1024; ++i) reference += flake_cover(at(), kUp, 0.4f, 0.0) / 1024.0;
+    for (int i = 0; i < 4; ++i) {
+      filtered += flake_cover(at(), kUp, 0.4f, footprint) / 4.0;
+      point += flake_cover(at(), kUp, 0.4f, 0.0) / 4.0;
+    }
+    err_filtered += (filtered - reference) * (filtered - reference) / pixels;
+    err_point += (point - reference) * (point - reference) / pixels;
+  }
+  EXPECT_LT(std::sqrt(err_filtered), 0.5 * std::sqrt(err_point))
+      << "rms error filtered " << std::sqrt(err_filtered) << ", point-sampled "
+      << std::sqrt(err_point);
+}
+
+TEST(SnowFlakes, FlakesDisappearIntoTheirMeanBeyondFourDiameters) {
+  // Past four flake diameters only the clumps remain: the value is the
+  // smooth local coverage, never a flake's 0 or 1 (unless c is); below two
+  // it is a flake's.
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(0.0, 50.0);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d p(746000.0 + u(rng), 4030000.0 + u(rng), 2100.0);
+    const float v = flake_cover(p, kUp, 0.4f, 8.0 * kFlakeRadius);
+    EXPECT_EQ(v, clumped_coverage(p.x(), p.y(), 0.4f, 0x5f1a7e2u, 8.0 * kFlakeRadius));
+    EXPECT_GT(v, 0.0f);
+    EXPECT_LT(v, 1.0f);
+    const float close = flake_cover(p, kUp, 0.4f, 4.0 * kFlakeRadius);
+    EXPECT_TRUE(close == 0.0f || close == 1.0f) << close;
+  }
+}
+
+TEST(SnowFlakes, MoreCoverageOnlyAddsFlakes) {
+  // A point covered at coverage c is covered at every larger coverage: the
+  // start of a snowfall grows, it does not reshuffle.
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(0.0, 30.0);
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector3d p(746000.0 + u(rng), 4030000.0 + u(rng), 2100.0);
+    float before = 0.0f;
+    for (const float c : kCoverages) {
+      const float now = flake_cover(p, kUp, c, 0.0);
+      ASSERT_GE(now, before) << "coverage " << c;
+      before = now;
+    }
+  }
+}
+
+TEST(SnowFlakes, DeterministicAndOrderFree) {
+  // A pure function of the position: the same bits whatever the order of
+  // evaluation; different planes and positions give different patterns.
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(0.0, 10.0);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 5000; ++i)
+    points.emplace_back(746000.0 + u(rng), 4030000.0 + u(rng), 2000.0 + u(rng));
+  std::vector<float> forward, backward(points.size());
+  for (const auto& p : points) forward.push_back(flake_cover(p, kUp, 0.35f, 0.002));
+  for (std::size_t i = points.size(); i-- > 0;)
+    backward[i] = flake_cover(points[i], kUp, 0.35f, 0.002);
+  EXPECT_EQ(forward, backward);
+  // The wall's pattern is not the ground's seen edge-on.
+  int differ = 0;
+  for (const auto& p : points) {
+    const Eigen::Vector3d swapped(p.x(), p.z(), p.y());
+    differ += flake_cover(p, kUp, 0.35f, 0.0) !=
+              flake_cover(swapped, Eigen::Vector3f(0, 1, 0), 0.35f, 0.0);
+  }
+  EXPECT_GT(differ, 1000);
+}
+
+// A flat surface 100 m square (local coordinates, origin north-west) of dark
+// rock under snow of coverage `cover` and depth `depth`, without sub-cell
+// detail so that albedos compare exactly.
+TerrainSurface thin_snow(float cover, float depth) {
+  TerrainSurface s;
+  s.ground = *material_preset("dark_rock");
+  s.ground.detail = {};
+  s.snow.detail = {};
+  s.snow_cover = terrain::HeightField(100, 100, cover, terrain::local_georeference(1.0));
+  s.snow_depth = terrain::HeightField(100, 100, depth, terrain::local_georeference(1.0));
+  return s;
+}
+
+TEST(SnowFlakes, ThinSnowShadesAsFlakesUpCloseAndAsTheBlendFarAway) {
+  // 9 mm of snow covering 0.3 of the ground (the snowfall's thin snow of
+  // 3 cm over 0.3 of it): up close each point is bare rock or a flake whose
+  // snow lies 3 cm deep (white), 0.3 of them flakes; far away the blend.
+  const TerrainSurface s = thin_snow(0.3f, 0.009f);
+  const Eigen::Vector3f flake =
+      layer_albedo(s.snow.albedo, s.ground.albedo, s.snow_scattering * 0.03f);
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(1.0, 99.0);
+  int flakes = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const double x = u(rng), y = -u(rng);
+    const SurfacePoint p = shade_terrain(s, x, y, kUp, 0.0);
+    const bool on_flake = p.snow == 1.0f;
+    ASSERT_TRUE(on_flake || p.snow == 0.0f) << p.snow;
+    ASSERT_LT((p.material.albedo - (on_flake ? flake : s.ground.albedo)).norm(), 1e-5f);
+    flakes += on_flake;
+  }
+  EXPECT_NEAR(static_cast<double>(flakes) / n, 0.3, 0.015);
+  EXPECT_GT(flake.minCoeff(), 0.85f);  // 3 cm of snow over dark rock reads white
+  const SurfacePoint far = shade_terrain(s, 50.0, -50.0, kUp, 5.0);
+  EXPECT_EQ(far.snow, 0.3f);
+  EXPECT_LT((far.material.albedo - mix(s.ground, Material{flake}, 0.3f).albedo).norm(), 1e-5f);
+}
+
+TEST(SnowFlakes, StuckFlakesOnAWallWithoutDepthReadWhite) {
+  // Adhesion: coverage without depth. The flakes are a flake's depth of
+  // snow (kFlakeDepth), not the bare rock the zero depth would give.
+  const TerrainSurface s = thin_snow(0.5f, 0.0f);
+  const Eigen::Vector3f wall(0.97f, 0.0f, 0.243f);
+  float brightest = 0.0f;
+  for (int i = 0; i < 400; ++i) {
+    const SurfacePoint p = shade_terrain(s, 10.0 + 0.0037 * i, -50.0, wall, 0.0,
+                                         Relief{0.0f, 76.0f, 2000.0 + 0.0051 * i});
+    brightest = std::max(brightest, p.material.albedo.minCoeff());
+  }
+  EXPECT_GT(brightest, 0.7f);
+}
+
+TEST(SnowFlakes, NoneAndFullCoverage) {
+  const Eigen::Vector3d p(746001.0, 4030002.0, 2000.0);
+  EXPECT_EQ(flake_cover(p, kUp, 0.0f, 0.0), 0.0f);
+  EXPECT_EQ(flake_cover(p, kUp, -0.5f, 0.0), 0.0f);
+  EXPECT_EQ(flake_cover(p, kUp, 1.0f, 0.0), 1.0f);
+  EXPECT_EQ(flake_cover(p, kUp, NAN, 0.0), 0.0f);
+}
+
+}  // namespace
+}  // namespace drift::render
