@@ -129,14 +129,18 @@ void add_marks_command(CLI::App& root) {
                 "surface with the marks)");
   sub->add_option("--snow-min", c->snow_min,
                   "snow shallower than this (m) leaves the ground's material")
+      ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   sub->add_option("--memory-steps", c->options.memory_steps,
                   "steps a cell that slid keeps relaxing (paper 000, 3.5)")
+      ->check(CLI::Range(0, 1000000))  // the ranges of MarksOptions::validate (marks.h)
       ->capture_default_str();
   sub->add_option("--erosion-passes", c->options.erosion_passes,
                   "most relaxation passes per erosion")
+      ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   sub->add_option("--margin", c->options.margin, "free cells kept around an object's footprint")
+      ->check(CLI::Range(2, 1000))
       ->capture_default_str();
   sub->add_option("--renderer", c->renderer,
                   "how the object's bottom is rendered: cpu (z-buffer, faster at these sizes) or "

@@ -5,11 +5,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "pipeline/cli.h"
 #include "pipeline/progress_bar.h"
 #include "pipeline/soil_scenario_file.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
@@ -59,12 +62,56 @@ void apply_overrides(const SoilCommand& c, soil::SoilScenario& sc) {
   }
 }
 
+// Writes every product (into the OutputSet's temporary files); returns what to
+// report once they are committed, so "wrote" is never printed for a file that a
+// later failure leaves unreplaced.
+std::vector<std::string> write_products(const SoilCommand& c, const soil::SoilScenario& sc,
+                                        const soil::SoilState& state,
+                                        const soil::SurfaceOptions& surface) {
+  std::vector<std::string> wrote;
+  const terrain::Mesh mesh = soil::soil_surface(state, surface, sc.options.soil.moisture);
+  if (mesh.triangles.empty()) throw Error("scenario '" + c.scenario + "' left no soil surface");
+  write_mesh(mesh, c.output);
+  wrote.push_back(c.output + " (" + std::to_string(mesh.triangle_count()) + " triangles)");
+  if (!c.collision.empty()) {
+    const terrain::Mesh bodies = soil::iso_surface(state.shape, state.psi);
+    if (bodies.triangles.empty()) throw Error("--collision: the scenario has no terrain or bodies");
+    write_mesh(bodies, c.collision);
+    wrote.push_back(c.collision + " (" + std::to_string(bodies.triangle_count()) + " triangles)");
+  }
+  if (!c.vdb.empty()) {
+    soil::write_density_vdb(state, c.vdb);
+    wrote.push_back(c.vdb + " (grids density, collision)");
+  }
+  if (!c.surface.empty()) {
+    terrain::HeightField top = soil::top_surface(
+        state, sc.geo.crs_wkt.empty() && sc.terrain.kind != soil::TerrainSource::Kind::HeightField
+                   ? terrain::local_georeference(sc.shape.voxel_size)
+                   : sc.geo);
+    terrain::write_geotiff(top, c.surface, {"top of soil and ground (m)", "m"});
+    wrote.push_back(c.surface);
+  }
+  if (!c.ground.empty()) {
+    terrain::write_geotiff(soil::ground_raster(sc.shape, sc.terrain.heights, c.ground_margin),
+                           c.ground, {"ground under the soil (m)", "m"});
+    wrote.push_back(c.ground);
+  }
+  return wrote;
+}
+
 void run_soil(SoilCommand& c) {
   check_mesh_path(c.output, "-o");
   if (!c.collision.empty()) check_mesh_path(c.collision, "--collision");
   if (c.frame_every < 1) usage_error("--frame-every must be at least 1");
   soil::SoilScenario sc = read_soil_scenario(c.scenario, c.terrain);
   apply_overrides(c, sc);
+  if (!c.ground.empty()) {  // --ground's raster, checked before the simulation
+    const std::uint64_t w = sc.shape.nx + 2ull * c.ground_margin,
+                        h = sc.shape.ny + 2ull * c.ground_margin;
+    require_memory(w * h * sizeof(float),
+                   "--ground raster of " + std::to_string(w) + " x " + std::to_string(h) + " cells",
+                   "lower --ground-margin");
+  }
   if (!c.frames.empty() && !fs::is_directory(c.frames))
     throw Error("--frames directory '" + c.frames + "' does not exist; create it first");
 
@@ -93,35 +140,9 @@ void run_soil(SoilCommand& c) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress(1.0, "done");
 
-  const terrain::Mesh mesh = soil::soil_surface(sim.state(), surface, sc.options.soil.moisture);
-  if (mesh.triangles.empty()) throw Error("scenario '" + c.scenario + "' left no soil surface");
-  write_mesh(mesh, c.output);
-  std::printf("soil: wrote %s (%zu triangles)\n", c.output.c_str(), mesh.triangle_count());
-  if (!c.collision.empty()) {
-    const terrain::Mesh bodies = soil::iso_surface(sim.state().shape, sim.state().psi);
-    if (bodies.triangles.empty()) throw Error("--collision: the scenario has no terrain or bodies");
-    write_mesh(bodies, c.collision);
-    std::printf("soil: wrote %s (%zu triangles)\n", c.collision.c_str(), bodies.triangle_count());
-  }
-  if (!c.vdb.empty()) {
-    soil::write_density_vdb(sim.state(), c.vdb);
-    std::printf("soil: wrote %s (grids density, collision)\n", c.vdb.c_str());
-  }
-  if (!c.surface.empty()) {
-    terrain::HeightField top = soil::top_surface(
-        sim.state(),
-        sc.geo.crs_wkt.empty() && sc.terrain.kind != soil::TerrainSource::Kind::HeightField
-            ? terrain::local_georeference(sc.shape.voxel_size)
-            : sc.geo);
-    terrain::write_geotiff(top, c.surface, {"top of soil and ground (m)", "m"});
-    std::printf("soil: wrote %s\n", c.surface.c_str());
-  }
-  if (!c.ground.empty()) {
-    terrain::write_geotiff(soil::ground_raster(sc.shape, sc.terrain.heights, c.ground_margin),
-                           c.ground, {"ground under the soil (m)", "m"});
-    std::printf("soil: wrote %s\n", c.ground.c_str());
-  }
+  const std::vector<std::string> wrote = write_products(c, sc, sim.state(), surface);
   outputs.commit();
+  for (const std::string& line : wrote) std::printf("soil: wrote %s\n", line.c_str());
   const double mass1 = sim.state().mass();
   std::printf(
       "soil: %d steps of %dx%dx%d voxels (%.3g m) in %.2f s (%.1f steps/s); soil %.6g -> "
@@ -143,7 +164,8 @@ void add_soil_command(CLI::App& root) {
   sub->add_option("-o,--output", c->output, "soil surface mesh, .ply or .obj (metres)")->required();
   sub->add_option("--terrain", c->terrain,
                   "metric GeoTIFF replacing the dem the scenario's [terrain] names");
-  sub->add_option("--steps", c->steps, "time steps (overrides the scenario's)");
+  sub->add_option("--steps", c->steps, "time steps (overrides the scenario's)")
+      ->check(CLI::Range(0, 10000000));  // as the scenario's [simulation] steps
   sub->add_option("--soil", c->soil_type, "soil type of the thesis's table 6")
       ->check(CLI::IsMember({"dry_sand", "sandy_loam", "loam"}));
   sub->add_option("--phi", c->phi, "angle of internal friction (degrees, [0, 60))");
@@ -161,6 +183,7 @@ void add_soil_command(CLI::App& root) {
                   "GeoTIFF of the ground under the soil (terrain or the grid's floor), widened by "
                   "--ground-margin columns, in the meshes' frame: a terrain to render them on");
   sub->add_option("--ground-margin", c->ground_margin, "columns added around the grid")
+      ->check(CLI::Range(0, 100000))
       ->capture_default_str();
   sub->add_flag("--no-ridge-fix", c->no_ridge_fix,
                 "extract the raw density (shows the thesis's vertical ridges)");

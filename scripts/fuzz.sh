@@ -2,7 +2,9 @@
 # Fuzzes every reader of outside input (tests/fuzz/fuzz_targets.h) with libFuzzer:
 # builds the targets with clang, AddressSanitizer and UndefinedBehaviorSanitizer
 # into build-fuzz/ and runs each for SECONDS (default 60), niced.
-#   scripts/fuzz.sh [SECONDS] [TARGET...]   targets: raster scene objects track obj ply image
+#   scripts/fuzz.sh [SECONDS] [TARGET...]   targets: raster scene objects track scenario obj ply image
+# The timeout (60 s per input) is wall-clock: generous, as a niced fuzzer on a
+# busy machine gets little CPU (a 2 s unit once took 24 s so).
 # New inputs collect in build-fuzz/corpus/<target>/; a crash, leak or hang is
 # written to build-fuzz/findings/<target>/ and stops that target. Keep each
 # finding as a regression input under tests/fuzz/regressions/<target>/ (the
@@ -12,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(raster scene objects track obj ply image); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(raster scene objects track scenario obj ply image); fi
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRIFT_FUZZ=ON \
   -DDRIFT_BUILD_BENCHMARKS=OFF >/dev/null
@@ -26,7 +28,7 @@ for t in "${targets[@]}"; do
   if ! ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     nice -n 19 "build-fuzz/tests/fuzz/fuzz_$t" "build-fuzz/corpus/$t" "tests/fuzz/corpus/$t" \
-    -max_total_time="$seconds" -timeout=20 -rss_limit_mb=4096 -max_len=65536 \
+    -max_total_time="$seconds" -timeout=60 -rss_limit_mb=4096 -max_len=65536 \
     -artifact_prefix="build-fuzz/findings/$t/" -print_final_stats=1 \
     2> "build-fuzz/findings/$t.log"; then
     echo "fuzz: $t FOUND something: see build-fuzz/findings/$t/ and build-fuzz/findings/$t.log"

@@ -54,7 +54,9 @@ std::array<double, 2> cell_size_metres(const GeoReference& geo, int width, int h
 }
 
 int utm_epsg(double lon, double lat) {
-  const int zone = std::clamp(static_cast<int>(std::floor((lon + 180.0) / 6.0)) + 1, 1, 60);
+  // Clamped before the conversion: a longitude of 1e300 is no int (UBSan).
+  const double z = std::floor((lon + 180.0) / 6.0) + 1.0;
+  const int zone = std::isnan(z) ? 1 : static_cast<int>(std::clamp(z, 1.0, 60.0));
   return (lat >= 0 ? 32600 : 32700) + zone;
 }
 
@@ -101,8 +103,8 @@ struct WarpPlan {
 
 // The target CRS and cell size: a geographic DEM goes to the UTM zone of its
 // centre at about its finest metric spacing, unless keep_crs.
-void plan_grid(const RasterHeader& header, const ImportOptions& o, WarpPlan& plan,
-               std::vector<std::string>& report) {
+void plan_grid(const fs::path& path, const RasterHeader& header, const ImportOptions& o,
+               WarpPlan& plan, std::vector<std::string>& report) {
   OGRSpatialReference srs;
   plan.has_crs =
       !header.geo.crs_wkt.empty() && srs.importFromWkt(header.geo.crs_wkt.c_str()) == OGRERR_NONE;
@@ -110,6 +112,10 @@ void plan_grid(const RasterHeader& header, const ImportOptions& o, WarpPlan& pla
   plan.reproject = plan.geographic && !o.keep_crs;
   if (plan.reproject) {
     const auto lonlat = centre_lonlat(header.geo, header.width, header.height);
+    if (!(std::fabs(lonlat[0]) <= 540.0 && std::fabs(lonlat[1]) <= 90.0)) {  // found by fuzzing
+      throw Error("'" + path.string() + "' is in degrees but its centre (" + fmt(lonlat[0]) + ", " +
+                  fmt(lonlat[1]) + ") lies off the globe; check its georeference (gdalinfo)");
+    }
     const int epsg = utm_epsg(lonlat[0], lonlat[1]);
     // Square cells near the source's finest metric spacing.
     const auto metric = cell_size_metres(header.geo, header.width, header.height);
@@ -134,7 +140,7 @@ WarpPlan plan_warp(const fs::path& path, const RasterHeader& header, const Impor
   WarpPlan plan;
   // Warped into memory (GDAL's MEM driver): no temporary file at all.
   plan.args = {"-of", "MEM", "-ot", "Float32", "-r", "bilinear", "-dstnodata", "nan"};
-  plan_grid(header, o, plan, report);
+  plan_grid(path, header, o, plan, report);
   if (o.resample_m) plan.cell = *o.resample_m;
   if (!(plan.cell > 0)) throw Error("'" + path.string() + "' has no usable cell size");
   plan.args.insert(plan.args.end(), {"-tr", fmt(plan.cell), fmt(plan.cell)});
@@ -186,6 +192,24 @@ void require_warp_memory(const RasterHeader& h, const ImportOptions& o, const Wa
   require_memory(static_cast<std::uint64_t>(bytes), what, fix);
 }
 
+// The DEM is band 1; GDALWarp would warp every band into memory (GDAL 3.6 has
+// no -b for warps), and a 400-byte TIFF declaring 65535 samples per pixel kept
+// it busy for minutes growing a band list (found by fuzz_raster). A VRT of
+// band 1 over the open file is warped instead.
+GDALDatasetH first_band(GDALDatasetH file, const fs::path& path) {
+  if (GDALGetRasterCount(file) <= 1) return file;
+  const char* args[] = {"-of", "VRT", "-b", "1", nullptr};
+  std::unique_ptr<GDALTranslateOptions, decltype(&GDALTranslateOptionsFree)> topts(
+      GDALTranslateOptionsNew(const_cast<char**>(args), nullptr), GDALTranslateOptionsFree);
+  int usage_error = 0;
+  GDALDatasetH band1 = topts ? GDALTranslate("", file, topts.get(), &usage_error) : nullptr;
+  if (!band1) {
+    GDALClose(file);
+    throw Error("cannot read band 1 of '" + path.string() + "': " + last_gdal_message());
+  }
+  return band1;
+}
+
 // Runs the warp into memory and reads the grid from it.
 HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const ImportOptions& o) {
   ensure_gdal();
@@ -197,11 +221,13 @@ HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const Impor
   std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopts(
       GDALWarpAppOptionsNew(argv.data(), nullptr), GDALWarpAppOptionsFree);
   if (!wopts) throw Error("internal: bad warp options for '" + path.string() + "'");
-  GDALDatasetH src = GDALOpen(path.c_str(), GA_ReadOnly);
-  if (!src) throw Error("cannot open '" + path.string() + "': " + last_gdal_message());
+  GDALDatasetH file = GDALOpen(path.c_str(), GA_ReadOnly);
+  if (!file) throw Error("cannot open '" + path.string() + "': " + last_gdal_message());
+  GDALDatasetH src = first_band(file, path);
   int usage_error = 0;
   GDALDatasetH dst = GDALWarp("", nullptr, 1, &src, wopts.get(), &usage_error);
-  GDALClose(src);
+  if (src != file) GDALClose(src);
+  GDALClose(file);
   if (!dst) {
     throw Error("cannot warp '" + path.string() + "': " + last_gdal_message() +
                 (o.crop || o.crop_lonlat ? " (does the crop box overlap the DEM?)" : ""));

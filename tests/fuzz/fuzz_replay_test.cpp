@@ -5,6 +5,7 @@
 // errors in the readers would show.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -32,8 +33,13 @@ TEST_P(FuzzReplay, EveryKeptInputIsReadOrRefused) {
     for (const auto& entry : fs::directory_iterator(dir)) {
       const std::vector<char> data = bytes_of(entry.path());
       SCOPED_TRACE(entry.path().string());
+      const auto start = std::chrono::steady_clock::now();
       EXPECT_NO_THROW(drift::fuzz::run_target(
           GetParam(), reinterpret_cast<const std::uint8_t*>(data.data()), data.size()));
+      // A hang is a finding too: 20 s is far above any kept input's time (under
+      // a second, a few under the sanitizers).
+      EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                20.0);
       ++replayed;
     }
   }

@@ -8,14 +8,17 @@
 
 #include "pipeline/object_list.h"
 #include "pipeline/scene_file.h"
+#include "pipeline/soil_scenario_file.h"
 #include "pipeline/track_file.h"
 #include "render/image_compare.h"
 #include "render/image_io.h"
 #include "render/tiles.h"
 #include "terrain/error.h"
 #include "terrain/import.h"
+#include "terrain/marks/marks.h"
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
+#include "terrain/soil/scenario.h"
 
 namespace drift::fuzz {
 
@@ -23,11 +26,27 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The files a fuzzed file may name by a relative path (the seeds do): small
+// meshes and a metric DEM, so that the readers go on past the reference.
+void write_fixtures(const fs::path& dir) {
+  const char* tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  for (const char* name : {"ball.obj", "rock.obj", "hut.obj", "shoe.obj"})
+    std::ofstream(dir / name) << tetra;
+  terrain::HeightField dem(24, 24, 10.0f, terrain::local_georeference(1.0));
+  for (int r = 0; r < 24; ++r)
+    for (int c = 0; c < 24; ++c) dem(c, r) = 10.0f + 0.25f * static_cast<float>(c + r);
+  terrain::write_geotiff(dem, dir / "dem.tif");
+}
+
 // The readers take paths: each input goes to a file of this process, named with
 // the extension the reader chooses its format by.
 fs::path as_file(const std::uint8_t* data, std::size_t size, const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("drift-fuzz-" + std::to_string(getpid()));
-  fs::create_directories(dir);
+  static const fs::path dir = [] {
+    const fs::path d = fs::temp_directory_path() / ("drift-fuzz-" + std::to_string(getpid()));
+    fs::create_directories(d);
+    write_fixtures(d);
+    return d;
+  }();
   const fs::path file = dir / name;
   std::ofstream(file, std::ios::binary | std::ios::trunc)
       .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
@@ -67,10 +86,46 @@ void objects(const std::uint8_t* data, std::size_t size) {
   refusals_allowed([&] { pipeline::read_objects_file(file); });
 }
 
-// drift marks --track: [[objects]] with keyframes, material, step.
+// drift marks --track: [[objects]] with keyframes, material, step. A short
+// track is also run on a small flat ground under its first keyframe, so the
+// values it holds reach the marks geometry (windows, sweeps, sub-steps).
 void track(const std::uint8_t* data, std::size_t size) {
   const fs::path file = as_file(data, size, "track.toml");
-  refusals_allowed([&] { pipeline::read_track_file(file); });
+  refusals_allowed([&] {
+    const pipeline::TrackFile t = pipeline::read_track_file(file);
+    double t0 = 1e300, t1 = -1e300;
+    for (const marks::MarkObject& o : t.objects)
+      t0 = std::min(t0, o.trajectory.start()), t1 = std::max(t1, o.trajectory.end());
+    if ((t1 - t0) / t.step > 8) return;  // a few steps: many inputs a second
+    const Eigen::Vector3d at = t.objects.front().trajectory.keys.front().position;
+    terrain::GeoReference geo = terrain::local_georeference(0.02);
+    geo.geotransform[0] = at.x() - 0.32, geo.geotransform[3] = at.y() + 0.32;
+    const terrain::HeightField ground(32, 32, static_cast<float>(at.z() - 0.02), geo);
+    marks::MarksOptions o;
+    o.step = t.step;
+    o.camera = t.camera;
+    const marks::Material m = t.material.value_or(*marks::material_preset("sand"));
+    marks::simulate_marks(ground, t.objects, marks::MaterialField{{m}, {}}, o);
+  });
+}
+
+// drift soil SCENARIO.toml: grid, soil, bodies, terrain (a DEM window or a
+// voxel terrain). Small grids are also voxelised and stepped twice, so the
+// scenario's values reach the voxelisation and the first steps.
+void scenario(const std::uint8_t* data, std::size_t size) {
+  const fs::path file = as_file(data, size, "scenario.toml");
+  refusals_allowed([&] {
+    const soil::SoilScenario sc = pipeline::read_soil_scenario(file);
+    const double voxels = double(sc.shape.nx) * sc.shape.ny * sc.shape.nz;
+    if (voxels > 24.0 * 24 * 24) return;  // small: many inputs a second
+    soil::SoilSimulation sim = soil::make_simulation(sc);
+    sim.step();
+    sim.step();
+    const std::vector<float>& rho = sim.state().rho;
+    for (float v : rho) {
+      if (!std::isfinite(v)) throw std::logic_error("soil let a non-finite density through");
+    }
+  });
 }
 
 void obj(const std::uint8_t* data, std::size_t size) {
@@ -108,8 +163,8 @@ void image(const std::uint8_t* data, std::size_t size) {
 
 const std::vector<Target>& targets() {
   static const std::vector<Target> all = {
-      {"raster", raster}, {"scene", scene}, {"objects", objects}, {"track", track},
-      {"obj", obj},       {"ply", ply},     {"image", image}};
+      {"raster", raster},     {"scene", scene}, {"objects", objects}, {"track", track},
+      {"scenario", scenario}, {"obj", obj},     {"ply", ply},         {"image", image}};
   return all;
 }
 

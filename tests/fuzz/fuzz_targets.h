@@ -18,7 +18,8 @@ struct Target {
   void (*run)(const std::uint8_t* data, std::size_t size);
 };
 
-// Every target, by name: raster, scene, objects, track, obj, ply, image.
+// Every target, by name: raster, scene, objects, track, scenario, obj, ply,
+// image.
 const std::vector<Target>& targets();
 
 // Runs target `name` on one input; returns false if there is no such target.

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +57,27 @@ fs::path dem(const fs::path& d, float value = 1.0f, double cell = 10.0) {
   return p;
 }
 
+// A small soil scenario: a column of sand on the grid's floor.
+const char* kSoilScenario =
+    "[grid]\nsize = [16, 16, 16]\nvoxel = 0.1\n[simulation]\nsteps = 5\n"
+    "[[soil_body]]\n[[soil_body.primitive]]\nshape = \"cylinder\"\ncenter = [0.8, 0.8, 0.6]\n"
+    "radius = 0.3\nhalf_height = 0.4\n";
+
+// A ball pressed into the middle of dem(): keyframes at 0 and `end` seconds.
+std::string ball_track(double end, double step) {
+  auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return std::string(text);
+  };
+  return "step = " + number(step) +
+         "\n[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
+         "/data/objects/ball.obj\"\nscale = 5\n"
+         "[[objects.keyframes]]\ntime = 0\nposition = [80, -80, 103]\n"
+         "[[objects.keyframes]]\ntime = " +
+         number(end) + "\nposition = [80, -80, 99]\n";
+}
+
 #define EXPECT_REFUSED(result, code, needle)                        \
   do {                                                              \
     const Result r_ = (result);                                     \
@@ -71,6 +93,10 @@ TEST(RefusalsCli, NonFiniteNumbersAreUsageErrorsInEverySubcommand) {
   const std::string png = (d / "a.png").string();
   put(d / "scene.toml", "[terrain]\nraster = \"dem.tif\"\n");
   const std::string scene = (d / "scene.toml").string();
+  put(d / "soil.toml", kSoilScenario);
+  put(d / "track.toml", ball_track(160.0, 0.1));
+  const std::string soil = "soil " + (d / "soil.toml").string() + " -o " + (d / "s.ply").string();
+  const std::string marks = "marks " + i + " --track " + (d / "track.toml").string() + o;
   for (const std::string& args : {
            "import " + i + o + " --resample nan",
            "import " + i + o + " --exaggerate inf",
@@ -86,6 +112,12 @@ TEST(RefusalsCli, NonFiniteNumbersAreUsageErrorsInEverySubcommand) {
            "compare " + png + " " + png + " --pixel-threshold nan",
            "compare " + png + " " + png + " --threshold inf",
            "sheet " + png + " -o " + png + " --exposure nan",
+           soil + " --phi nan",
+           soil + " --cohesion inf",
+           soil + " --moisture nan",
+           soil + " --gamma -inf",
+           marks + " --snow-min nan",
+           marks + " --snow-min inf",
        }) {
     const Result r = drift(args, d);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.log;
@@ -185,6 +217,83 @@ TEST(RefusalsCli, SizesAreCheckedAgainstMemoryBeforeAllocating) {
                        d),
                  1, "--mesh-edge");
   EXPECT_FALSE(fs::exists(d / "depth.tif") || fs::exists(d / "s.png"));
+}
+
+TEST(RefusalsCli, SoilRefusesValuesOutOfRangeAndGridsLargerThanMemory) {
+  const fs::path d = test_dir(), out = d / "soil.ply";
+  put(out, "old");
+  const std::string run = "soil " + (d / "s.toml").string() + " -o " + out.string();
+  const std::string base = kSoilScenario;
+  const struct {
+    std::string from, to, needle;
+  } cases[] = {
+      {"voxel = 0.1", "voxel = 1e-39", "voxel"},
+      {"voxel = 0.1", "voxel = inf", "voxel"},
+      {"steps = 5", "steps = 5\ndt = nan", "dt"},
+      {"radius = 0.3", "radius = 1e300", "radius"},
+      {"size = [16, 16, 16]", "size = [16, 16, 100000]", "size"},
+  };
+  for (const auto& c : cases) {
+    std::string text = base;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    put(d / "s.toml", text);
+    EXPECT_REFUSED(drift(run, d), 1, c.needle);
+    EXPECT_NE(drift(run, d).log.find("s.toml"), std::string::npos) << c.to;
+  }
+  // 512^3 voxels: the state is checked against memory before it is allocated.
+  std::string big = base;
+  big.replace(big.find("[16, 16, 16]"), 12, "[512, 512, 512]");
+  put(d / "s.toml", big);
+  EXPECT_REFUSED(drift(run, d, "DRIFT_MEMORY_LIMIT=256M"), 1, "is available");
+  EXPECT_REFUSED(drift(run + " --steps 2000000000", d), 2, "--steps");
+  // The --ground raster, widened by --ground-margin, is checked before the work.
+  put(d / "s.toml", base);
+  const std::string ground = run + " --ground " + (d / "g.tif").string();
+  EXPECT_REFUSED(drift(ground + " --ground-margin 50000", d, "DRIFT_MEMORY_LIMIT=256M"), 1,
+                 "--ground raster of 100016 x 100016 cells");
+  EXPECT_REFUSED(drift(ground + " --ground-margin -5", d), 2, "--ground-margin");
+  EXPECT_EQ(slurp(out), "old");
+  EXPECT_FALSE(fs::exists(d / "g.tif"));
+}
+
+// "wrote" is printed for outputs only once they are all in place: a failure
+// while the second output is made leaves the first unreplaced and unreported.
+TEST(RefusalsCli, SoilReportsOnlyCommittedOutputs) {
+  const fs::path d = test_dir(), out = d / "soil.ply";
+  put(out, "old");
+  put(d / "s.toml", kSoilScenario);  // no terrain, no bodies: no --collision mesh
+  const Result r = drift("soil " + (d / "s.toml").string() + " -o " + out.string() +
+                             " --collision " + (d / "bodies.ply").string(),
+                         d);
+  EXPECT_EQ(r.status, 1) << r.log;
+  EXPECT_NE(r.log.find("--collision"), std::string::npos) << r.log;
+  EXPECT_EQ(r.log.find("wrote"), std::string::npos) << r.log;
+  EXPECT_EQ(slurp(out), "old");
+  EXPECT_FALSE(fs::exists(d / "bodies.ply"));
+}
+
+TEST(RefusalsCli, MarksRefusesValuesOutOfRangeEndlessTracksAndGroundsLargerThanMemory) {
+  const fs::path d = test_dir(), out = d / "out.tif";
+  put(out, "old");
+  const std::string run =
+      "marks " + dem(d).string() + " --track " + (d / "t.toml").string() + " -o " + out.string();
+  put(d / "t.toml", ball_track(1.0, 1e-300));
+  EXPECT_REFUSED(drift(run, d), 1, "step");
+  put(d / "t.toml", ball_track(1.0, std::numeric_limits<double>::infinity()));
+  EXPECT_REFUSED(drift(run, d), 1, "t.toml");
+  // 1e9 s at the smallest step: 1e15 steps, refused rather than run for ever.
+  put(d / "t.toml", ball_track(1e9, 1e-6));
+  EXPECT_REFUSED(drift(run, d), 1, "raise 'step'");
+  put(d / "t.toml", ball_track(1.0, 0.1));
+  EXPECT_REFUSED(drift(run + " --memory-steps 2000000", d), 2, "--memory-steps");
+  // A 2048^2 ground needs ~120 MB of marks state: checked before allocating.
+  drift::terrain::HeightField big(2048, 2048, 100.0f, drift::terrain::local_georeference(0.1));
+  drift::terrain::write_geotiff(big, d / "big.tif");
+  EXPECT_REFUSED(drift("marks " + (d / "big.tif").string() + " --track " + (d / "t.toml").string() +
+                           " -o " + out.string(),
+                       d, "DRIFT_MEMORY_LIMIT=64M"),
+                 1, "marks state for a 2048 x 2048 ground");
+  EXPECT_EQ(slurp(out), "old");
 }
 
 TEST(RefusalsCli, NonFiniteMeshVerticesAreRefused) {

@@ -199,7 +199,8 @@ TEST(RenderCommand, FailedRunKeepsExistingOutput) {
 TEST(RenderCommand, BadSizeIsAUsageError) {
   const fs::path scene = write_scene("ok.toml", std::string(kTerrain));
   const std::string cmd = std::string(DRIFT_EXECUTABLE) + " render " + scene.string() +
-                          " --size 0x10 -o /tmp/x.png 2>/dev/null";
+                          " --size 0x10 -o " + (fs::temp_directory_path() / "x.png").string() +
+                          " 2>/dev/null";
   EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 2);
 }
 
