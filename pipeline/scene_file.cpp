@@ -71,7 +71,6 @@ void read_detail(Section& s, render::MaterialOverride& m) {
   m.detail = d;
 }
 
-
 // The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
 // `material` names a preset (which sets every field), and `color`,
 // `roughness` and `wetness` set (or override) one field each. `preset` gets
@@ -250,8 +249,8 @@ void read_snow(const toml::table& root, const fs::path& path, SceneFile& scene) 
       snow.number("forward_scattering", surface.snow.forward_scattering, 0.0, 1.0));
   surface.snow_scattering =
       static_cast<float>(snow.number("scattering", surface.snow_scattering, 1.0, 1e5));
-  surface.snow_cover_outside = static_cast<float>(
-      snow.number("cover_outside", surface.snow_cover_outside, 0.0, 1.0));
+  surface.snow_cover_outside =
+      static_cast<float>(snow.number("cover_outside", surface.snow_cover_outside, 0.0, 1.0));
   snow.finish();
 }
 

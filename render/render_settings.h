@@ -84,12 +84,12 @@ struct RenderSettings {
 struct SceneInput {
   terrain::HeightField terrain;  // metric CRS (or local), heights in metres
   double vertical_exaggeration = 1.0;
-  TerrainSurface surface;  // materials and the layers that place them
+  TerrainSurface surface;    // materials and the layers that place them
   SurroundOptions surround;  // the ground beyond the DEM's edge (render/surround.h)
   std::vector<terrain::PlacedMesh> meshes;
   Sun sun;
   Sky sky;
-  CloudOptions clouds;  // a cloud layer (render/clouds.h); physical sky only
+  CloudOptions clouds;           // a cloud layer (render/clouds.h); physical sky only
   std::optional<Camera> camera;  // none: the default view of the terrain
 };
 

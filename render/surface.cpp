@@ -171,7 +171,8 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   if (channels) cover(p.coverage, channels->snow, p.snow);
   if (surface.ripples && normal.z() > 1e-3f)
     apply_ripples(surface.ripples.value(), x, y, normal, footprint, p);
-  const DetailedGround detail = ground_detail(p.material, x, y, relief.altitude, p.normal, footprint);
+  const DetailedGround detail =
+      ground_detail(p.material, x, y, relief.altitude, p.normal, footprint);
   p.material.albedo = detail.albedo;
   p.material.roughness = detail.roughness;
   p.normal = detail.normal;

@@ -273,11 +273,11 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   const bool surround = rh.hit.geomID == surround_geometry_;
   std::optional<Eigen::Vector3f> facet;  // beyond the DEM: its smooth normal, facing up
   if (surround) facet = surround_normal(rh.hit.primID, rh.hit.u, rh.hit.v);
-  const Eigen::Vector3f n = rh.hit.geomID < terrain_geometries_ || surround
-                                ? shade_terrain_hit(hit, cone, facet)
-                                : shade_mesh_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v,
-                                                 {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, hit,
-                                                 footprint(cone, hit));
+  const Eigen::Vector3f n =
+      rh.hit.geomID < terrain_geometries_ || surround
+          ? shade_terrain_hit(hit, cone, facet)
+          : shade_mesh_hit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v,
+                           {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, hit, footprint(cone, hit));
   // Face the ray: a mesh may be seen from either side, and terrain from below
   // at the edges. (Embree's Ng of our grids points down: rows run south.)
   hit.normal = n.dot(d) > 0 ? Eigen::Vector3f(-n) : n;
@@ -324,8 +324,8 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
     const float mean = std::clamp(
         (1.0f - u - v) * cover[tri[0]] + u * cover[tri[1]] + v * cover[tri[2]], 0.0f, 1.0f);
     // Below full coverage, flakes (render/snow_flakes.h).
-    const float c = flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean,
-                                footprint);
+    const float c =
+        flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean, footprint);
     hit.material = mix(hit.material, surface_.snow, c);
     hit.snow = c;
     hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel
