@@ -13,25 +13,16 @@
 #include <fstream>
 
 #include "terrain/raster_io.h"
+#include "tests/test_files.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path test_dir() {
-  const fs::path d = fs::temp_directory_path() / "drift_refusals_cli" /
-                     ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+using drift::testing::put;
+using drift::testing::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
-void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+fs::path test_dir() { return drift::testing::test_dir("drift_refusals_cli"); }
 
 struct Result {
   int status;
