@@ -95,7 +95,7 @@ Vector3f PathTracer::cloudy_sky(const Vector3f& origin, const Vector3f& dir, con
                                 bool from_camera, const RayCone& cone) const {
   CloudCrossing c;
   if (!clouds_ || !clouds_->cross(origin, dir, 1e30f, c)) return behind;
-  const float footprint = cone.width + cone.spread * c.distance;
+  const float footprint = cone.width_at(c.distance);
   const CloudLook look = cloud_look(*clouds_, c, dir, cloud_light_, footprint);
   if (look.transmittance >= 1.0f) return behind;
   // The sky's light is the air before the layer, the layer, and what lies
@@ -113,7 +113,7 @@ void PathTracer::cross_clouds(Path& path, float distance, int depth, PixelSample
   // with the air and ground behind added by cross_air through the throughput.
   CloudCrossing c;
   if (!clouds_->cross(path.origin, path.dir, distance, c)) return;
-  const float footprint = path.cone.width + path.cone.spread * c.distance;
+  const float footprint = path.cone.width_at(c.distance);
   const CloudLook look = cloud_look(*clouds_, c, path.dir, cloud_light_, footprint);
   if (look.transmittance >= 1.0f) return;
   const AirSegment air =
@@ -222,7 +222,7 @@ void PathTracer::sample_sun(const Path& path, const Hit& hit, const Vector3f& p,
     Vector3f e = air_ ? air_->sun_irradiance(base_altitude_ + hit.position.z()) : sun_irradiance_;
     // Cloud shadow, blurred as the sun's disc blurs it (its penumbra).
     if (clouds_) {
-      const float width = path.cone.width + path.cone.spread * hit.distance;
+      const float width = path.cone.width_at(hit.distance);
       e *= clouds_->transmittance(p, l, width, sun_penumbra_);
     }
     out.radiance += path.throughput.cwiseProduct(bsdf.eval(l)).cwiseProduct(e) * cos_l;
@@ -242,7 +242,7 @@ void PathTracer::sample_sky(const Path& path, const Hit& hit, const Vector3f& p,
     const float w = power_heuristic(light.pdf, bsdf.pdf(light.dir));
     Vector3f sky = sky_light(light.dir);
     if (clouds_) {
-      const RayCone cone{path.cone.width + path.cone.spread * hit.distance, kCloudLightingSpread};
+      const RayCone cone{path.cone.width_at(hit.distance), kCloudLightingSpread};
       sky = cloudy_sky(p, light.dir, sky, false, cone);
     }
     out.radiance += path.throughput.cwiseProduct(f).cwiseProduct(sky) * (cos_l * w / light.pdf);
@@ -263,7 +263,7 @@ bool PathTracer::bounce(Path& path, const Hit& hit, const Vector3f& p, const Gro
   path.origin = p;
   path.throughput = path.throughput.cwiseProduct(sample.weight);
   // A diffuse bounce spreads the footprint over about a radian.
-  path.cone = {path.cone.width + path.cone.spread * hit.distance, 1.0f};
+  path.cone = {path.cone.width_at(hit.distance), 1.0f};
   if (depth >= 2) {  // Russian roulette (unbiased)
     const float q = std::min(0.95f, path.throughput.maxCoeff());
     if (rng.next() >= q) return false;

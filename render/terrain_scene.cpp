@@ -38,9 +38,7 @@ void check_device(RTCDevice device, const char* what) {
 constexpr int kMaxGridSide = 32767;
 
 // The ray's footprint (metres) where it hit.
-double footprint(const RayCone& cone, const Hit& hit) {
-  return cone.width + cone.spread * hit.distance;
-}
+double footprint(const RayCone& cone, const Hit& hit) { return cone.width_at(hit.distance); }
 
 }  // namespace
 

@@ -32,6 +32,9 @@ struct Hit {
 struct RayCone {
   float width = 0.0f;
   float spread = 0.0f;
+
+  // The footprint's width (metres) `distance` along the ray.
+  float width_at(float distance) const { return width + spread * distance; }
 };
 
 class TerrainScene {
