@@ -1,0 +1,30 @@
+// One source for snowfall's defaults and ranges: the table in
+// snow/snowfall_parameters.cpp. docs/snowfall.md's options table must agree
+// with it row by row, and validate() must hold every range at both ends.
+#include "snow/snowfall_parameters.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/parameter_table.h"
+
+using namespace drift::snow;
+
+TEST(SnowfallParameters, DocsAgreeWithTheTable) {
+  drift::testing::expect_docs_agree(snowfall_parameters(), DRIFT_SOURCE_DIR "/docs/snowfall.md");
+}
+
+TEST(SnowfallParameters, ValidateHoldsEveryRangeAndNamesTheField) {
+  drift::testing::expect_validate_holds_ranges(snowfall_parameters());
+}
+
+// No field or flag has two rows (the docs test finds rows by flag).
+TEST(SnowfallParameters, EveryRowNamesAFieldOfItsOwn) {
+  const auto& table = snowfall_parameters();
+  for (std::size_t i = 0; i < table.size(); ++i)
+    for (std::size_t j = i + 1; j < table.size(); ++j) {
+      EXPECT_STRNE(table[i].field, table[j].field);
+      if (*table[i].flag) {
+        EXPECT_STRNE(table[i].flag, table[j].flag);
+      }
+    }
+}
