@@ -78,7 +78,7 @@ inline void require_in(const std::string& field, double value, double lo, double
 
 // One row of an options struct's parameter table (Mitsuba's parameter tables
 // are the model): the field as library errors name it, the command line's
-// flag, the range, the unit and what it means. The struct's validate(), the
+// flag and the file's key, the range, the unit and what it means. The struct's validate(), the
 // command line's flags and help (pipeline/parameter_flags.h), and the docs'
 // table all come from the rows; the defaults are the struct's own (Options{}).
 template <class Options>
@@ -94,6 +94,8 @@ struct Parameter {
   const char* meaning;
   double (*get)(const Options&);
   void (*set)(Options&, double);
+  // The key in a scene or scenario file, with its table: "[soil] phi"; "" if none.
+  const char* key = "";
 
   std::string range() const { return range_text(lo, hi, ends, unit); }
   // Finite, in range and, for an integer, whole.

@@ -19,36 +19,48 @@
 namespace drift::testing {
 
 // The rows of `page`'s table headed "| option | default | range | meaning |",
-// by flag: default, range, meaning.
+// by their first cell: default, range, meaning.
 inline std::map<std::string, std::vector<std::string>> documented_options(const std::string& page) {
   std::map<std::string, std::vector<std::string>> rows;
   for (const auto& cells : markdown_table(page, "| option | default | range | meaning |"))
-    if (cells.size() == 4 && cells[0].rfind("`--", 0) == 0)
-      rows[cells[0].substr(1, cells[0].size() - 2)] = {cells[1], cells[2], cells[3]};
+    if (cells.size() == 4 && cells[0].rfind('`', 0) == 0)
+      rows[cells[0]] = {cells[1], cells[2], cells[3]};
   return rows;
 }
 
-// Every row with a flag is in `page`'s options table with the struct's
-// default, the row's range and meaning; the table lists nothing else.
+// A row's first cell in the docs: its file key and its flag, each in
+// backticks, "`[soil] phi` / `--phi`"; "" for a row with neither.
+template <class Options>
+std::string docs_label(const terrain::Parameter<Options>& p) {
+  std::string label;
+  if (*p.key) label = std::string("`") + p.key + "`";
+  if (*p.key && *p.flag) label += " / ";
+  if (*p.flag) label += std::string("`") + p.flag + "`";
+  return label;
+}
+
+// Every row with a key or a flag is in `page`'s options table with the
+// struct's default, the row's range and meaning; the table lists nothing else.
 template <class Options>
 void expect_docs_agree(const std::vector<terrain::Parameter<Options>>& table,
                        const std::string& page) {
   const auto rows = documented_options(page);
   const Options defaults;
-  std::size_t flagged = 0;
+  std::size_t documented = 0;
   for (const terrain::Parameter<Options>& p : table) {
-    if (!*p.flag) continue;
-    ++flagged;
-    const auto it = rows.find(p.flag);
+    const std::string label = docs_label(p);
+    if (label.empty()) continue;
+    ++documented;
+    const auto it = rows.find(label);
     if (it == rows.end()) {
-      ADD_FAILURE() << p.flag << " is not in " << page;
+      ADD_FAILURE() << label << " is not in " << page;
       continue;
     }
-    EXPECT_EQ(it->second[0], terrain::format_value(p.get(defaults))) << p.flag;
-    EXPECT_EQ(it->second[1], p.range()) << p.flag;
-    EXPECT_EQ(it->second[2], p.meaning) << p.flag;
+    EXPECT_EQ(it->second[0], terrain::format_value(p.get(defaults))) << label;
+    EXPECT_EQ(it->second[1], p.range()) << label;
+    EXPECT_EQ(it->second[2], p.meaning) << label;
   }
-  EXPECT_EQ(rows.size(), flagged) << page << " lists other options";
+  EXPECT_EQ(rows.size(), documented) << page << " lists other options";
 }
 
 // validate() takes each range's ends (and the default) and refuses what lies

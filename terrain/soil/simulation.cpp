@@ -7,6 +7,7 @@
 
 #include "terrain/error.h"
 #include "terrain/soil/deformation.h"
+#include "terrain/soil/soil_parameters.h"
 
 namespace drift::soil {
 
@@ -21,26 +22,14 @@ void mark_box(const VoxelBox& box, ColumnMask& dirty, const terrain::Grid3Shape&
 
 }  // namespace
 
-void validate(const SoilOptions& o) {
-  auto check = [](bool ok, const char* name, double v, const char* range) {
-    if (!ok)
-      throw Error(std::string("soil option ") + name + " is " + std::to_string(v) +
-                  "; it must lie in " + range);
-  };
-  check(std::isfinite(o.dt) && o.dt > 0 && o.dt <= 1, "dt (s)", o.dt, "(0, 1]");
-  check(std::isfinite(o.gravity) && o.gravity >= 0 && o.gravity <= 100, "gravity (m/s^2)",
-        o.gravity, "[0, 100]");
-  check(o.propagation_iterations >= 0 && o.propagation_iterations <= 64, "propagation_iterations",
-        o.propagation_iterations, "[0, 64]");
-  check(o.overflow_passes >= 0 && o.overflow_passes <= 64, "overflow_passes", o.overflow_passes,
-        "[0, 64]");
-  validate(o.soil);
+void SoilOptions::validate() const {
+  for (const SoilParameter& p : soil_parameters()) p.require(*this);
 }
 
 SoilSimulation::SoilSimulation(SoilState state, std::vector<RigidObject> bodies,
                                const SoilOptions& options)
     : state_(std::move(state)), options_(options), slippage_(state_.shape) {
-  validate(options_);
+  options_.validate();
   for (RigidObject& b : bodies) {
     validate(b, "body");
     if (b.moves()) {
