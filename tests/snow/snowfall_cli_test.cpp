@@ -74,7 +74,8 @@ TEST(SnowfallCli, BadInputIsRefusedWithAMessageAndNoOutput) {
   EXPECT_NE(output(d).find("missing.tif"), std::string::npos) << output(d);
   EXPECT_EQ(run(ground.string() + out + " --direction 45", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --direction 45,0", d), 2);
-  EXPECT_NE(output(d).find("elevation"), std::string::npos) << output(d);
+  EXPECT_NE(output(d).find("--direction EL is 0; it must lie in (0, 90]"), std::string::npos)
+      << output(d);
   EXPECT_EQ(run(ground.string() + out + " --maps 0", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --spread -3", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --occlusion raytrace", d), 2);
