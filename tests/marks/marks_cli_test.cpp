@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -18,10 +19,8 @@ fs::path dir() { return drift::testing::test_dir("drift_marks_cli"); }
 
 // A flat metric ground (1 cm cells, UTM-sized coordinates) at 2000 m.
 fs::path ground(const fs::path& d) {
-  drift::terrain::HeightField g(64, 64, 2000.0f, drift::terrain::local_georeference(0.01));
-  g.geo().geotransform[0] = 600000.0;
-  g.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(g, d / "ground.tif");
+  drift::terrain::write_geotiff(drift::testing::flat_utm_ground(64, 2000.0f, 0.01),
+                                d / "ground.tif");
   return d / "ground.tif";
 }
 

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -17,10 +18,8 @@ fs::path dir() { return drift::testing::test_dir("drift_snowfall_cli"); }
 
 // A small metric ground (UTM 53N) and an objects file with a rock on it.
 fs::path setup(const fs::path& d) {
-  drift::terrain::HeightField g(40, 40, 1500.0f, drift::terrain::local_georeference(0.5));
-  g.geo().geotransform[0] = 600000.0;
-  g.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(g, d / "ground.tif");
+  drift::terrain::write_geotiff(drift::testing::flat_utm_ground(40, 1500.0f, 0.5),
+                                d / "ground.tif");
   std::ofstream(d / "objects.toml") << "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
                                        "/data/objects/rock_b.obj\"\nposition = [600010.0, "
                                        "3999990.0, 1500.0]\n";
