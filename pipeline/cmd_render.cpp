@@ -159,12 +159,11 @@ std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
   std::string text((std::istreambuf_iterator<char>(in)), {});
   std::vector<std::string> parts = {o.size, o.terrain};
   for (const RenderOptions::ProductFlag& f : o.product_flags) parts.push_back(f.value);
-  for (const std::string& part :
-       {o.sun_time, std::to_string(scene.settings.samples_per_pixel),
-        std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
-        std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)}) {
-    parts.push_back(part);
-  }
+  parts.insert(
+      parts.end(),
+      {o.sun_time, std::to_string(scene.settings.samples_per_pixel),
+       std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
+       std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)});
   for (const std::string& part : parts) text.append("\n").append(part);
   std::uint64_t hash = 14695981039346656037ull;
   for (unsigned char c : text) hash = (hash ^ c) * 1099511628211ull;
