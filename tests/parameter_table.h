@@ -103,3 +103,14 @@ void expect_validate_holds_ranges(const std::vector<terrain::Parameter<Options>>
 }
 
 }  // namespace drift::testing
+
+// The two tests every parameter table gets: `suite`.DocsAgreeWithTheTable
+// (against `page`, relative to the source tree) and
+// `suite`.ValidateHoldsEveryRangeAndNamesTheField.
+#define DRIFT_PARAMETER_TABLE_TESTS(suite, table, page)                    \
+  TEST(suite, DocsAgreeWithTheTable) {                                     \
+    drift::testing::expect_docs_agree(table(), DRIFT_SOURCE_DIR "/" page); \
+  }                                                                        \
+  TEST(suite, ValidateHoldsEveryRangeAndNamesTheField) {                   \
+    drift::testing::expect_validate_holds_ranges(table());                 \
+  }

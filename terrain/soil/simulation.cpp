@@ -1,7 +1,5 @@
 #include "terrain/soil/simulation.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 
@@ -77,19 +75,9 @@ void SoilSimulation::step() {
 }
 
 void add_soil(SoilState& s, const std::vector<Primitive>& prims, const Eigen::Vector3d& pos) {
-  const terrain::Grid3Shape& g = s.shape;
-  const VoxelBox box = voxel_box(prims, pos, g);
-  if (box.empty()) return;
-  const double h = g.voxel_size;
-  tbb::parallel_for(box.lo.y(), box.hi.y(), [&](int y) {
-    for (int x = box.lo.x(); x < box.hi.x(); ++x)
-      for (int z = box.lo.z(); z < box.hi.z(); ++z) {
-        const Eigen::Vector3d lo = g.origin + h * Eigen::Vector3d(x, y, z);
-        const double c = coverage(prims, pos, lo, lo + Eigen::Vector3d::Constant(h));
-        const std::size_t i = g.index(x, y, z);
-        const float room = std::max(0.0f, 1.0f - std::max(s.psi_static[i], s.psi[i]) - s.rho[i]);
-        s.rho[i] += std::min(room, static_cast<float>(c));
-      }
+  for_each_covered_voxel(prims, pos, s.shape, [&s](std::size_t i, float c) {
+    const float room = std::max(0.0f, 1.0f - std::max(s.psi_static[i], s.psi[i]) - s.rho[i]);
+    s.rho[i] += std::min(room, c);
   });
 }
 

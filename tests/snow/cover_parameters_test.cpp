@@ -11,13 +11,7 @@
 
 using namespace drift::snow;
 
-TEST(CoverParameters, DocsAgreeWithTheTable) {
-  drift::testing::expect_docs_agree(cover_parameters(), DRIFT_SOURCE_DIR "/docs/snow.md");
-}
-
-TEST(CoverParameters, ValidateHoldsEveryRangeAndNamesTheField) {
-  drift::testing::expect_validate_holds_ranges(cover_parameters());
-}
+DRIFT_PARAMETER_TABLE_TESTS(CoverParameters, cover_parameters, "docs/snow.md")
 
 TEST(CoverParameters, ASnowLineMustBeFinite) {
   CoverOptions o;

@@ -9,13 +9,7 @@
 
 using namespace drift::snow;
 
-TEST(SnowfallParameters, DocsAgreeWithTheTable) {
-  drift::testing::expect_docs_agree(snowfall_parameters(), DRIFT_SOURCE_DIR "/docs/snowfall.md");
-}
-
-TEST(SnowfallParameters, ValidateHoldsEveryRangeAndNamesTheField) {
-  drift::testing::expect_validate_holds_ranges(snowfall_parameters());
-}
+DRIFT_PARAMETER_TABLE_TESTS(SnowfallParameters, snowfall_parameters, "docs/snowfall.md")
 
 // No field or flag has two rows (the docs test finds rows by flag).
 TEST(SnowfallParameters, EveryRowNamesAFieldOfItsOwn) {

@@ -9,13 +9,7 @@
 
 using namespace drift::soil;
 
-TEST(SoilParameters, DocsAgreeWithTheTable) {
-  drift::testing::expect_docs_agree(soil_parameters(), DRIFT_SOURCE_DIR "/docs/soil.md");
-}
-
-TEST(SoilParameters, ValidateHoldsEveryRangeAndNamesTheField) {
-  drift::testing::expect_validate_holds_ranges(soil_parameters());
-}
+DRIFT_PARAMETER_TABLE_TESTS(SoilParameters, soil_parameters, "docs/soil.md")
 
 // Every preset of table 6 lies within the table's ranges.
 TEST(SoilParameters, ThePresetsAreValid) {
