@@ -76,9 +76,10 @@ void apply_size(const std::string& size, render::RenderSettings& settings) {
   }
   settings.width = std::stoi(m[1]);
   settings.height = std::stoi(m[2]);
-  if (settings.width < 1 || settings.height < 1 || settings.width > 16384 ||
-      settings.height > 16384) {
-    usage_error("--size '" + size + "': each side must be 1..16384");
+  constexpr int kMax = render::RenderSettings::kMaxSide;
+  if (settings.width < 1 || settings.height < 1 || settings.width > kMax ||
+      settings.height > kMax) {
+    usage_error("--size '" + size + "': each side must be 1.." + std::to_string(kMax));
   }
 }
 
@@ -243,7 +244,7 @@ void add_render_command(CLI::App& root) {
                                  [o](const CLI::App& self) { run_render(*o, self); });
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
   sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)")
-      ->check(CLI::Range(1, 1 << 20));
+      ->check(CLI::Range(1, render::RenderSettings::kMaxSamplesPerPixel));
   sub->add_option("--noise-target", o->noise_target,
                   "adaptive sampling: stop a pixel when the relative standard error of its "
                   "luminance is below this (e.g. 0.02; 0 turns it off; --spp is the most)")
@@ -264,10 +265,10 @@ void add_render_command(CLI::App& root) {
          "--exposure", o->exposure_ev,
          "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
          "EXR stays linear)")
-      ->check(CLI::Range(-20.0, 20.0));
+      ->check(CLI::Range(-render::DisplayTransform::kMaxEv, render::DisplayTransform::kMaxEv));
   sub->add_option("--exposure-compensation", o->compensation_ev,
                   "EV added to the metered exposure (overrides [output] exposure_compensation)")
-      ->check(CLI::Range(-20.0, 20.0));
+      ->check(CLI::Range(-render::DisplayTransform::kMaxEv, render::DisplayTransform::kMaxEv));
   add_seed_option(*sub, o->seed);
 }
 

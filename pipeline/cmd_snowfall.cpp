@@ -14,6 +14,7 @@
 #include "terrain/error.h"
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
+#include "terrain/products.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -39,6 +40,14 @@ terrain::HeightField snow_surface(const terrain::HeightField& ground,
   for (std::size_t i = 0; i < top.size(); ++i)
     top.values()[i] = ground.values()[i] + depth.values()[i];
   return top;
+}
+
+// --mesh-out's help from the declared form it writes (terrain/products.h).
+std::string mesh_out_help() {
+  std::string help = "PLY of the objects raised by their snow, with per-vertex";
+  const auto& names = terrain::products::kSnowyObjects.attributes;
+  for (std::size_t i = 0; i < names.size(); ++i) help += (i ? ", " : " ") + std::string(names[i]);
+  return help;
 }
 
 // --direction's help from the table's rows for its two parts.
@@ -113,9 +122,7 @@ void add_snowfall_command(CLI::App& root) {
   sub->add_option("--cover", c->cover, "snow coverage GeoTIFF (0..1)");
   sub->add_option("--surface", c->surface,
                   "snow surface GeoTIFF: ground + snow depth (m), e.g. for drift marks");
-  sub->add_option("--mesh-out", c->mesh_out,
-                  "PLY of the objects raised by their snow, with per-vertex snow_depth, "
-                  "snow_probability, snow_coverage, snow_adhesion");
+  sub->add_option("--mesh-out", c->mesh_out, mesh_out_help());
   sub->add_option("--direction", c->direction, direction_help())
       ->expected(2)
       ->delimiter(',')

@@ -47,9 +47,12 @@ void read_exposure(Section& out, const toml::table* table, render::DisplayTransf
     if (mode != "auto")
       out.invalid("exposure", "is '" + mode + "'; use \"auto\" or a number of EV");
   } else if (node) {
-    display.exposure_ev = out.number("exposure", 0.0, -20.0, 20.0);
+    display.exposure_ev = out.number("exposure", 0.0, -render::DisplayTransform::kMaxEv,
+                                     render::DisplayTransform::kMaxEv);
   }
-  const double compensation = out.number("exposure_compensation", 0.0, -20.0, 20.0);
+  const double compensation =
+      out.number("exposure_compensation", 0.0, -render::DisplayTransform::kMaxEv,
+                 render::DisplayTransform::kMaxEv);
   if (compensation != 0.0 && !display.auto_exposure)
     out.invalid("exposure_compensation",
                 "needs exposure = \"auto\"; with a fixed exposure set that instead");
@@ -390,13 +393,15 @@ void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene
 // [render]: size, sampling and seed.
 void read_render(const toml::table& root, const fs::path& path, render::RenderSettings& settings) {
   Section rs(subtable(root, "render", path), "render", path);
-  settings.width = rs.integer("width", settings.width, 1, 16384);
-  settings.height = rs.integer("height", settings.height, 1, 16384);
-  settings.samples_per_pixel = rs.integer("spp", settings.samples_per_pixel, 1, 1 << 20);
+  settings.width = rs.integer("width", settings.width, 1, render::RenderSettings::kMaxSide);
+  settings.height = rs.integer("height", settings.height, 1, render::RenderSettings::kMaxSide);
+  settings.samples_per_pixel =
+      rs.integer("spp", settings.samples_per_pixel, 1, render::RenderSettings::kMaxSamplesPerPixel);
   settings.max_depth = rs.integer("max_depth", settings.max_depth, 1, 1024);
   settings.noise_target =
       static_cast<float>(rs.number("noise_target", settings.noise_target, 0.0, 1.0));
-  settings.min_samples = rs.integer("min_spp", settings.min_samples, 1, 1 << 20);
+  settings.min_samples =
+      rs.integer("min_spp", settings.min_samples, 1, render::RenderSettings::kMaxSamplesPerPixel);
   settings.seed = rs.seed("seed", settings.seed);
   settings.sample_sky = rs.boolean("sample_sky", settings.sample_sky);
   rs.finish();

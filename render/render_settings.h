@@ -62,6 +62,10 @@ struct Camera {
 };
 
 struct RenderSettings {
+  // The ranges the scene file and the command line both hold the settings to.
+  static constexpr int kMaxSide = 16384;               // width and height, pixels
+  static constexpr int kMaxSamplesPerPixel = 1 << 20;  // samples_per_pixel, min_samples
+
   int width = 960;
   int height = 540;
   int samples_per_pixel = 64;  // the most a pixel takes

@@ -21,6 +21,10 @@ enum class ToneCurve {
 inline constexpr std::array<float, 3> kDaylightWhiteBalance{0.9003f, 1.0252f, 1.0904f};
 
 struct DisplayTransform {
+  // A fixed exposure or a compensation lies in [-kMaxEv, kMaxEv] (scene file
+  // and command line alike).
+  static constexpr double kMaxEv = 20.0;
+
   double exposure_ev = 0.0;  // multiply radiance by 2^exposure_ev before the curve
   ToneCurve curve = ToneCurve::Filmic;
   std::array<float, 3> white_balance{1.0f, 1.0f, 1.0f};  // R, G, B gains before the curve
