@@ -264,7 +264,13 @@ bool PathTracer::bounce(Path& path, const Hit& hit, const Vector3f& p, const Gro
   path.throughput = path.throughput.cwiseProduct(sample.weight);
   // A diffuse bounce spreads the footprint over about a radian.
   path.cone = {path.cone.width_at(hit.distance), 1.0f};
-  if (depth >= 2) {  // Russian roulette (unbiased)
+  // Russian roulette (unbiased) from the second bounce on: a path that has
+  // already bounced once off ground of albedo ~0.1-0.3 carries little light,
+  // so most of it is cut there and the survivors weighted up. On the default
+  // frame this takes 6 % of the rays (2.92 -> 2.76 a sample) and ~10 % of the
+  // CPU time for ~2 % more relMSE; from the first bounce it would take 32 %
+  // of the rays but nearly double the relMSE (docs/rendering.md, "Speed").
+  if (depth >= 1) {
     const float q = std::min(0.95f, path.throughput.maxCoeff());
     if (rng.next() >= q) return false;
     path.throughput /= q;
