@@ -34,8 +34,8 @@ Image crop(const Image& image, int x, int y, int w, int h) {
   Image out(w, h, image.channels);
   const std::size_t row = static_cast<std::size_t>(w) * image.channels.size();
   for (int r = 0; r < h; ++r) {
-    const float* from = &image.pixels[(static_cast<std::size_t>(y + r) * image.width + x) *
-                                      image.channels.size()];
+    const float* from =
+        &image.pixels[(static_cast<std::size_t>(y + r) * image.width + x) * image.channels.size()];
     std::copy(from, from + row, out.pixels.begin() + static_cast<std::ptrdiff_t>(r * row));
   }
   return out;
