@@ -52,7 +52,7 @@ const std::vector<SandParameter>& sand_parameters() {
 #undef DRIFT_SAND_FIELD
 
 std::string range_text(const SandParameter& p) {
-  return terrain::range_text(p.lo, p.hi, false, p.unit);
+  return terrain::range_text(p.lo, p.hi, terrain::Ends::Closed, p.unit);
 }
 
 }  // namespace drift::dunes

@@ -5,12 +5,12 @@
 #include <memory>
 
 #include "pipeline/cli.h"
+#include "pipeline/parameter_flags.h"
 #include "pipeline/progress_bar.h"
 #include "snow/cover_parameters.h"
 #include "snow/snow_cover.h"
 #include "terrain/error.h"
 #include "terrain/output_set.h"
-#include "terrain/parameter.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -21,25 +21,15 @@ struct CoverCommand {
   std::string dem, output, accessibility, descriptor, hemisphere = "auto",
                                                       sun_step = "per-triangle";
   double snow_line = 0.0;
-  // The table's flags as parsed (snow/cover_parameters.h); only those given
-  // override CoverOptions{}'s defaults.
-  std::vector<double> values = std::vector<double>(snow::cover_parameters().size(), 0.0);
+  // The table's flags (snow/cover_parameters.h); only those given override
+  // CoverOptions{}'s defaults.
+  ParameterFlags<snow::CoverOptions> parameters{snow::cover_parameters()};
 };
-
-// A flag's help: its meaning, range and default, from the table.
-std::string parameter_help(const snow::CoverParameter& p) {
-  return std::string(p.meaning) + " " + p.range() +
-         " (default: " + terrain::format_value(p.get(snow::CoverOptions{})) + ")";
-}
 
 void run_cover(CoverCommand& c, const CLI::App& sub) {
   snow::CoverOptions o;
-  FlagNames flags;
-  for (std::size_t i = 0; i < snow::cover_parameters().size(); ++i) {
-    const snow::CoverParameter& p = snow::cover_parameters()[i];
-    if (sub.count(p.flag)) p.set(o, c.values[i]);
-    flags.emplace_back(p.field, p.flag);
-  }
+  c.parameters.apply(sub, o);
+  FlagNames flags = c.parameters.flag_names();
   if (sub.count("--radius") && sub.count("--radius-cells")) {
     usage_error("give --radius (metres) or --radius-cells, not both");
   }
@@ -94,11 +84,7 @@ void add_snow_cover_command(CLI::App& root) {
                                  [c](const CLI::App& self) { run_cover(*c, self); });
   sub->add_option("dem", c->dem, "DEM GeoTIFF in metres (drift import)")->required();
   sub->add_option("-o,--output", c->output, "snow cover GeoTIFF, 1 - t in [0, 1]")->required();
-  for (std::size_t i = 0; i < snow::cover_parameters().size(); ++i) {
-    const snow::CoverParameter& p = snow::cover_parameters()[i];
-    CLI::Option* opt = sub->add_option(p.flag, c->values[i], parameter_help(p));
-    if (p.integer) opt->check(CLI::Validator(whole_number, "WHOLE"));
-  }
+  c->parameters.add_to(*sub);
   sub->add_option("--sun-step", c->sun_step,
                   "per-triangle (the paper: t = t phi + 1 - phi for each facing triangle) or mean "
                   "(phi averaged over the 12 triangles, applied once)")

@@ -7,8 +7,10 @@
 
 #include "pipeline/cli.h"
 #include "pipeline/object_list.h"
+#include "pipeline/parameter_flags.h"
 #include "pipeline/progress_bar.h"
 #include "snow/snowfall.h"
+#include "snow/snowfall_parameters.h"
 #include "terrain/error.h"
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
@@ -20,10 +22,13 @@ namespace {
 
 struct SnowfallCommand {
   std::string ground, objects, output, cover, surface, mesh_out;
-  std::vector<double> direction{0.0, 90.0};
+  std::vector<double> direction{snow::SnowfallOptions{}.azimuth_deg,
+                                snow::SnowfallOptions{}.elevation_deg};
   std::string occlusion = "sweep";
-  unsigned long long seed = 1;
-  snow::SnowfallOptions options;
+  unsigned long long seed = snow::SnowfallOptions{}.seed;
+  // The table's flags (snow/snowfall_parameters.h); only those given override
+  // SnowfallOptions{}'s defaults.
+  ParameterFlags<snow::SnowfallOptions> parameters{snow::snowfall_parameters()};
 };
 
 // SPEC 3a's third output: the height of the snow's top, for stages that press
@@ -36,9 +41,19 @@ terrain::HeightField snow_surface(const terrain::HeightField& ground,
   return top;
 }
 
-void run_snowfall(SnowfallCommand& c) {
+// --direction's help from the table's rows for its two parts.
+std::string direction_help() {
+  std::string help = "AZ,EL where the snow comes from, like a sun position (0,90: straight down)";
+  for (const snow::SnowfallParameter& p : snow::snowfall_parameters())
+    if (std::string(p.flag).rfind("--direction ", 0) == 0)
+      help += std::string("; ") + (p.flag + 12) + " in " + p.range();
+  return help;
+}
+
+void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   if (c.direction.size() != 2) usage_error("--direction takes AZ,EL (degrees)");
-  snow::SnowfallOptions o = c.options;
+  snow::SnowfallOptions o;
+  c.parameters.apply(sub, o);
   o.azimuth_deg = c.direction[0];
   o.elevation_deg = c.direction[1];
   o.seed = c.seed;
@@ -47,18 +62,7 @@ void run_snowfall(SnowfallCommand& c) {
   if (!c.mesh_out.empty() && c.objects.empty())
     usage_error("--mesh-out needs --objects (there are no objects to write)");
   // Before reading anything large; the ranges live in SnowfallOptions::validate().
-  validate_flags([&o] { o.validate(); }, {{"azimuth_deg", "--direction's azimuth"},
-                                          {"elevation_deg", "--direction's elevation"},
-                                          {"spread_deg", "--spread"},
-                                          {"maps", "--maps"},
-                                          {"rate_m_per_h", "--rate"},
-                                          {"hours", "--hours"},
-                                          {"repose_deg", "--repose"},
-                                          {"mesh_max_edge", "--mesh-edge"},
-                                          {"occlusion.object_texel", "--object-texel"},
-                                          {"coverage.thin_depth", "--thin-depth"},
-                                          {"coverage.adhesion", "--adhesion"},
-                                          {"max_iterations", "--max-iterations"}});
+  validate_flags([&o] { o.validate(); }, c.parameters.flag_names());
 
   OutputSet outputs({c.output, c.cover, c.surface, c.mesh_out}, {c.ground, c.objects});
   const terrain::HeightField ground = terrain::read_raster(c.ground);
@@ -101,8 +105,7 @@ void add_snowfall_command(CLI::App& root) {
       add_subcommand(group, "fall",
                      "snowfall on a DEM and objects: occlusion by depth maps, jittered directions, "
                      "stabilisation (paper 003)",
-                     [c] { run_snowfall(*c); });
-  snow::SnowfallOptions& o = c->options;
+                     [c](const CLI::App& self) { run_snowfall(*c, self); });
   sub->add_option("ground", c->ground, "ground heights, a metric GeoTIFF (see drift import)")
       ->required();
   sub->add_option("--objects", c->objects, "TOML file of [[objects]] (mesh, position, ...)");
@@ -113,37 +116,15 @@ void add_snowfall_command(CLI::App& root) {
   sub->add_option("--mesh-out", c->mesh_out,
                   "PLY of the objects raised by their snow, with per-vertex snow_depth, "
                   "snow_probability, snow_coverage, snow_adhesion");
-  sub->add_option("--direction", c->direction,
-                  "AZ,EL where the snow comes from (degrees, like a sun position; 0,90 = "
-                  "straight down)")
+  sub->add_option("--direction", c->direction, direction_help())
       ->expected(2)
       ->delimiter(',')
-      ->capture_default_str();
-  sub->add_option("--spread", o.spread_deg, "std. deviation of the direction jitter (deg)")
-      ->capture_default_str();
-  sub->add_option("--maps", o.maps, "number of jittered depth maps")->capture_default_str();
-  sub->add_option("--rate", o.rate_m_per_h, "fresh snow on open flat ground (m per hour)")
-      ->capture_default_str();
-  sub->add_option("--hours", o.hours, "duration of the snowfall (h)")->capture_default_str();
-  sub->add_option("--repose", o.repose_deg, "angle of repose of snow (deg)")->capture_default_str();
-  sub->add_option("--mesh-edge", o.mesh_max_edge,
-                  "split object edges longer than this (m); 0 keeps the meshes")
-      ->capture_default_str();
-  sub->add_option("--object-texel", o.occlusion.object_texel,
-                  "texel of the object depth maps (m); 0 = automatic")
       ->capture_default_str();
   sub->add_option("--occlusion", c->occlusion,
                   "how the ground occludes: sweep (horizon sweep) or opengl (OSMesa depth map)")
       ->check(CLI::IsMember({"sweep", "opengl"}))
       ->capture_default_str();
-  sub->add_option("--thin-depth", o.coverage.thin_depth,
-                  "snow thinner than this (m) shows as scattered flakes")
-      ->capture_default_str();
-  sub->add_option("--adhesion", o.coverage.adhesion,
-                  "coverage of flakes stuck on walls facing the snow (0..1)")
-      ->capture_default_str();
-  sub->add_option("--max-iterations", o.max_iterations, "limit on stabilisation passes")
-      ->capture_default_str();
+  c->parameters.add_to(*sub);
   add_seed_option(*sub, c->seed);
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pipeline/cli.h"
+#include "pipeline/parameter_flags.h"
 #include "pipeline/progress_bar.h"
 #include "pipeline/soil_scenario_file.h"
 #include "terrain/error.h"
@@ -16,6 +17,7 @@
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
+#include "terrain/soil/soil_parameters.h"
 #include "terrain/soil/surface.h"
 #include "terrain/soil/top_surface.h"
 
@@ -29,7 +31,9 @@ struct SoilCommand {
   std::string scenario, output, vdb, surface, collision, frames, soil_type, terrain, ground;
   int ground_margin = 32;
   int steps = -1, frame_every = 10;
-  double phi = NAN, cohesion = NAN, gamma = NAN, moisture = NAN;
+  // --phi, --cohesion, --gamma, --moisture (terrain/soil/soil_parameters.h):
+  // those given override the scenario's soil.
+  ParameterFlags<soil::SoilOptions> parameters{soil::soil_parameters()};
   bool no_ridge_fix = false;
 };
 
@@ -47,19 +51,12 @@ void check_mesh_path(const std::string& path, const char* flag) {
 }
 
 // The command line's values over the scenario's own.
-void apply_overrides(const SoilCommand& c, soil::SoilScenario& sc) {
+// A preset (--soil) first, then the single values over it.
+void apply_overrides(const SoilCommand& c, const CLI::App& sub, soil::SoilScenario& sc) {
   if (c.steps >= 0) sc.steps = c.steps;
-  soil::SoilType& t = sc.options.soil;
-  if (!c.soil_type.empty()) t = soil::soil_preset(c.soil_type);
-  if (!std::isnan(c.phi)) t.phi_deg = c.phi;
-  if (!std::isnan(c.cohesion)) t.cohesion = c.cohesion;
-  if (!std::isnan(c.gamma)) t.gamma = c.gamma;
-  if (!std::isnan(c.moisture)) t.moisture = c.moisture;
-  try {
-    soil::validate(sc.options);
-  } catch (const Error& e) {
-    usage_error(e.what());
-  }
+  if (!c.soil_type.empty()) sc.options.soil = soil::soil_preset(c.soil_type);
+  c.parameters.apply(sub, sc.options);
+  validate_flags([&sc] { sc.options.validate(); }, c.parameters.flag_names());
 }
 
 // Writes every product (into the OutputSet's temporary files); returns what to
@@ -99,12 +96,12 @@ std::vector<std::string> write_products(const SoilCommand& c, const soil::SoilSc
   return wrote;
 }
 
-void run_soil(SoilCommand& c) {
+void run_soil(SoilCommand& c, const CLI::App& sub) {
   check_mesh_path(c.output, "-o");
   if (!c.collision.empty()) check_mesh_path(c.collision, "--collision");
   if (c.frame_every < 1) usage_error("--frame-every must be at least 1");
   soil::SoilScenario sc = read_soil_scenario(c.scenario, c.terrain);
-  apply_overrides(c, sc);
+  apply_overrides(c, sub, sc);
   if (!c.ground.empty()) {  // --ground's raster, checked before the simulation
     const std::uint64_t w = sc.shape.nx + 2ull * c.ground_margin,
                         h = sc.shape.ny + 2ull * c.ground_margin;
@@ -158,21 +155,17 @@ void add_soil_command(CLI::App& root) {
   CLI::App* sub = add_subcommand(root, "soil",
                                  "voxel soil that pours, slides, piles and is pushed, dug and "
                                  "lifted; writes its surface (paper 004; docs/soil.md)",
-                                 [c] { run_soil(*c); });
+                                 [c](const CLI::App& self) { run_soil(*c, self); });
   sub->add_option("scenario", c->scenario, "scenario TOML (see data/soil/, docs/soil.md)")
       ->required();
   sub->add_option("-o,--output", c->output, "soil surface mesh, .ply or .obj (metres)")->required();
   sub->add_option("--terrain", c->terrain,
                   "metric GeoTIFF replacing the dem the scenario's [terrain] names");
   sub->add_option("--steps", c->steps, "time steps (overrides the scenario's)")
-      ->check(CLI::Range(0, 10000000));  // as the scenario's [simulation] steps
+      ->check(CLI::Range(0, soil::SoilScenario::kMaxSteps));
   sub->add_option("--soil", c->soil_type, "soil type of the thesis's table 6")
       ->check(CLI::IsMember({"dry_sand", "sandy_loam", "loam"}));
-  sub->add_option("--phi", c->phi, "angle of internal friction (degrees, [0, 60))");
-  sub->add_option("--cohesion", c->cohesion, "cohesion c (t/m, [0, 20])");
-  sub->add_option("--gamma", c->gamma, "specific weight (t/m^2, (0, 10])");
-  sub->add_option("--moisture", c->moisture,
-                  "moisture (0 dry .. 1 damp): adds cohesion, wets the surface");
+  c->parameters.add_to(*sub);
   sub->add_option("--frames", c->frames, "directory for a surface mesh every --frame-every steps");
   sub->add_option("--frame-every", c->frame_every, "steps between frames")->capture_default_str();
   sub->add_option("--vdb", c->vdb, "OpenVDB file of the density and collision grids");

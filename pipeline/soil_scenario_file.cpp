@@ -6,6 +6,7 @@
 #include "pipeline/toml_section.h"
 #include "terrain/bilinear.h"
 #include "terrain/raster_io.h"
+#include "terrain/soil/soil_parameters.h"
 
 namespace drift::pipeline {
 
@@ -83,11 +84,7 @@ void read_soil(const toml::table& root, const std::filesystem::path& file, soil:
   } catch (const Error& e) {
     s.invalid("type", std::string("is unknown: ") + e.what());
   }
-  soil::SoilType& t = sc.options.soil;
-  t.phi_deg = s.number("phi", t.phi_deg, 0, 59.9);
-  t.cohesion = s.number("cohesion", t.cohesion, 0, 20);
-  t.gamma = s.number("gamma", t.gamma, 0.01, 10);
-  t.moisture = s.number("moisture", t.moisture, 0, 1);
+  s.parameters(soil::soil_parameters(), sc.options);  // phi, cohesion, gamma, moisture
   s.finish();
 }
 
@@ -95,11 +92,8 @@ void read_simulation(const toml::table& root, const std::filesystem::path& file,
                      soil::SoilScenario& sc) {
   Section s(root["simulation"].as_table(), "simulation", file, kDoc);
   soil::SoilOptions& o = sc.options;
-  sc.steps = s.integer("steps", sc.steps, 0, 10000000);
-  o.dt = s.number("dt", o.dt, 1e-5, 1);
-  o.gravity = s.number("gravity", o.gravity, 0, 100);
-  o.propagation_iterations = s.integer("propagation_iterations", o.propagation_iterations, 0, 64);
-  o.overflow_passes = s.integer("overflow_passes", o.overflow_passes, 0, 64);
+  sc.steps = s.integer("steps", sc.steps, 0, soil::SoilScenario::kMaxSteps);
+  s.parameters(soil::soil_parameters(), o);  // dt, gravity, propagation_iterations, ...
   const std::string overflow = s.string("overflow").value_or("up");
   if (overflow == "up")
     o.overflow = soil::OverflowHeuristic::Up;

@@ -20,6 +20,7 @@
 
 #include "terrain/error.h"
 #include "terrain/input_path.h"
+#include "terrain/parameter.h"
 
 namespace drift::pipeline {
 
@@ -160,6 +161,18 @@ class Section {
     return out;
   }
 
+  // Reads the keys of a parameter table (terrain/parameter.h) that belong to
+  // this table (a row's key "[name] key") into `o`, where given: numbers,
+  // whole for integer rows, in each row's range.
+  template <class Options>
+  void parameters(const std::vector<terrain::Parameter<Options>>& table, Options& o) {
+    const std::string prefix = "[" + name_ + "] ";
+    for (const terrain::Parameter<Options>& p : table) {
+      const std::string key(p.key);
+      if (key.rfind(prefix, 0) == 0) parameter(p, key.substr(prefix.size()), o);
+    }
+  }
+
   // Reports a bad value of `key` (read before) with the file and line.
   [[noreturn]] void invalid(const char* key, const std::string& what) const {
     const toml::node* node = table_ ? table_->get(key) : nullptr;
@@ -186,6 +199,16 @@ class Section {
   }
 
  private:
+  template <class Options>
+  void parameter(const terrain::Parameter<Options>& p, const std::string& key, Options& o) {
+    const toml::node* node = take(key.c_str());
+    if (!node) return;
+    const std::optional<double> v = node->value<double>();
+    if (!v || node->is_boolean()) fail(key.c_str(), *node, "must be a number");
+    if (p.integer && !node->is_integer()) fail(key.c_str(), *node, "must be an integer");
+    if (!p.admits(*v)) fail(key.c_str(), *node, "is " + fmt(*v) + "; it must lie in " + p.range());
+    p.set(o, *v);
+  }
   const toml::node* take(const char* key) {
     used_.insert(key);
     return table_ ? table_->get(key) : nullptr;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "snow/snowfall_directions.h"
+#include "snow/snowfall_parameters.h"
 #include "snow/stabilise_grid.h"
 #include "snow/stabilise_mesh.h"
 #include "terrain/error.h"
@@ -17,11 +18,6 @@
 namespace drift::snow {
 
 namespace {
-
-// The one idiom of options structs (terrain/parameter.h).
-void check(bool ok, const char* field, double value, const char* range) {
-  terrain::require_field(ok, field, value, range);
-}
 
 // Snow on one object: the polygon variant.
 struct ObjectSnow {
@@ -156,29 +152,9 @@ void write_snowy_objects(const SnowScene& scene, const std::vector<ObjectSnow>& 
 
 }  // namespace
 
+// The ranges live in one table (snow/snowfall_parameters.cpp).
 void SnowfallOptions::validate() const {
-  check(azimuth_deg >= 0 && azimuth_deg <= 360, "azimuth_deg", azimuth_deg, "[0, 360]");
-  check(elevation_deg > 0 && elevation_deg <= 90, "elevation_deg", elevation_deg, "(0, 90]");
-  check(spread_deg >= 0 && spread_deg <= 30, "spread_deg", spread_deg, "[0, 30]");
-  check(maps >= 1 && maps <= 1024, "maps", maps, "[1, 1024]");
-  check(rate_m_per_h > 0 && rate_m_per_h <= 10, "rate_m_per_h", rate_m_per_h, "(0, 10] m/h");
-  check(hours > 0 && hours <= 1e4, "hours", hours, "(0, 10000]");
-  check(repose_deg > 0 && repose_deg < 90, "repose_deg", repose_deg, "(0, 90)");
-  check(mesh_max_edge >= 0 && std::isfinite(mesh_max_edge), "mesh_max_edge", mesh_max_edge,
-        "[0, inf) m (0 keeps the meshes)");
-  check(occlusion.object_texel >= 0 && std::isfinite(occlusion.object_texel),
-        "occlusion.object_texel", occlusion.object_texel, "[0, inf) m (0 = automatic)");
-  check(coverage.thin_depth > 0 && coverage.thin_depth <= 10, "coverage.thin_depth",
-        coverage.thin_depth, "(0, 10] m");
-  check(coverage.adhesion >= 0 && coverage.adhesion <= 1, "coverage.adhesion", coverage.adhesion,
-        "[0, 1]");
-  check(coverage.adhesion_min_slope >= 0 && coverage.adhesion_min_slope < 90,
-        "coverage.adhesion_min_slope", coverage.adhesion_min_slope, "[0, 90)");
-  check(coverage.adhesion_depth > 0, "coverage.adhesion_depth", coverage.adhesion_depth,
-        "(0, inf) m");
-  check(tolerance > 0, "tolerance", tolerance, "(0, inf) m");
-  check(ground_tolerance > 0, "ground_tolerance", ground_tolerance, "(0, inf) m");
-  check(max_iterations >= 1, "max_iterations", max_iterations, "[1, inf)");
+  for (const SnowfallParameter& p : snowfall_parameters()) p.require(*this);
 }
 
 SnowfallResult simulate_snowfall(const terrain::HeightField& ground,

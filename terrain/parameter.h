@@ -42,47 +42,70 @@ inline void require_field(bool ok, const std::string& field, double value,
   if (!ok) throw ParameterError(field, "is " + format_value(value) + "; it must lie in " + range);
 }
 
-// A range as messages, help and docs give it: "[lo, hi]", "(lo, hi]" with an
-// open lower end, "inf" for an unbounded upper one, then the unit if any.
-inline std::string range_text(double lo, double hi, bool lo_open = false, const char* unit = "") {
+// Which ends of a range belong to it: [lo, hi], (lo, hi], [lo, hi) or (lo, hi).
+enum class Ends { Closed, OpenLow, OpenHigh, Open };
+inline bool low_open(Ends e) { return e == Ends::OpenLow || e == Ends::Open; }
+inline bool high_open(Ends e) { return e == Ends::OpenHigh || e == Ends::Open; }
+
+// A range as messages, help and docs give it: "[lo, hi]", "(lo, hi)" with open
+// ends, "inf)" for an unbounded upper one, then the unit if any.
+inline std::string range_text(double lo, double hi, Ends ends = Ends::Closed,
+                              const char* unit = "") {
   // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
-  std::string range = lo_open ? "(" : "[";
+  std::string range = low_open(ends) ? "(" : "[";
   range += format_value(lo);
   range += ", ";
-  range += std::isinf(hi) ? std::string("inf)") : format_value(hi) + "]";
+  if (std::isinf(hi))
+    range += "inf)";
+  else
+    (range += format_value(hi)) += high_open(ends) ? ")" : "]";
   if (*unit) (range += " ") += unit;
   return range;
+}
+
+// Whether `v` is finite and lies in the range (NaN fails every comparison).
+inline bool in_range(double v, double lo, double hi, Ends ends) {
+  return std::isfinite(v) && (low_open(ends) ? v > lo : v >= lo) &&
+         (high_open(ends) ? v < hi : v <= hi);
 }
 
 // The closed range [lo, hi] (finite values only).
 inline void require_in(const std::string& field, double value, double lo, double hi,
                        const char* unit = "") {
   require_field(std::isfinite(value) && value >= lo && value <= hi, field, value,
-                range_text(lo, hi, false, unit));
+                range_text(lo, hi, Ends::Closed, unit));
 }
 
 // One row of an options struct's parameter table (Mitsuba's parameter tables
 // are the model): the field as library errors name it, the command line's
-// flag, the range, the unit and what it means. The struct's validate(), the
-// command line's flags and help, and the docs' table all come from the rows;
-// the defaults are the struct's own (Options{}).
+// flag and the file's key, the range, the unit and what it means. The struct's validate(), the
+// command line's flags and help (pipeline/parameter_flags.h), and the docs'
+// table all come from the rows; the defaults are the struct's own (Options{}).
 template <class Options>
 struct Parameter {
   const char* field;
+  // The command line's flag: "--maps"; a part of a flag that takes several
+  // values: "--direction AZ"; "" for a field the command line does not set.
   const char* flag;
-  double lo, hi;  // hi may be +inf
-  bool lo_open;   // (lo, hi] rather than [lo, hi]
-  bool integer;   // a whole number
+  double lo, hi;  // hi may be +inf (an integer field's hi must fit its type)
+  Ends ends;
+  bool integer;  // a whole number
   const char* unit;
   const char* meaning;
   double (*get)(const Options&);
   void (*set)(Options&, double);
+  // The key in a scene or scenario file, with its table: "[soil] phi"; "" if none.
+  const char* key = "";
 
-  std::string range() const { return range_text(lo, hi, lo_open, unit); }
-  // Finite, in range and, for an integer, whole (NaN fails every comparison).
+  std::string range() const { return range_text(lo, hi, ends, unit); }
+  // Finite, in range and, for an integer, whole.
   bool admits(double v) const {
-    return std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi &&
-           (!integer || v == std::floor(v));
+    return in_range(v, lo, hi, ends) && (!integer || v == std::floor(v));
+  }
+  // A flag of its own (not "" and not a part of a flag with several values).
+  bool has_own_flag() const {
+    const std::string f = flag;
+    return f.rfind("--", 0) == 0 && f.find(' ') == std::string::npos;
   }
   // Throws ParameterError naming the field unless `o`'s value is admitted.
   void require(const Options& o) const { require_field(admits(get(o)), field, get(o), range()); }

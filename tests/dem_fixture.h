@@ -18,4 +18,13 @@ terrain::HeightField dem_from(int n, double cell, double offset, F f) {
   return dem;
 }
 
+// A flat n x n ground at height z, `cell` metres a cell, placed at UTM-sized
+// coordinates (NW corner at 600000 E, 4000000 N) as a user's ground would be.
+inline terrain::HeightField flat_utm_ground(int n, float z, double cell) {
+  terrain::HeightField g(n, n, z, terrain::local_georeference(cell));
+  g.geo().geotransform[0] = 600000.0;
+  g.geo().geotransform[3] = 4000000.0;
+  return g;
+}
+
 }  // namespace drift::testing

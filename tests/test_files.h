@@ -1,10 +1,12 @@
 // Files for the tests that run drift on disk: a fresh folder per test case
-// (inside the process's private TMPDIR, tests/test_main.cpp) and whole-file
-// reads and writes.
+// (inside the process's private TMPDIR, tests/test_main.cpp), whole-file
+// reads and writes, and running the drift binary.
 #pragma once
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -30,5 +32,18 @@ inline std::string slurp(const std::filesystem::path& p) {
 inline void put(const std::filesystem::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
 }
+
+// Runs the drift binary (DRIFT_EXECUTABLE) with `args` (shell words), its
+// output and errors into `dir`/log.txt (read by drift_log). Returns the exit
+// status, or 128 + the signal that ended it.
+inline int run_drift(const std::string& args, const std::filesystem::path& dir) {
+  const std::string cmd =
+      std::string(DRIFT_EXECUTABLE) + " " + args + " > " + (dir / "log.txt").string() + " 2>&1";
+  const int raw = std::system(cmd.c_str());
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+}
+
+// What the last run_drift in `dir` printed.
+inline std::string drift_log(const std::filesystem::path& dir) { return slurp(dir / "log.txt"); }
 
 }  // namespace drift::testing

@@ -63,31 +63,37 @@ namespace {
 
 float room(const SoilState& s, std::size_t i) { return std::max(0.0f, 1.0f - s.psi[i]); }
 
+// Calls f(c), c the index of a column's bottom voxel, for every column that
+// `dirty` marks (every column when it is null); parallel over rows y.
+template <class F>
+void for_each_dirty_column(const terrain::Grid3Shape& g, const ColumnMask* dirty, F&& f) {
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x)
+      if (!dirty || (*dirty)[static_cast<std::size_t>(y) * g.nx + x]) f(g.column(x, y));
+  });
+}
+
 // One Jacobi pass of "up one voxel", in place per column: the excess of
 // voxel z is computed from the values before the pass (z is read before it is
 // written, and the carry holds what z - 1 sent up).
 void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
-  tbb::parallel_for(0, g.ny, [&](int y) {
-    for (int x = 0; x < g.nx; ++x) {
-      if (dirty && !(*dirty)[static_cast<std::size_t>(y) * g.nx + x]) continue;
-      const std::size_t c = g.column(x, y);
-      float carry = 0, cu[3] = {0, 0, 0};
-      for (int z = 0; z < g.nz; ++z) {
-        const std::size_t i = c + z;
-        const float r = s.rho[i];
-        const float ex = z + 1 < g.nz ? std::max(0.0f, r - room(s, i)) : 0.0f;
-        if (ex == 0 && carry == 0) continue;
-        const float u[3] = {s.ux[i], s.uy[i], s.uz[i]};
-        const float kept = r - ex, now = kept + carry;
-        const float inv = detail::weight_inverse(now);
-        s.ux[i] = (kept * u[0] + carry * cu[0]) * inv;
-        s.uy[i] = (kept * u[1] + carry * cu[1]) * inv;
-        s.uz[i] = (kept * u[2] + carry * cu[2]) * inv;
-        s.rho[i] = now;
-        carry = ex;
-        std::copy(u, u + 3, cu);
-      }
+  for_each_dirty_column(g, dirty, [&](std::size_t c) {
+    float carry = 0, cu[3] = {0, 0, 0};
+    for (int z = 0; z < g.nz; ++z) {
+      const std::size_t i = c + z;
+      const float r = s.rho[i];
+      const float ex = z + 1 < g.nz ? std::max(0.0f, r - room(s, i)) : 0.0f;
+      if (ex == 0 && carry == 0) continue;
+      const float u[3] = {s.ux[i], s.uy[i], s.uz[i]};
+      const float kept = r - ex, now = kept + carry;
+      const float inv = detail::weight_inverse(now);
+      s.ux[i] = (kept * u[0] + carry * cu[0]) * inv;
+      s.uy[i] = (kept * u[1] + carry * cu[1]) * inv;
+      s.uz[i] = (kept * u[2] + carry * cu[2]) * inv;
+      s.rho[i] = now;
+      carry = ex;
+      std::copy(u, u + 3, cu);
     }
   });
 }
@@ -173,25 +179,21 @@ void resolve_overflow(SoilState& s, OverflowHeuristic h, int passes, const Colum
 
 void settle_overflow(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
-  tbb::parallel_for(0, g.ny, [&](int y) {
-    for (int x = 0; x < g.nx; ++x) {
-      if (dirty && !(*dirty)[static_cast<std::size_t>(y) * g.nx + x]) continue;
-      const std::size_t c = g.column(x, y);
-      float carry = 0;
-      for (int z = 0; z < g.nz; ++z) {
-        float& r = s.rho[c + z];
-        r += carry;
-        carry = std::max(0.0f, r - room(s, c + z));
-        r -= carry;
-      }
-      for (int z = g.nz - 1; z >= 0 && carry > 0; --z) {
-        float& r = s.rho[c + z];
-        const float take = std::min(carry, std::max(0.0f, room(s, c + z) - r));
-        r += take;
-        carry -= take;
-      }
-      if (carry > 0) s.rho[c + g.nz - 1] += carry;  // a column full to the top: keep the mass
+  for_each_dirty_column(g, dirty, [&](std::size_t c) {
+    float carry = 0;
+    for (int z = 0; z < g.nz; ++z) {
+      float& r = s.rho[c + z];
+      r += carry;
+      carry = std::max(0.0f, r - room(s, c + z));
+      r -= carry;
     }
+    for (int z = g.nz - 1; z >= 0 && carry > 0; --z) {
+      float& r = s.rho[c + z];
+      const float take = std::min(carry, std::max(0.0f, room(s, c + z) - r));
+      r += take;
+      carry -= take;
+    }
+    if (carry > 0) s.rho[c + g.nz - 1] += carry;  // a column full to the top: keep the mass
   });
 }
 

@@ -194,8 +194,9 @@ VoxelBox voxel_box(const std::vector<Primitive>& prims, const Vector3d& pos,
   return box;
 }
 
-void add_coverage(const std::vector<Primitive>& prims, const Vector3d& pos,
-                  const terrain::Grid3Shape& shape, std::vector<float>& field) {
+void for_each_covered_voxel(const std::vector<Primitive>& prims, const Vector3d& pos,
+                            const terrain::Grid3Shape& shape,
+                            const std::function<void(std::size_t, float)>& fill) {
   const VoxelBox box = voxel_box(prims, pos, shape);
   if (box.empty()) return;
   const double h = shape.voxel_size;
@@ -204,10 +205,15 @@ void add_coverage(const std::vector<Primitive>& prims, const Vector3d& pos,
       for (int z = box.lo.z(); z < box.hi.z(); ++z) {
         const Vector3d lo = shape.origin + h * Vector3d(x, y, z);
         const double c = coverage(prims, pos, lo, lo + Vector3d::Constant(h));
-        if (c <= 0.0) continue;
-        float& v = field[shape.index(x, y, z)];
-        v = std::min(1.0f, v + static_cast<float>(c));
+        if (c > 0.0) fill(shape.index(x, y, z), static_cast<float>(c));
       }
+  });
+}
+
+void add_coverage(const std::vector<Primitive>& prims, const Vector3d& pos,
+                  const terrain::Grid3Shape& shape, std::vector<float>& field) {
+  for_each_covered_voxel(prims, pos, shape, [&field](std::size_t i, float c) {
+    field[i] = std::min(1.0f, field[i] + c);
   });
 }
 

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -66,6 +68,13 @@ struct VoxelBox {
 };
 VoxelBox voxel_box(const std::vector<Primitive>& primitives, const Eigen::Vector3d& position,
                    const terrain::Grid3Shape& shape);
+
+// Calls fill(i, c) for each voxel i (an index of `shape`) in the voxel box of
+// `primitives` at `position` that they cover by a fraction c > 0. Parallel
+// over rows y: `fill` may touch voxel i only.
+void for_each_covered_voxel(const std::vector<Primitive>& primitives,
+                            const Eigen::Vector3d& position, const terrain::Grid3Shape& shape,
+                            const std::function<void(std::size_t, float)>& fill);
 
 // Adds the coverage of the object at `position` to `field` (saturating at
 // 1) over its voxel box. Parallel over rows; the same bits on any thread count.

@@ -96,7 +96,7 @@ SoilSimulation make_simulation(const SoilScenario& sc) {
                 " must be a positive number of metres");
   if (!g.origin.allFinite()) throw Error("scenario '" + sc.name + "': grid origin is not finite");
   if (sc.steps < 0) throw Error("scenario '" + sc.name + "': steps must be >= 0");
-  validate(sc.options);
+  sc.options.validate();
   SoilState state(g);  // checks sizes and memory
   if (sc.terrain.kind == TerrainSource::Kind::HeightField)
     voxelise_heights(sc.terrain.heights, state);

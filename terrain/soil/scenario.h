@@ -41,7 +41,8 @@ struct SoilScenario {
   terrain::Grid3Shape shape{64, 64, 64, 0.1, {0, 0, 0}};
   terrain::GeoReference geo;  // of the top-surface raster; empty CRS = local
   SoilOptions options;
-  int steps = 600;
+  int steps = 600;  // [0, kMaxSteps]
+  static constexpr int kMaxSteps = 10000000;
   std::vector<SoilBody> soil;
   std::vector<RigidObject> bodies;
   TerrainSource terrain;

@@ -1,12 +1,11 @@
 #include "terrain/soil/simulation.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include "terrain/error.h"
 #include "terrain/soil/deformation.h"
+#include "terrain/soil/soil_parameters.h"
 
 namespace drift::soil {
 
@@ -21,26 +20,14 @@ void mark_box(const VoxelBox& box, ColumnMask& dirty, const terrain::Grid3Shape&
 
 }  // namespace
 
-void validate(const SoilOptions& o) {
-  auto check = [](bool ok, const char* name, double v, const char* range) {
-    if (!ok)
-      throw Error(std::string("soil option ") + name + " is " + std::to_string(v) +
-                  "; it must lie in " + range);
-  };
-  check(std::isfinite(o.dt) && o.dt > 0 && o.dt <= 1, "dt (s)", o.dt, "(0, 1]");
-  check(std::isfinite(o.gravity) && o.gravity >= 0 && o.gravity <= 100, "gravity (m/s^2)",
-        o.gravity, "[0, 100]");
-  check(o.propagation_iterations >= 0 && o.propagation_iterations <= 64, "propagation_iterations",
-        o.propagation_iterations, "[0, 64]");
-  check(o.overflow_passes >= 0 && o.overflow_passes <= 64, "overflow_passes", o.overflow_passes,
-        "[0, 64]");
-  validate(o.soil);
+void SoilOptions::validate() const {
+  for (const SoilParameter& p : soil_parameters()) p.require(*this);
 }
 
 SoilSimulation::SoilSimulation(SoilState state, std::vector<RigidObject> bodies,
                                const SoilOptions& options)
     : state_(std::move(state)), options_(options), slippage_(state_.shape) {
-  validate(options_);
+  options_.validate();
   for (RigidObject& b : bodies) {
     validate(b, "body");
     if (b.moves()) {
@@ -88,19 +75,9 @@ void SoilSimulation::step() {
 }
 
 void add_soil(SoilState& s, const std::vector<Primitive>& prims, const Eigen::Vector3d& pos) {
-  const terrain::Grid3Shape& g = s.shape;
-  const VoxelBox box = voxel_box(prims, pos, g);
-  if (box.empty()) return;
-  const double h = g.voxel_size;
-  tbb::parallel_for(box.lo.y(), box.hi.y(), [&](int y) {
-    for (int x = box.lo.x(); x < box.hi.x(); ++x)
-      for (int z = box.lo.z(); z < box.hi.z(); ++z) {
-        const Eigen::Vector3d lo = g.origin + h * Eigen::Vector3d(x, y, z);
-        const double c = coverage(prims, pos, lo, lo + Eigen::Vector3d::Constant(h));
-        const std::size_t i = g.index(x, y, z);
-        const float room = std::max(0.0f, 1.0f - std::max(s.psi_static[i], s.psi[i]) - s.rho[i]);
-        s.rho[i] += std::min(room, static_cast<float>(c));
-      }
+  for_each_covered_voxel(prims, pos, s.shape, [&s](std::size_t i, float c) {
+    const float room = std::max(0.0f, 1.0f - std::max(s.psi_static[i], s.psi[i]) - s.rho[i]);
+    s.rho[i] += std::min(room, c);
   });
 }
 

@@ -6,17 +6,11 @@
 //   gravity (eq. 29)
 //   slippage on the multi-level heightfield (sec. 3.2.3, Li & Moshell)
 //
-// Options (defaults, units, ranges):
-// | option                 | default   | unit  | range / meaning                          |
-// |------------------------|-----------|-------|------------------------------------------|
-// | dt                     | 1/60      | s     | (0, 1]; soil moves at most 1 voxel a step |
-// | gravity                | 9.81      | m/s^2 | [0, 100]                                 |
-// | propagation_iterations | 4         |       | [0, 64], the thesis's alpha              |
-// | overflow               | Up        |       | fig. 30's heuristic                      |
-// | overflow_passes        | 4         |       | [0, 64]                                  |
-// | settle                 | true      |       | carry leftover overflow up (eq. 17 holds)|
-// | slippage               | true      |       | Li & Moshell slippage on                 |
-// | soil                   | dry sand  |       | see soil_type.h                          |
+// Options: the numeric ones (dt, gravity, propagation_iterations, overflow_passes
+// and the soil's phi, c, gamma, moisture) with their defaults, units and ranges
+// are in one table, terrain/soil/soil_parameters.cpp; besides them, overflow
+// (fig. 30's heuristic), settle (carry leftover overflow up, so that eq. 17
+// holds) and slippage (Li & Moshell slippage on).
 #pragma once
 
 #include <memory>
@@ -39,10 +33,11 @@ struct SoilOptions {
   bool settle = true;
   bool slippage = true;
   SoilType soil;
-};
 
-// Throws drift::Error naming the option, its value and the range.
-void validate(const SoilOptions& options);
+  // Throws terrain::ParameterError naming the field, its value and the range
+  // (terrain/soil/soil_parameters.cpp).
+  void validate() const;
+};
 
 class SoilSimulation {
  public:

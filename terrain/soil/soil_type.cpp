@@ -1,7 +1,5 @@
 #include "terrain/soil/soil_type.h"
 
-#include <cmath>
-
 #include "terrain/error.h"
 
 namespace drift::soil {
@@ -15,9 +13,6 @@ const SoilType kPresets[] = {
     {"loam", 20.0, 0.5, 2.0, 0.0},
 };
 
-void check(bool ok, const std::string& field, double v, const std::string& range) {
-  if (!ok) throw Error("soil " + field + " is " + std::to_string(v) + "; it must lie in " + range);
-}
 }  // namespace
 
 SoilType soil_preset(const std::string& name) {
@@ -27,16 +22,5 @@ SoilType soil_preset(const std::string& name) {
 }
 
 std::vector<std::string> soil_preset_names() { return {"dry_sand", "sandy_loam", "loam"}; }
-
-void validate(const SoilType& s) {
-  check(std::isfinite(s.phi_deg) && s.phi_deg >= 0 && s.phi_deg < 60, "phi (degrees)", s.phi_deg,
-        "[0, 60)");
-  check(std::isfinite(s.cohesion) && s.cohesion >= 0 && s.cohesion <= 20, "cohesion c (t/m)",
-        s.cohesion, "[0, 20]");
-  check(std::isfinite(s.gamma) && s.gamma > 0 && s.gamma <= 10, "specific weight gamma (t/m^2)",
-        s.gamma, "(0, 10]");
-  check(std::isfinite(s.moisture) && s.moisture >= 0 && s.moisture <= 1, "moisture", s.moisture,
-        "[0, 1]");
-}
 
 }  // namespace drift::soil

@@ -25,10 +25,11 @@ namespace drift::soil {
 
 struct SoilType {
   std::string name = "dry_sand";
-  double phi_deg = 30.0;  // angle of internal friction, degrees, [0, 60)
-  double cohesion = 0.0;  // c, t/m, [0, 20]
-  double gamma = 1.95;    // specific weight, t/m^2, (0, 10]
-  double moisture = 0.0;  // [0, 1]
+  // Ranges: terrain/soil/soil_parameters.cpp.
+  double phi_deg = 30.0;  // angle of internal friction, degrees
+  double cohesion = 0.0;  // c, t/m
+  double gamma = 1.95;    // specific weight, t/m^2
+  double moisture = 0.0;  // 0 dry .. 1 wet
 
   // Apparent cohesion of moist sand, t/m at moisture 1 (about 3 kPa: the
   // order of the capillary cohesion of damp sand).
@@ -40,8 +41,5 @@ struct SoilType {
 // drift::Error listing the names for anything else.
 SoilType soil_preset(const std::string& name);
 std::vector<std::string> soil_preset_names();
-
-// Throws drift::Error naming the field, the value and the valid range.
-void validate(const SoilType& soil);
 
 }  // namespace drift::soil

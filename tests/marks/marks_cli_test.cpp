@@ -8,25 +8,19 @@
 #include <fstream>
 
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
+#include "tests/test_files.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path dir() {
-  const fs::path d = fs::temp_directory_path() / "drift_marks_cli" /
-                     ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path dir() { return drift::testing::test_dir("drift_marks_cli"); }
 
 // A flat metric ground (1 cm cells, UTM-sized coordinates) at 2000 m.
 fs::path ground(const fs::path& d) {
-  drift::terrain::HeightField g(64, 64, 2000.0f, drift::terrain::local_georeference(0.01));
-  g.geo().geotransform[0] = 600000.0;
-  g.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(g, d / "ground.tif");
+  drift::terrain::write_geotiff(drift::testing::flat_utm_ground(64, 2000.0f, 0.01),
+                                d / "ground.tif");
   return d / "ground.tif";
 }
 
@@ -43,15 +37,10 @@ std::string track(const std::string& keyframes_extra = "", const std::string& to
 }
 
 int run(const std::string& args, const fs::path& d) {
-  const std::string cmd =
-      std::string(DRIFT_EXECUTABLE) + " marks " + args + " > " + (d / "out.txt").string() + " 2>&1";
-  return WEXITSTATUS(std::system(cmd.c_str()));
+  return drift::testing::run_drift("marks " + args, d);
 }
 
-std::string output(const fs::path& d) {
-  std::ifstream f(d / "out.txt");
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
+std::string output(const fs::path& d) { return drift::testing::drift_log(d); }
 
 TEST(MarksCli, WritesTheMarkedGroundDisturbanceAndFrames) {
   const fs::path d = dir(), g = ground(d);

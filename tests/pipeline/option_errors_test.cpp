@@ -2,36 +2,18 @@
 // validate() and speaks of fields; the command line maps the field to its flag.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "snow/snow_cover.h"
 #include "snow/snowfall.h"
 #include "terrain/import.h"
 #include "terrain/parameter.h"
+#include "tests/test_files.h"
 
 namespace fs = std::filesystem;
 
 namespace {
-
-// Runs `drift ARGS`; returns the exit status and fills `err` with stderr.
-int run_drift(const std::string& args, std::string& err) {
-  const fs::path log =
-      fs::temp_directory_path() /
-      ("drift_option_errors_" +
-       std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + ".log");
-  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " " + args + " 2> " + log.string();
-  const int status = std::system(cmd.c_str());
-  std::ifstream f(log);
-  std::stringstream s;
-  s << f.rdbuf();
-  err = s.str();
-  fs::remove(log);
-  return WEXITSTATUS(status);
-}
 
 // The library's message names `field` and no flag.
 template <class Options>
@@ -60,15 +42,18 @@ TEST(OptionErrors, LibrarySpeaksOfFields) {
 }
 
 TEST(OptionErrors, CommandLineSpeaksOfFlags) {
-  const std::string out = (fs::temp_directory_path() / "drift_option_errors.tif").string();
-  std::string err;
-  EXPECT_EQ(run_drift("snow cover missing.tif -o " + out + " --region 40", err), 2);
-  EXPECT_NE(err.find("--region is 40; it must lie in (0, 32]"), std::string::npos) << err;
-  EXPECT_EQ(run_drift("snow fall missing.tif -o " + out + " --spread 40", err), 2);
-  EXPECT_NE(err.find("--spread is 40"), std::string::npos) << err;
-  EXPECT_EQ(run_drift("import missing.tif -o " + out + " --exaggerate 0", err), 1);
-  EXPECT_NE(err.find("--exaggerate is 0"), std::string::npos) << err;
-  EXPECT_EQ(run_drift("dunes --size 32 --L0 100 -o " + out, err), 1);
-  EXPECT_NE(err.find("--L0 is 100"), std::string::npos) << err;
+  using drift::testing::drift_log;
+  using drift::testing::run_drift;
+  const fs::path d = drift::testing::test_dir("drift_option_errors");
+  const std::string out = (d / "out.tif").string();
+  EXPECT_EQ(run_drift("snow cover missing.tif -o " + out + " --region 40", d), 2);
+  EXPECT_NE(drift_log(d).find("--region is 40; it must lie in (0, 32]"), std::string::npos)
+      << drift_log(d);
+  EXPECT_EQ(run_drift("snow fall missing.tif -o " + out + " --spread 40", d), 2);
+  EXPECT_NE(drift_log(d).find("--spread is 40"), std::string::npos) << drift_log(d);
+  EXPECT_EQ(run_drift("import missing.tif -o " + out + " --exaggerate 0", d), 1);
+  EXPECT_NE(drift_log(d).find("--exaggerate is 0"), std::string::npos) << drift_log(d);
+  EXPECT_EQ(run_drift("dunes --size 32 --L0 100 -o " + out, d), 1);
+  EXPECT_NE(drift_log(d).find("--L0 is 100"), std::string::npos) << drift_log(d);
   EXPECT_FALSE(fs::exists(out));
 }

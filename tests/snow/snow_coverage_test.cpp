@@ -68,7 +68,9 @@ TEST(SnowfallDirections, WeightsFollowTheGaussianOfTheirAngle) {
   // Directions nearer the mean weigh more.
   for (const auto& a : dirs)
     for (const auto& b : dirs)
-      if (a.angle_rad < b.angle_rad - 1e-9) EXPECT_GT(a.weight, b.weight);
+      if (a.angle_rad < b.angle_rad - 1e-9) {
+        EXPECT_GT(a.weight, b.weight);
+      }
 }
 
 }  // namespace

@@ -7,24 +7,19 @@
 #include <fstream>
 
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
+#include "tests/test_files.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path dir() {
-  const fs::path d = fs::temp_directory_path() / "drift_snowfall_cli" /
-                     ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  fs::create_directories(d);
-  return d;
-}
+fs::path dir() { return drift::testing::test_dir("drift_snowfall_cli"); }
 
 // A small metric ground (UTM 53N) and an objects file with a rock on it.
 fs::path setup(const fs::path& d) {
-  drift::terrain::HeightField g(40, 40, 1500.0f, drift::terrain::local_georeference(0.5));
-  g.geo().geotransform[0] = 600000.0;
-  g.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(g, d / "ground.tif");
+  drift::terrain::write_geotiff(drift::testing::flat_utm_ground(40, 1500.0f, 0.5),
+                                d / "ground.tif");
   std::ofstream(d / "objects.toml") << "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
                                        "/data/objects/rock_b.obj\"\nposition = [600010.0, "
                                        "3999990.0, 1500.0]\n";
@@ -32,15 +27,10 @@ fs::path setup(const fs::path& d) {
 }
 
 int run(const std::string& args, const fs::path& d) {
-  const std::string cmd = std::string(DRIFT_EXECUTABLE) + " snow fall " + args + " > " +
-                          (d / "out.txt").string() + " 2>&1";
-  return WEXITSTATUS(std::system(cmd.c_str()));
+  return drift::testing::run_drift("snow fall " + args, d);
 }
 
-std::string output(const fs::path& d) {
-  std::ifstream f(d / "out.txt");
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
+std::string output(const fs::path& d) { return drift::testing::drift_log(d); }
 
 TEST(SnowfallCli, WritesDepthCoverSurfaceAndMesh) {
   const fs::path d = dir(), ground = setup(d);
@@ -74,7 +64,8 @@ TEST(SnowfallCli, BadInputIsRefusedWithAMessageAndNoOutput) {
   EXPECT_NE(output(d).find("missing.tif"), std::string::npos) << output(d);
   EXPECT_EQ(run(ground.string() + out + " --direction 45", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --direction 45,0", d), 2);
-  EXPECT_NE(output(d).find("elevation"), std::string::npos) << output(d);
+  EXPECT_NE(output(d).find("--direction EL is 0; it must lie in (0, 90]"), std::string::npos)
+      << output(d);
   EXPECT_EQ(run(ground.string() + out + " --maps 0", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --spread -3", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --occlusion raytrace", d), 2);

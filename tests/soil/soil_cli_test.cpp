@@ -9,18 +9,13 @@
 
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
+#include "tests/test_files.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path dir() {
-  const fs::path d = fs::temp_directory_path() / "drift_soil_cli" /
-                     ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path dir() { return drift::testing::test_dir("drift_soil_cli"); }
 
 // A small column of soil on a block.
 const char* kScenario = R"([grid]
@@ -43,15 +38,10 @@ half_height = 0.4
 )";
 
 int run(const std::string& args, const fs::path& d) {
-  const std::string cmd =
-      std::string(DRIFT_EXECUTABLE) + " soil " + args + " > " + (d / "out.txt").string() + " 2>&1";
-  return WEXITSTATUS(std::system(cmd.c_str()));
+  return drift::testing::run_drift("soil " + args, d);
 }
 
-std::string output(const fs::path& d) {
-  std::ifstream f(d / "out.txt");
-  return std::string(std::istreambuf_iterator<char>(f), {});
-}
+std::string output(const fs::path& d) { return drift::testing::drift_log(d); }
 
 TEST(SoilCli, WritesMeshVdbSurfaceAndGround) {
   const fs::path d = dir();

@@ -106,12 +106,20 @@ float min_rho(const SoilState& s) { return *std::min_element(s.rho.begin(), s.rh
 
 namespace drift::soil::fixtures {
 
-SoilScenario push_scenario(int n, const SoilOptions& options) {
+namespace {
+// An empty scenario on an n^3 grid of 0.1 m voxels.
+SoilScenario cube_scenario(const char* name, int n, const SoilOptions& options) {
   SoilScenario sc;
-  sc.name = "push";
-  const double h = 0.1, L = n * h;
-  sc.shape = {n, n, n, h, {0, 0, 0}};
+  sc.name = name;
+  sc.shape = {n, n, n, 0.1, {0, 0, 0}};
   sc.options = options;
+  return sc;
+}
+}  // namespace
+
+SoilScenario push_scenario(int n, const SoilOptions& options) {
+  SoilScenario sc = cube_scenario("push", n, options);
+  const double L = n * sc.shape.voxel_size;
   sc.soil.push_back(
       {"ground",
        {{PrimitiveKind::Cuboid, {L / 2, L / 2, 0.125 * L}, {L / 2, L / 2, 0.125 * L}}},
@@ -126,11 +134,8 @@ SoilScenario push_scenario(int n, const SoilOptions& options) {
 }
 
 SoilScenario pour_block_scenario(int n, const SoilOptions& options) {
-  SoilScenario sc;
-  sc.name = "pour_block";
-  const double h = 0.1, L = n * h;
-  sc.shape = {n, n, n, h, {0, 0, 0}};
-  sc.options = options;
+  SoilScenario sc = cube_scenario("pour_block", n, options);
+  const double L = n * sc.shape.voxel_size;
   sc.bodies.push_back({"block",
                        {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.12 * L, 0.12 * L, 0.15 * L}}},
                        {{0.0, {0.5 * L, 0.5 * L, 0.15 * L}}}});
