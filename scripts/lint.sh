@@ -5,6 +5,12 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 mapfile -t sources < <(git ls-files '*.cpp' '*.h' | grep -E '^(terrain|render|snow|dunes|pipeline|tests)/')
 status=0
+# Reports in a private folder (never a predictable name in /tmp), removed on exit.
+reports=$(mktemp -d)
+trap 'rm -rf "$reports"' EXIT
+trap 'exit 129' HUP
+trap 'exit 130' INT
+trap 'exit 143' TERM
 echo "== clang-format"
 unformatted=$(clang-format --dry-run "${sources[@]}" 2>&1 | grep -c "warning:" || true)
 echo "clang-format: $unformatted places differ from .clang-format"
@@ -20,10 +26,10 @@ for entry in db:
     entry["command"] = re.sub(r"-Xclang -include-pch -Xclang \S+|-include \S+cmake_pch\.hxx|-Winvalid-pch", "", entry["command"])
 json.dump(db, open("build/tidy/compile_commands.json", "w"))
 PY
-clang-tidy -p build/tidy --quiet "${cpps[@]}" 2>/dev/null | grep -E "warning:|error:" | sort -u | tee /tmp/drift-tidy.txt
-[ -s /tmp/drift-tidy.txt ] && status=1
+clang-tidy -p build/tidy --quiet "${cpps[@]}" 2>/dev/null | grep -E "warning:|error:" | sort -u | tee "$reports/tidy.txt"
+[ -s "$reports/tidy.txt" ] && status=1
 echo "== cppcheck"
 cppcheck --quiet --std=c++20 --language=c++ --enable=warning,performance,portability \
-  --inline-suppr --suppress=missingIncludeSystem -I . "${cpps[@]}" 2>&1 | tee /tmp/drift-cppcheck.txt
-[ -s /tmp/drift-cppcheck.txt ] && status=1
+  --inline-suppr --suppress=missingIncludeSystem -I . "${cpps[@]}" 2>&1 | tee "$reports/cppcheck.txt"
+[ -s "$reports/cppcheck.txt" ] && status=1
 exit $status

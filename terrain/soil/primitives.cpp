@@ -49,8 +49,7 @@ Vector3d Primitive::upper() const {
     case PrimitiveKind::Sphere:
       return center + Vector3d::Constant(size.x());
     case PrimitiveKind::Cylinder:
-      return center + Vector3d(size.x(), size.x(), size.z());
-    case PrimitiveKind::Cone:
+    case PrimitiveKind::Cone:  // both reach size.z() above the centre (the cone's base)
       return center + Vector3d(size.x(), size.x(), size.z());
     default:
       return center + size;
