@@ -162,6 +162,8 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
   layer.material = read_material(s, preset);
   layer.name = coverage_name(s, preset, "layer" + std::to_string(index + 1));
   layer.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
+  // Snow shows a partial mask as flakes, as snow cover does (render/surface.h).
+  layer.flakes = s.boolean("flakes", preset == "snow");
   s.finish();
   if (!mask_file) s.invalid_table("needs 'mask' (a raster in [0, 1] in the DEM's CRS)");
   require_material(s, layer.material);

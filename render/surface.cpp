@@ -85,6 +85,7 @@ Material base_material(const TerrainSurface& surface, double x, double y) {
 // The rules and layers over the base, each over what lies beneath in order
 // (so later ones win where they overlap), and their coverage shares.
 void stack_layers(const TerrainSurface& surface, double x, double y, const Relief& relief,
+                  const Eigen::Vector3f& normal, double footprint,
                   const CoverageChannels* channels, Material& ground, SurfacePoint& p) {
   auto put_on_top = [&](const MaterialOverride& material, float w,
                         const std::vector<int> CoverageChannels::*entries, std::size_t i) {
@@ -106,7 +107,9 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
   for (std::size_t i = 0; i < surface.layers.size(); ++i) {
     const MaterialLayer& layer = surface.layers[i];
     const float mask = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f);
-    put_on_top(layer.material, mask * layer.opacity, &CoverageChannels::layers, i);
+    const float w = mask * layer.opacity;
+    put_on_top(layer.material, layer.flakes ? flake_cover({x, y, relief.z}, normal, w, footprint) : w,
+               &CoverageChannels::layers, i);
   }
 }
 
@@ -155,7 +158,7 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
                : 0.0f;
   Material ground = base_material(surface, x, y);
   if (channels) p.coverage[channels->ground] = 1.0f;
-  stack_layers(surface, x, y, relief, channels, ground, p);
+  stack_layers(surface, x, y, relief, normal, footprint, channels, ground, p);
   Material snow = surface.snow;
   if (surface.snow_depth && p.snow > 0.0f) {
     // Thin snow lets the ground show through (translucency). Where it lies

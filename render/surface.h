@@ -26,6 +26,10 @@ struct MaterialLayer {
   MaterialOverride material;
   terrain::HeightField mask;
   float opacity = 1.0f;
+  // Snow placed by a mask: a weight below 1 shows as flakes covering that
+  // share of the ground (render/snow_flakes.h), as snow cover does, not as a
+  // pale film. The scene file sets it for layers of the `snow` preset.
+  bool flakes = false;
 };
 
 // Wind ripples as bump mapping on the ground (paper 002, section 5).

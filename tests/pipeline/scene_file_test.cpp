@@ -378,7 +378,10 @@ TEST(SceneFile, ReadsMaterialRulesAndLayers) {
                                      "[[terrain.rule]]\ncolor = [0.5, 0.4, 0.3]\nslope_min = 40\n"
                                      "opacity = 0.5\n"
                                      "[[terrain.layer]]\nmask = \"wet.tif\"\nwetness = 1\n"
-                                     "name = \"puddles\"\n");
+                                     "name = \"puddles\"\n"
+                                     "[[terrain.layer]]\nmask = \"drift.tif\"\nmaterial = \"snow\"\n"
+                                     "[[terrain.layer]]\nmask = \"film.tif\"\nmaterial = \"snow\"\n"
+                                     "flakes = false\n");
   const auto s = drift::pipeline::read_scene_file(p);
   const auto& surface = s.input.surface;
   EXPECT_EQ(surface.ground.albedo, drift::render::material_preset("rock")->albedo);
@@ -392,9 +395,13 @@ TEST(SceneFile, ReadsMaterialRulesAndLayers) {
   EXPECT_FLOAT_EQ(surface.rules[0].slope.band, 5.0f);  // the default band
   EXPECT_FALSE(surface.rules[1].material.roughness.has_value());
   EXPECT_FLOAT_EQ(surface.rules[1].opacity, 0.5f);
-  ASSERT_EQ(surface.layers.size(), 1u);
+  ASSERT_EQ(surface.layers.size(), 3u);
   EXPECT_FLOAT_EQ(*surface.layers[0].material.wetness, 1.0f);
-  ASSERT_EQ(s.layer_masks.size(), 1u);
+  // Snow placed by a mask shows as flakes unless told otherwise.
+  EXPECT_FALSE(surface.layers[0].flakes);
+  EXPECT_TRUE(surface.layers[1].flakes);
+  EXPECT_FALSE(surface.layers[2].flakes);
+  ASSERT_EQ(s.layer_masks.size(), 3u);
   EXPECT_EQ(s.layer_masks[0], p.parent_path() / "wet.tif");
   // Coverage channels: the preset's name, else rule<N> / layer<N>, or `name`.
   EXPECT_EQ(surface.ground_name, "rock");

@@ -220,6 +220,36 @@ TEST(SnowFlakes, ThinSnowShadesAsFlakesUpCloseAndAsTheBlendFarAway) {
   EXPECT_LT((far.material.albedo - mix(s.ground, Material{flake}, 0.3f).albedo).norm(), 1e-5f);
 }
 
+TEST(SnowFlakes, SnowPlacedByAMaskShadesAsFlakesToo) {
+  // A [[terrain.layer]] of snow whose mask is 0.3: up close each point is
+  // bare rock or snow, 0.3 of them snow (the same covered-area = coverage
+  // rule as snow cover); far away the even blend, exactly. Without `flakes`
+  // the layer stays a film (the blend up close too).
+  TerrainSurface s = thin_snow(0.0f, 0.0f);
+  s.snow_cover.reset(), s.snow_depth.reset();
+  MaterialLayer layer;
+  layer.material.albedo = s.snow.albedo;
+  layer.mask = terrain::HeightField(100, 100, 0.3f, terrain::local_georeference(1.0));
+  layer.flakes = true;
+  s.layers.push_back(layer);
+  const Eigen::Vector3f film = mix(s.ground, s.snow, 0.3f).albedo;
+  std::mt19937_64 rng(43);
+  std::uniform_real_distribution<double> u(1.0, 99.0);
+  int flakes = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const double x = u(rng), y = -u(rng);
+    const Eigen::Vector3f a = shade_terrain(s, x, y, kUp, 0.0).material.albedo;
+    const bool on_flake = (a - s.snow.albedo).norm() < 1e-5f;
+    ASSERT_TRUE(on_flake || (a - s.ground.albedo).norm() < 1e-5f) << a.transpose();
+    flakes += on_flake;
+  }
+  EXPECT_NEAR(static_cast<double>(flakes) / n, 0.3, 0.015);
+  EXPECT_LT((shade_terrain(s, 50.0, -50.0, kUp, 5.0).material.albedo - film).norm(), 1e-5f);
+  s.layers[0].flakes = false;
+  EXPECT_LT((shade_terrain(s, 50.0, -50.0, kUp, 0.0).material.albedo - film).norm(), 1e-5f);
+}
+
 TEST(SnowFlakes, StuckFlakesOnAWallWithoutDepthReadWhite) {
   // Adhesion: coverage without depth. The flakes are a flake's depth of
   // snow (kFlakeDepth), not the bare rock the zero depth would give.
