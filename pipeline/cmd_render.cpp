@@ -11,6 +11,7 @@
 #include "pipeline/cli.h"
 #include "pipeline/progress_bar.h"
 #include "pipeline/scene_file.h"
+#include "pipeline/scene_products.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
 #include "render/tiles.h"
@@ -27,7 +28,15 @@ struct RenderOptions {
   double noise_target = -1.0;  // < 0: the scene's
   std::string size;
   std::vector<std::string> outputs;
-  std::string terrain, snow_cover, snow_depth, snow_objects, ripples;
+  std::string terrain;
+  // The stages' product-file flags (--snow-cover, --ripples, ...;
+  // pipeline/scene_products.h), in the table's order, each with its value.
+  struct ProductFlag {
+    const StageSection* section;
+    const ProductFileKey* file;
+    std::string value;
+  };
+  std::vector<ProductFlag> product_flags;
   unsigned long long seed = 0;
   std::string tile;
   std::string sun_time;
@@ -73,6 +82,19 @@ void apply_size(const std::string& size, render::RenderSettings& settings) {
   }
 }
 
+// The stages' product-file flags over their sections' keys; a section that
+// makes no products without its keys (as [ripples]) must be there.
+void apply_product_flags(const RenderOptions& o, SceneFile& scene) {
+  for (const RenderOptions::ProductFlag& f : o.product_flags) {
+    if (f.value.empty()) continue;
+    if (!scene.loads(f.section->name)) {
+      throw Error(std::string(f.file->flag) + " needs a [" + f.section->name + "] section in '" +
+                  o.scene + "'; see docs/rendering.md");
+    }
+    scene.product_files[product_key(*f.section, *f.file)] = f.value;
+  }
+}
+
 // The command line's overrides of the scene file.
 void apply_overrides(const RenderOptions& o, const CLI::App& sub, SceneFile& scene) {
   if (o.spp > 0) scene.settings.samples_per_pixel = o.spp;
@@ -90,16 +112,7 @@ void apply_overrides(const RenderOptions& o, const CLI::App& sub, SceneFile& sce
     scene.display.auto_exposure = false;
   }
   if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
-  if (!o.snow_cover.empty()) scene.snow_cover = o.snow_cover;
-  if (!o.snow_depth.empty()) scene.snow_depth = o.snow_depth;
-  if (!o.snow_objects.empty()) scene.snow_objects = o.snow_objects;
-  if (!o.ripples.empty()) {
-    if (!scene.input.surface.ripples) {
-      throw Error("--ripples needs a [ripples] section in '" + o.scene +
-                  "' (scale, rotation, strength); see docs/rendering.md");
-    }
-    scene.ripples = o.ripples;
-  }
+  apply_product_flags(o, scene);
   if (!o.outputs.empty()) {
     scene.outputs.clear();
     for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
@@ -144,13 +157,14 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
 std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
   std::ifstream in(o.scene, std::ios::binary);
   std::string text((std::istreambuf_iterator<char>(in)), {});
-  for (const std::string& part :
-       {o.size, o.terrain, o.snow_cover, o.snow_depth, o.snow_objects, o.ripples, o.sun_time,
-        std::to_string(scene.settings.samples_per_pixel),
-        std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
-        std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)}) {
-    text.append("\n").append(part);
-  }
+  std::vector<std::string> parts = {o.size, o.terrain};
+  for (const RenderOptions::ProductFlag& f : o.product_flags) parts.push_back(f.value);
+  parts.insert(
+      parts.end(),
+      {o.sun_time, std::to_string(scene.settings.samples_per_pixel),
+       std::to_string(scene.settings.noise_target), std::to_string(scene.settings.seed),
+       std::to_string(scene.display.exposure_ev), std::to_string(scene.display.auto_exposure)});
+  for (const std::string& part : parts) text.append("\n").append(part);
   std::uint64_t hash = 14695981039346656037ull;
   for (unsigned char c : text) hash = (hash ^ c) * 1099511628211ull;
   char hex[17];
@@ -207,6 +221,20 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   print_exposure(image, scene.display, o.tile.empty());
 }
 
+// One flag per product file of the stages' sections, e.g. --snow-cover
+// "snow cover raster (overrides [snow] cover)".
+void add_product_flags(CLI::App& sub, RenderOptions& o) {
+  for (const StageSection& section : stage_sections())
+    for (const ProductFileKey& file : section.files)
+      o.product_flags.push_back({&section, &file, ""});
+  // Bound once the list is complete: the values must not move.
+  for (RenderOptions::ProductFlag& f : o.product_flags) {
+    sub.add_option(
+        f.file->flag, f.value,
+        std::string(f.file->what) + " (overrides [" + f.section->name + "] " + f.file->key + ")");
+  }
+}
+
 }  // namespace
 
 void add_render_command(CLI::App& root) {
@@ -224,11 +252,7 @@ void add_render_command(CLI::App& root) {
   sub->add_option("-o,--output", o->outputs,
                   "output file(s), .png and/or .exr (override the scene)");
   sub->add_option("--terrain", o->terrain, "terrain raster (overrides [terrain] raster)");
-  sub->add_option("--snow-cover", o->snow_cover, "snow cover raster (overrides [snow] cover)");
-  sub->add_option("--snow-depth", o->snow_depth, "snow depth raster (overrides [snow] depth)");
-  sub->add_option("--snow-objects", o->snow_objects,
-                  "snowy objects from drift snow fall --mesh-out (overrides [snow] objects)");
-  sub->add_option("--ripples", o->ripples, "ripple height tile (overrides [ripples] raster)");
+  add_product_flags(*sub, *o);
   sub->add_option("--tile", o->tile,
                   "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16) to EXR; "
                   "join the bands with drift merge (docs/rendering.md)");

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "pipeline/object_list.h"
+#include "pipeline/scene_products.h"
 #include "pipeline/toml_section.h"
 #include "render/atmosphere.h"
 #include "render/land_form.h"
@@ -19,8 +20,6 @@
 #include "render/surface.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
-#include "terrain/mesh_io.h"
-#include "terrain/products.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -172,18 +171,14 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
   return layer;
 }
 
-// The scene file's sections, each read by its own function below; the order
-// here is the order `unknown section` lists them in.
-constexpr std::array<const char*, 10> kSections = {
-    "terrain", "snow", "ripples", "sun", "sky", "clouds", "camera", "objects", "render", "output"};
-
 // Every top-level key must be a known section.
 void check_sections(const toml::table& root, const fs::path& path) {
+  const std::vector<std::string> sections = scene_sections();
   for (const auto& [k, node] : root) {
     const std::string key(k.str());
-    if (std::find(kSections.begin(), kSections.end(), key) != kSections.end()) continue;
+    if (std::find(sections.begin(), sections.end(), key) != sections.end()) continue;
     std::string known;
-    for (const char* s : kSections) known += std::string(known.empty() ? "" : ", ") + s;
+    for (const std::string& s : sections) known += (known.empty() ? "" : ", ") + s;
     throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
                 ": unknown section '" + key + "' (known: " + known + ")");
   }
@@ -237,48 +232,18 @@ std::optional<fs::path> read_terrain(const toml::table& root, const fs::path& pa
   return objects_file;
 }
 
-// [snow]: the snow products (rasters, snowy objects) and the snow's look.
-void read_snow(const toml::table& root, const fs::path& path, SceneFile& scene) {
-  render::TerrainSurface& surface = scene.input.surface;
-  Section snow(subtable(root, "snow", path), "snow", path);
-  if (const auto cover = snow.string("cover")) scene.snow_cover = resolve(path, *cover);
-  if (const auto depth = snow.string("depth")) scene.snow_depth = resolve(path, *depth);
-  if (const auto objects = snow.string("objects")) scene.snow_objects = resolve(path, *objects);
-  surface.snow.albedo = snow.color("color", surface.snow.albedo);
-  surface.snow.roughness = static_cast<float>(
-      snow.number("roughness", surface.snow.roughness, 0.0, render::kMaxRoughness));
-  surface.snow.forward_scattering = static_cast<float>(
-      snow.number("forward_scattering", surface.snow.forward_scattering, 0.0, 1.0));
-  surface.snow_scattering =
-      static_cast<float>(snow.number("scattering", surface.snow_scattering, 1.0, 1e5));
-  surface.snow_cover_outside =
-      static_cast<float>(snow.number("cover_outside", surface.snow_cover_outside, 0.0, 1.0));
-  snow.finish();
-}
-
-// [ripples]: the ripple tile bump-mapped on the ground (paper 002).
-void read_ripples(const toml::table& root, const fs::path& path, SceneFile& scene) {
-  const toml::table* ripple_table = subtable(root, "ripples", path);
-  if (!ripple_table) return;
-  Section rip(ripple_table, "ripples", path);
-  const auto ripple_raster = rip.string("raster");
-  if (!ripple_raster)
-    rip.invalid_table("needs 'raster' (a tileable height field from drift dunes --model ripples)");
-  scene.ripples = resolve(path, *ripple_raster);
-  render::RippleLayer layer;
-  // At least 0.1 mm: the bump map divides by it (1e-39 overflowed inside Embree).
-  const double cell = rip.number("cell", 0.0, 1e-4, 100.0);
-  if (cell > 0.0) scene.ripple_texel_metres = cell;
-  layer.rotation_deg = rip.number("rotation", 0.0, -360.0, 360.0);
-  layer.strength = static_cast<float>(rip.number("strength", 1.0, 0.0, 100.0));
-  if (const auto fade = rip.vector<2>("fade_slope", 0.0, 90.0)) {
-    if (!((*fade)[0] < (*fade)[1]))
-      rip.invalid("fade_slope", "must be [start, end] with start < end");
-    layer.fade_start_deg = static_cast<float>((*fade)[0]);
-    layer.fade_end_deg = static_cast<float>((*fade)[1]);
+// A stage's section (pipeline/scene_products.h): its product files, then its
+// own keys; keeps what loads its products.
+void read_stage_section(const toml::table& root, const fs::path& path, const StageSection& stage,
+                        SceneFile& scene) {
+  Section section(subtable(root, stage.name, path), stage.name, path);
+  for (const ProductFileKey& file : stage.files) {
+    if (const auto name = section.string(file.key))
+      scene.product_files[product_key(stage, file)] = resolve(path, *name);
   }
-  rip.finish();
-  scene.input.surface.ripples = std::move(layer);
+  if (SceneFile::Loader load = stage.read(section, scene))
+    scene.product_loaders.emplace_back(stage.name, std::move(load));
+  section.finish();
 }
 
 // [sun]: by azimuth and elevation, or by date and time over the DEM.
@@ -466,8 +431,7 @@ SceneFile read_scene_file(const fs::path& path) {
   check_sections(root, path);
   SceneFile scene;
   const std::optional<fs::path> objects_file = read_terrain(root, path, scene);
-  read_snow(root, path, scene);
-  read_ripples(root, path, scene);
+  for (const StageSection& stage : stage_sections()) read_stage_section(root, path, stage, scene);
   read_sun(root, path, scene);
   read_sky(root, path, scene.input.sky);
   read_clouds(root, path, scene.input);
@@ -477,18 +441,15 @@ SceneFile read_scene_file(const fs::path& path) {
     for (auto& placed : read_objects_file(*objects_file))
       scene.input.meshes.push_back(std::move(placed));
   }
+  // An object's own mesh file may carry attributes (a PLY a stage wrote);
+  // only a stage's section ([snow] objects) brings the products it shades by.
+  for (terrain::PlacedMesh& placed : scene.input.meshes) placed.mesh.vertex_attributes.clear();
   read_render(root, path, scene.settings);
   read_output(root, path, scene);
   return scene;
 }
 
 namespace {
-// Reads a raster the scene places in metres; degrees are an error with the fix.
-terrain::HeightField read_metric_raster(const fs::path& file) {
-  terrain::HeightField grid = terrain::read_raster(file);
-  require_metric_crs(grid, file);
-  return grid;
-}
 
 // Puts the sun where it stands over the DEM's centre at the scene's date and
 // time (NOAA's algorithm), its azimuth turned from true north to the grid's.
@@ -507,32 +468,6 @@ void place_sun(SceneFile& scene) {
       std::atan2(north[0] - centre[0], north[1] - centre[1]) * 180.0 / std::numbers::pi;
   scene.input.sun.azimuth_deg = std::fmod(sun.azimuth_deg + convergence + 720.0, 360.0);
   scene.input.sun.elevation_deg = sun.elevation_deg;
-}
-
-// Replaces the scene's objects by their snowy versions from drift snow fall:
-// the same objects in the same order, raised by their snow, keeping their
-// colours, with per-vertex snow coverage.
-void place_snowy_objects(SceneFile& scene) {
-  std::vector<terrain::PlacedMesh>& meshes = scene.input.meshes;
-  const terrain::Mesh snowy = terrain::read_ply(scene.snow_objects);
-  std::vector<terrain::Mesh> parts;
-  try {
-    parts = terrain::split_by_attribute(snowy, terrain::products::kObjectIndex);
-  } catch (const Error& e) {
-    throw Error("'" + scene.snow_objects.string() + "': " + e.what() +
-                " (write it with drift snow fall --mesh-out)");
-  }
-  if (parts.size() != meshes.size()) {
-    throw Error("'" + scene.snow_objects.string() + "' holds " + std::to_string(parts.size()) +
-                " objects but the scene has " + std::to_string(meshes.size()) +
-                "; give the scene the objects file drift snow fall was given");
-  }
-  for (std::size_t o = 0; o < parts.size(); ++o) {
-    const std::vector<float>* cover = parts[o].attribute(terrain::products::kSnowCoverage);
-    meshes[o].position = parts[o].origin;
-    meshes[o].snow_coverage = cover ? *cover : std::vector<float>{};
-    meshes[o].mesh = std::move(parts[o]);
-  }
 }
 
 // Turns the camera's lon/lat ends into CRS points at their height above the
@@ -573,7 +508,6 @@ void load_scene_terrain(SceneFile& scene) {
   }
   place_lonlat_camera(scene);
   if (scene.sun_time) place_sun(scene);
-  if (!scene.snow_objects.empty()) place_snowy_objects(scene);
   if (!scene.albedo_map.empty()) {
     surface.albedo_map = render::read_albedo_map(scene.albedo_map);
     require_metric_crs(surface.albedo_map->front(), scene.albedo_map);
@@ -584,31 +518,34 @@ void load_scene_terrain(SceneFile& scene) {
     scene.input.surround.rasters.push_back(read_metric_raster(f));
   if (uses_position(surface))
     surface.position = render::topographic_position(scene.input.terrain, scene.position_radius);
-  if (!scene.snow_cover.empty()) surface.snow_cover = read_metric_raster(scene.snow_cover);
-  if (!scene.snow_depth.empty()) surface.snow_depth = read_metric_raster(scene.snow_depth);
-  if (!scene.ripples.empty() && surface.ripples) {
-    terrain::HeightField tile = read_metric_raster(scene.ripples);
-    const double native = tile.geo().cell_size_x();
-    const double texel = scene.ripple_texel_metres.value_or(native);
-    // A ripple field scaled to another cell size is scaled as a whole, heights
-    // too, so its slopes (what shading sees) stay those simulated.
-    if (native > 0.0 && texel != native) {
-      for (float& v : tile.values()) v = static_cast<float>(v * (texel / native));
-    }
-    try {
-      surface.ripples->slopes = render::SlopePyramid(tile, texel);
-    } catch (const Error& e) {
-      throw Error("ripple raster '" + scene.ripples.string() + "': " + e.what());
-    }
-  }
+  for (const auto& [section, load] : scene.product_loaders) load(scene);
 }
 
 std::vector<fs::path> scene_inputs(const SceneFile& scene) {
-  std::vector<fs::path> inputs = {scene.terrain_raster, scene.snow_cover, scene.snow_depth,
-                                  scene.ripples,        scene.albedo_map, scene.snow_objects};
+  std::vector<fs::path> inputs = {scene.terrain_raster, scene.albedo_map};
+  for (const auto& [key, file] : scene.product_files) inputs.push_back(file);
   inputs.insert(inputs.end(), scene.layer_masks.begin(), scene.layer_masks.end());
   std::erase_if(inputs, [](const fs::path& p) { return p.empty(); });
   return inputs;
+}
+
+fs::path SceneFile::product_file(const std::string& key) const {
+  const auto found = product_files.find(key);
+  return found == product_files.end() ? fs::path() : found->second;
+}
+
+bool SceneFile::loads(const std::string& name) const {
+  return std::any_of(product_loaders.begin(), product_loaders.end(),
+                     [&](const auto& loader) { return loader.first == name; });
+}
+
+std::vector<std::string> scene_sections() {
+  // The renderer's own sections around the stages' (read in this order).
+  std::vector<std::string> sections = {"terrain"};
+  for (const StageSection& stage : stage_sections()) sections.emplace_back(stage.name);
+  for (const char* own : {"sun", "sky", "clouds", "camera", "objects", "render", "output"})
+    sections.emplace_back(own);
+  return sections;
 }
 
 }  // namespace drift::pipeline

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,19 +25,21 @@ struct GeoPoint {
 
 struct SceneFile {
   std::filesystem::path terrain_raster;  // resolved against the scene file's folder
-  // Layer rasters ([snow] cover and depth, [ripples] raster), resolved likewise;
-  // empty when the scene has none.
-  std::filesystem::path snow_cover, snow_depth, ripples, albedo_map;
+  std::filesystem::path albedo_map;      // likewise; empty when the scene has none
   // The masks of input.surface.layers, in order (read by load_scene_terrain).
   std::vector<std::filesystem::path> layer_masks;
   // [terrain] surround: coarser DEMs around the terrain (render/surround.h).
   std::vector<std::filesystem::path> surround_rasters;
-  // [snow] objects: the scene's objects as drift snow fall left them (a PLY
-  // with per-vertex "object" and "snow_coverage"), replacing their meshes.
-  std::filesystem::path snow_objects;
-  std::optional<double> ripple_texel_metres;  // default: the ripple raster's cell size
+  // The product files the stages' sections name, by "section.key" ("snow.cover",
+  // "ripples.raster": pipeline/scene_products.h), resolved likewise; drift
+  // render's flags override them.
+  std::map<std::string, std::filesystem::path> product_files;
+  // What puts a stage section's products into `input` once the terrain is
+  // loaded, by section, in the order of the sections (load_scene_terrain).
+  using Loader = std::function<void(SceneFile&)>;
+  std::vector<std::pair<std::string, Loader>> product_loaders;
   double position_radius = 150.0;  // [terrain] position_radius: metres (render/land_form.h)
-  int terrain_repeat = 1;  // [terrain] repeat: a tileable terrain laid out n x n (odd)
+  int terrain_repeat = 1;          // [terrain] repeat: a tileable terrain laid out n x n (odd)
   // [camera] from_lonlat / to_lonlat: resolved into input.camera by
   // load_scene_terrain.
   std::optional<GeoPoint> camera_from_lonlat, camera_to_lonlat;
@@ -46,12 +50,21 @@ struct SceneFile {
   render::RenderSettings settings;
   std::vector<std::filesystem::path> outputs;  // resolved against the current directory
   render::DisplayTransform display;
+
+  // The product file `key` names ("snow.cover"), or an empty path.
+  std::filesystem::path product_file(const std::string& key) const;
+  // Whether stage section `name` makes products (has a loader).
+  bool loads(const std::string& name) const;
 };
+
+// The scene file's sections, the stages' (pipeline/scene_products.h) among
+// the renderer's own, in the order they are read and listed in errors.
+std::vector<std::string> scene_sections();
 
 // Parses and validates; meshes are loaded, the terrain raster is not.
 SceneFile read_scene_file(const std::filesystem::path& path);
 
-// Every file the scene reads (rasters, masks, snowy objects), for refusing
+// Every file the scene reads (rasters, masks, product files), for refusing
 // them as outputs.
 std::vector<std::filesystem::path> scene_inputs(const SceneFile& scene);
 

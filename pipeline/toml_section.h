@@ -46,6 +46,8 @@ class Section {
           std::string doc = "docs/rendering.md")
       : table_(table), name_(std::move(name)), file_(file), doc_(std::move(doc)) {}
 
+  // Whether the file has the table at all.
+  bool present() const { return table_ != nullptr; }
   // Whether the table gives `key` (without taking it).
   bool has(const char* key) const { return table_ && table_->contains(key); }
 

@@ -12,6 +12,7 @@
 #include "render/surround.h"
 #include "terrain/grid.h"
 #include "terrain/mesh.h"
+#include "terrain/products.h"
 
 namespace drift::render {
 
@@ -84,8 +85,13 @@ struct RenderSettings {
 struct SceneInput {
   terrain::HeightField terrain;  // metric CRS (or local), heights in metres
   double vertical_exaggeration = 1.0;
+  // Height changes laid on the ground (terrain/products.h): the surface
+  // traced is the terrain raised by each, in order.
+  std::vector<terrain::products::HeightChange> height_changes;
   TerrainSurface surface;    // materials and the layers that place them
   SurroundOptions surround;  // the ground beyond the DEM's edge (render/surround.h)
+  // Objects, each an attributed mesh (terrain/products.h) placed in the scene:
+  // a kSnowCoverage attribute puts the snow material on it.
   std::vector<terrain::PlacedMesh> meshes;
   Sun sun;
   Sky sky;

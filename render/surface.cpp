@@ -51,13 +51,13 @@ std::array<terrain::HeightField, 3> read_albedo_map(const std::filesystem::path&
   return rgb;
 }
 
-terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
-                                    const terrain::HeightField& depth) {
+terrain::HeightField add_height_change(const terrain::HeightField& dem,
+                                       const terrain::HeightField& metres) {
   terrain::HeightField out = dem;
   for (int row = 0; row < dem.height(); ++row) {
     for (int x = 0; x < dem.width(); ++x) {
       const auto c = dem.geo().cell_center(x, row);
-      out(x, row) += std::max(0.0f, sample_raster(depth, c[0], c[1], 0.0f));
+      out(x, row) += std::max(0.0f, sample_raster(metres, c[0], c[1], 0.0f));
     }
   }
   return out;
@@ -113,11 +113,12 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
   }
 }
 
-// Ripples as bump mapping (paper 002, section 5): the tile's slope at the
-// footprint's level tilts the normal and its unresolved variance roughens
-// the sand; they fade under snow and on slip faces.
-void apply_ripples(const RippleLayer& r, double x, double y, const Eigen::Vector3f& normal,
-                   double footprint, SurfacePoint& p) {
+// A normal-detail tile as bump mapping (ripples: paper 002, section 5): the
+// tile's slope at the footprint's level tilts the shading normal p.normal and
+// its unresolved variance roughens the surface; it fades under snow and on
+// steep slopes of the smooth terrain `normal`.
+void apply_normal_detail(const NormalDetail& r, double x, double y, const Eigen::Vector3f& normal,
+                         double footprint, SurfacePoint& p) {
   // Ripples live on sand: not under snow, not on slip faces.
   const float slope_deg =
       std::acos(std::clamp(normal.z(), -1.0f, 1.0f)) * static_cast<float>(180.0 / std::numbers::pi);
@@ -140,8 +141,9 @@ void apply_ripples(const RippleLayer& r, double x, double y, const Eigen::Vector
   // Slope back to ground axes (the inverse rotation).
   const Eigen::Vector2f g(static_cast<float>(c * g_tile.x() + s * g_tile.y()),
                           static_cast<float>(-s * g_tile.x() + c * g_tile.y()));
-  // Surface z = Z(x, y) + h(x, y): n ~ (-(Zx + hx), -(Zy + hy), 1).
-  const Eigen::Vector3f base = normal / normal.z();
+  // Surface z = Z(x, y) + h(x, y): n ~ (-(Zx + hx), -(Zy + hy), 1), where Z
+  // is the surface so far (the terrain, tilted by any detail before).
+  const Eigen::Vector3f base = p.normal / p.normal.z();
   p.normal = Eigen::Vector3f(base.x() - g.x(), base.y() - g.y(), 1.0f).normalized();
 }
 
@@ -172,8 +174,9 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
   p.snow = flake_cover({x, y, relief.z}, normal, p.snow, footprint);
   p.material = mix(ground, snow, p.snow);
   if (channels) cover(p.coverage, channels->snow, p.snow);
-  if (surface.ripples && normal.z() > 1e-3f)
-    apply_ripples(surface.ripples.value(), x, y, normal, footprint, p);
+  if (normal.z() > 1e-3f)
+    for (const NormalDetail& tile : surface.normal_details)
+      apply_normal_detail(tile, x, y, normal, footprint, p);
   const DetailedGround detail =
       ground_detail(p.material, x, y, relief.altitude, p.normal, footprint);
   p.material.albedo = detail.albedo;

@@ -1,8 +1,8 @@
-// What covers the terrain: materials and the stage products that place them.
-// Snow cover (drift snow cover) and snow depth (drift snow fall) are rasters in
-// the DEM's CRS; ripples (drift dunes --model ripples) are a tileable bump map.
-// Every raster is sampled by CRS coordinates, so it need not share the DEM's
-// grid, only its CRS.
+// What covers the terrain: materials and the products that place them, by
+// their declared form (terrain/products.h), never by the stage that made
+// them: material masks (MaterialLayer, and the snow's cover), the snow's
+// depth, and normal-detail tiles (NormalDetail). Every raster is sampled by
+// CRS coordinates, so it need not share the DEM's grid, only its CRS.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,19 +32,21 @@ struct MaterialLayer {
   bool flakes = false;
 };
 
-// Wind ripples as bump mapping on the ground (paper 002, section 5).
-struct RippleLayer {
-  SlopePyramid slopes;           // of the periodic ripple height tile
+// A normal-detail tile: a periodic height tile bump-mapped on the ground,
+// e.g. wind ripples (paper 002, section 5). It fades under snow and on steep
+// slopes (ripples do not survive on slip faces).
+struct NormalDetail {
+  SlopePyramid slopes;           // of the periodic height tile
   double rotation_deg = 0.0;     // tile turned clockwise on the ground (e.g. to the wind)
-  float strength = 1.0f;         // scales the ripple slopes
-  float fade_start_deg = 24.0f;  // ripples fade out between these terrain
-  float fade_end_deg = 31.0f;    // slopes: they do not survive on slip faces
+  float strength = 1.0f;         // scales the tile's slopes
+  float fade_start_deg = 24.0f;  // the detail fades out between these terrain
+  float fade_end_deg = 31.0f;    // slopes
 };
 
 // The ground's material, bottom to top: `ground` (its albedo from
 // `albedo_map` where that covers the point), then `rules` by altitude and
 // slope, then `layers` by their masks, each over what lies beneath in order,
-// then snow by its cover.
+// then snow by its cover; then the normal details, in order.
 struct TerrainSurface {
   Material ground;
   std::string ground_name = "ground";  // its coverage channel (render/coverage.h)
@@ -61,8 +63,10 @@ struct TerrainSurface {
   // The cover where the raster does not reach (beyond a cropped snowfall,
   // on the ground around the DEM: render/surround.h).
   float snow_cover_outside = 0.0f;
-  std::optional<terrain::HeightField> snow_depth;  // metres, raises the surface
-  std::optional<RippleLayer> ripples;
+  // Metres of snow, for its translucency (layer_albedo above). The surface
+  // traced is raised by SceneInput::height_changes, which hold it too.
+  std::optional<terrain::HeightField> snow_depth;
+  std::vector<NormalDetail> normal_details;
   // The ground's albedo draped from an image in the DEM's CRS (an orthophoto
   // or a land-cover colour map): linear R, G, B in [0, 1]; outside it the
   // ground material's colour.
@@ -89,10 +93,11 @@ struct SurfacePoint {
 // nodata count as `outside`.
 float sample_raster(const terrain::HeightField& raster, double x, double y, float outside);
 
-// `dem` with `depth` (metres, sampled at each cell centre; outside and nodata
-// count as no snow) added to its valid cells.
-terrain::HeightField add_snow_depth(const terrain::HeightField& dem,
-                                    const terrain::HeightField& depth);
+// `dem` with the height change `metres` (sampled at each cell centre;
+// outside, nodata and values below zero count as none) added to its valid
+// cells.
+terrain::HeightField add_height_change(const terrain::HeightField& dem,
+                                       const terrain::HeightField& metres);
 
 // Where a terrain point lies, for material rules: its altitude in metres
 // (without vertical exaggeration) and the slope of the unbumped terrain in

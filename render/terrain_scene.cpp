@@ -16,6 +16,7 @@
 #include "terrain/error.h"
 #include "terrain/local_frame.h"
 #include "terrain/memory.h"
+#include "terrain/products.h"
 
 namespace drift::render {
 
@@ -40,6 +41,15 @@ constexpr int kMaxGridSide = 32767;
 // The ray's footprint (metres) where it hit.
 double footprint(const RayCone& cone, const Hit& hit) { return cone.width_at(hit.distance); }
 
+// The surface traced: the ground with every height change laid on it (none:
+// nothing, the ground itself is traced).
+std::optional<terrain::HeightField> raised_ground(const SceneInput& input) {
+  std::optional<terrain::HeightField> raised;
+  for (const terrain::products::HeightChange& change : input.height_changes)
+    raised = add_height_change(raised ? *raised : input.terrain, change.metres);
+  return raised;
+}
+
 }  // namespace
 
 struct TerrainScene::Embree {
@@ -54,12 +64,8 @@ struct TerrainScene::Embree {
 };
 
 TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<Embree>()) {
-  // The surface traced is the ground plus any lying snow.
-  const std::optional<terrain::HeightField> snowy =
-      input.surface.snow_depth
-          ? std::optional(add_snow_depth(input.terrain, *input.surface.snow_depth))
-          : std::nullopt;
-  const terrain::HeightField& dem = snowy ? *snowy : input.terrain;
+  const std::optional<terrain::HeightField> raised = raised_ground(input);
+  const terrain::HeightField& dem = raised ? *raised : input.terrain;
   check_terrain(dem);
   surface_ = input.surface;
   coverage_ = coverage_channels(surface_);
@@ -211,10 +217,11 @@ void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
     mesh_snow_triangles_.resize(id + 1);
   }
   mesh_albedo_[id] = placed.albedo;
-  if (!placed.snow_coverage.empty()) {
-    if (placed.snow_coverage.size() != placed.mesh.positions.size())
+  // An attributed mesh (terrain/products.h) may carry snow coverage.
+  if (const std::vector<float>* cover = placed.mesh.attribute(terrain::products::kSnowCoverage)) {
+    if (cover->size() != placed.mesh.positions.size())
       throw Error("a mesh's snow coverage must have one value per vertex");
-    mesh_snow_[id] = placed.snow_coverage;
+    mesh_snow_[id] = *cover;
     mesh_snow_triangles_[id] = placed.mesh.triangles;
   }
 }

@@ -66,10 +66,10 @@ struct SnowfallOptions {
 struct SnowfallResult {
   terrain::HeightField depth;     // m of snow (vertical), georeference of the ground
   terrain::HeightField coverage;  // [0, 1]
-  // All objects in one mesh, vertices raised by their snow, with per-vertex
-  // attributes snow_depth (m), snow_probability, snow_coverage, snow_adhesion
-  // and object (the index of the object in the input list).
-  // Positions are relative to mesh_origin (CRS metres): place it there.
+  // All objects in one mesh, vertices raised by their snow, in the declared
+  // form terrain::products::kSnowyObjects: per-vertex snow depth (m),
+  // probability, coverage, adhesion and the index of the object in the input
+  // list. Positions are relative to mesh_origin (CRS metres): place it there.
   terrain::Mesh objects;
   Eigen::Vector3d mesh_origin{0, 0, 0};
   // Bookkeeping (m^3): fallen = on ground + on objects + lost off the raster's edge.

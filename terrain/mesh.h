@@ -31,15 +31,14 @@ struct Mesh {
 };
 
 // An object as a scene places it (rocks, trees, huts): what snow falls on and
-// the renderer traces.
+// the renderer traces. Its mesh's attributes are products (terrain/products.h):
+// the snowy objects of drift snow fall carry their snow coverage.
 struct PlacedMesh {
   Mesh mesh;  // in its own frame (metres), already rotated and scaled
   // Where the mesh's origin stands, in the raster's CRS. Kept in double: UTM
   // coordinates in float would lose half a metre.
   Eigen::Vector3d position{0, 0, 0};
   Eigen::Vector3f albedo{0.5f, 0.5f, 0.5f};
-  // Per-vertex snow coverage in [0, 1] (from drift snow fall), or empty.
-  std::vector<float> snow_coverage;
 };
 
 }  // namespace drift::terrain

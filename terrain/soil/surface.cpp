@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "terrain/products.h"
 #include "terrain/soil/height_spans.h"
 
 namespace drift::soil {
@@ -128,7 +129,8 @@ terrain::Mesh soil_surface(const SoilState& s, const SurfaceOptions& o, double m
           ? iso_surface(s.shape, surface_density(s, o))
           : floor_padded_surface(s, surface_density(s, o), std::clamp(o.ramp_voxels, 1, 16));
   mesh.vertex_attributes.push_back(
-      {"wetness", std::vector<float>(mesh.positions.size(), static_cast<float>(moisture))});
+      {terrain::products::kWetness,
+       std::vector<float>(mesh.positions.size(), static_cast<float>(moisture))});
   return mesh;
 }
 

@@ -331,4 +331,17 @@ TEST(RefusalsCli, SceneOutputFilesResolveAgainstTheSceneFile) {
   EXPECT_TRUE(fs::exists(d / "scenes" / "out.png"));
 }
 
+TEST(RefusalsCli, StageFlagsNeedASectionOnlyWhereTheStageDoes) {
+  // The stages' product flags come from pipeline/scene_products.h: --ripples
+  // needs [ripples] (its look is set there), --snow-cover works without [snow].
+  const fs::path d = test_dir();
+  const std::string raster = dem(d).string();
+  put(d / "s.toml", "[terrain]\nraster = \"dem.tif\"\n");
+  const std::string render = "render " + (d / "s.toml").string() + " --size 8x4 --spp 1 -o ";
+  EXPECT_REFUSED(drift(render + (d / "r.png").string() + " --ripples " + raster, d), 1,
+                 "--ripples needs a [ripples] section");
+  EXPECT_FALSE(fs::exists(d / "r.png"));
+  EXPECT_EQ(drift(render + (d / "c.png").string() + " --snow-cover " + raster, d).status, 0);
+}
+
 }  // namespace

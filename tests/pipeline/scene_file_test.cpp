@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "pipeline/scene_products.h"
 #include "pipeline/toml_section.h"
 #include "render/image_io.h"
 #include "render/solar_position.h"
@@ -82,6 +83,40 @@ TEST(SceneFile, UnknownKeyNamesKeyAndFile) {
 TEST(SceneFile, UnknownSectionIsAnError) {
   EXPECT_NE(error_of(std::string(kTerrain) + "[camrea]\nfov = 3\n").find("camrea"),
             std::string::npos);
+}
+
+TEST(SceneFile, UnknownSectionListsEverySectionFromTheTables) {
+  // The list is made from the stages' table (pipeline/scene_products.h) and
+  // the renderer's own sections, in reading order; every section it names is
+  // one the reader accepts.
+  const std::string e = error_of(std::string(kTerrain) + "[camrea]\nfov = 3\n");
+  EXPECT_NE(e.find("(known: terrain, snow, ripples, sun, sky, clouds, camera, objects, render, "
+                   "output)"),
+            std::string::npos)
+      << e;
+  for (const drift::pipeline::StageSection& stage : drift::pipeline::stage_sections())
+    EXPECT_NE(e.find(std::string(", ") + stage.name + ","), std::string::npos) << stage.name;
+  for (const std::string& section : drift::pipeline::scene_sections()) {
+    if (section == "terrain") continue;
+    const std::string ok = error_of(std::string(kTerrain) + "[" + section + "]\n");
+    EXPECT_EQ(ok.find("unknown section"), std::string::npos) << section << ": " << ok;
+  }
+}
+
+TEST(SceneFile, StageFlagsOverrideTheirSectionsFiles) {
+  // Each product-file key of a stage's section lands in product_files under
+  // "section.key", the name drift render's flag overrides.
+  for (const drift::pipeline::StageSection& stage : drift::pipeline::stage_sections()) {
+    std::string text = std::string(kTerrain) + "[" + stage.name + "]\n";
+    for (const auto& file : stage.files) text += std::string(file.key) + " = \"f.tif\"\n";
+    const auto s = drift::pipeline::read_scene_file(write_scene("f.toml", text));
+    for (const auto& file : stage.files) {
+      EXPECT_EQ(s.product_file(drift::pipeline::product_key(stage, file)).filename(), "f.tif")
+          << stage.name << "." << file.key;
+      EXPECT_EQ(std::string(file.flag).rfind("--", 0), 0u) << file.flag;
+    }
+    EXPECT_TRUE(s.loads(stage.name)) << stage.name;
+  }
 }
 
 TEST(SceneFile, WrongTypeIsAnError) {
@@ -231,14 +266,15 @@ TEST(SceneFile, ReadsSnowAndRippleLayers) {
                          "[ripples]\nraster = \"ripples.tif\"\ncell = 0.05\nrotation = 30\n"
                          "strength = 2\nfade_slope = [20, 30]\n");
   const auto s = drift::pipeline::read_scene_file(p);
-  EXPECT_EQ(s.snow_cover, p.parent_path() / "cover.tif");
-  EXPECT_EQ(s.snow_depth, fs::path("/abs/depth.tif"));
-  EXPECT_EQ(s.ripples, p.parent_path() / "ripples.tif");
-  ASSERT_TRUE(s.ripple_texel_metres.has_value());
-  EXPECT_DOUBLE_EQ(*s.ripple_texel_metres, 0.05);
-  ASSERT_TRUE(s.input.surface.ripples.has_value());
-  EXPECT_DOUBLE_EQ(s.input.surface.ripples->rotation_deg, 30.0);
-  EXPECT_FLOAT_EQ(s.input.surface.ripples->fade_end_deg, 30.0f);
+  EXPECT_EQ(s.product_file("snow.cover"), p.parent_path() / "cover.tif");
+  EXPECT_EQ(s.product_file("snow.depth"), fs::path("/abs/depth.tif"));
+  EXPECT_EQ(s.product_file("snow.objects"), fs::path());
+  EXPECT_EQ(s.product_file("ripples.raster"), p.parent_path() / "ripples.tif");
+  EXPECT_TRUE(s.loads("snow"));
+  EXPECT_TRUE(s.loads("ripples"));
+  ASSERT_EQ(s.input.surface.normal_details.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.input.surface.normal_details[0].rotation_deg, 30.0);
+  EXPECT_FLOAT_EQ(s.input.surface.normal_details[0].fade_end_deg, 30.0f);
   EXPECT_FLOAT_EQ(s.input.surface.ground.roughness, 0.4f);
 }
 

@@ -130,11 +130,11 @@ TEST(Ripples, FarRipplesRoughenTheSand) {
   // slope), in quadrature with the sand's own; up close nearly none is added.
   TerrainSurface s;
   s.ground.roughness = 0.3f;
-  RippleLayer layer;
+  NormalDetail layer;
   const double texel = 0.05, amplitude = 0.02;
   layer.slopes = SlopePyramid(sine_tile(256, texel, 4, amplitude), texel);
   layer.strength = 2.0f;
-  s.ripples = layer;
+  s.normal_details = {layer};
   const Eigen::Vector3f up(0, 0, 1);
   const double g_rms = amplitude * 2 * kPi / (256 * texel / 4) / std::sqrt(2.0);
   const float far = shade_terrain(s, 0.3, -0.2, up, 1000.0).material.roughness;
@@ -157,16 +157,16 @@ TEST(SlopePyramid, RejectsBadTiles) {
 
 TEST(Ripples, RotationTurnsTheBumpsAndSlipFacesLoseThem) {
   TerrainSurface s;
-  RippleLayer layer;
+  NormalDetail layer;
   layer.slopes = SlopePyramid(sine_tile(64, 0.1, 2, 0.05), 0.1);
-  s.ripples = layer;
+  s.normal_details = {layer};
   const Eigen::Vector3f up(0, 0, 1);
   // Unrotated: crests run north-south, so the normal tilts east-west only.
   const Eigen::Vector3f n0 = shade_terrain(s, 0.05, -0.05, up, 0.0).normal;
   EXPECT_GT(std::abs(n0.x()), 0.05f);
   EXPECT_NEAR(n0.y(), 0.0f, 1e-6f);
   // Turned 90 degrees: crests run east-west, the normal tilts north-south.
-  s.ripples->rotation_deg = 90.0;
+  s.normal_details[0].rotation_deg = 90.0;
   const Eigen::Vector3f n90 = shade_terrain(s, 0.05, -0.05, up, 0.0).normal;
   EXPECT_NEAR(n90.x(), 0.0f, 1e-5f);
   EXPECT_GT(std::abs(n90.y()), 0.05f);
@@ -196,7 +196,8 @@ TEST(Snow, CoverBlendsTheMaterialAndDepthRaisesTheSurface) {
     for (int x = 0; x < 16; ++x) cover(x, row) = 1.0f, depth(x, row) = 2.0f;
   in.surface.snow_cover = cover;
   in.surface.snow_depth = depth;
-  in.surface.snow.detail = {};  // the snow's own albedo, without its variation
+  in.height_changes = {{"snow depth", depth}};  // a height change raises the traced surface
+  in.surface.snow.detail = {};                  // the snow's own albedo, without its variation
   in.sky.constant = true;
   const TerrainScene scene(in);
   Hit west, east;
@@ -251,7 +252,7 @@ TEST(Snow, MeshCoverageBlendsTheObjectsMaterial) {
   roof.mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
   roof.position = Eigen::Vector3d(6.0, -10.0, 0.0);
   roof.albedo = {0.3f, 0.2f, 0.1f};
-  roof.snow_coverage = {1.0f, 1.0f, 1.0f, 0.0f};
+  roof.mesh.vertex_attributes = {{drift::terrain::products::kSnowCoverage, {1, 1, 1, 0}}};
   in.meshes.push_back(roof);
   const TerrainScene scene(in);
   const Eigen::Vector3f down(0, 0, -1);
@@ -262,4 +263,23 @@ TEST(Snow, MeshCoverageBlendsTheObjectsMaterial) {
   EXPECT_LT(near_bare.snow, 0.1f);
   EXPECT_NEAR((near_snowy.material.albedo - in.surface.snow.albedo).norm(), 0.0f, 0.05f);
   EXPECT_NEAR((near_bare.material.albedo - roof.albedo).norm(), 0.0f, 0.1f);
+}
+
+TEST(HeightChanges, EachRaisesTheTracedSurfaceInTurnAndNoneLowersIt) {
+  // Flat ground at 100 m; one change lays 1 m everywhere, a second 0.5 m on
+  // the western half and -3 m (counts as none) on the eastern half.
+  SceneInput in;
+  in.terrain = HeightField(32, 32, 100.0f, local_georeference(1.0));
+  HeightField second(32, 32, -3.0f, local_georeference(1.0));
+  for (int row = 0; row < 32; ++row)
+    for (int x = 0; x < 16; ++x) second(x, row) = 0.5f;
+  in.height_changes = {{"one", HeightField(32, 32, 1.0f, local_georeference(1.0))},
+                       {"two", second}};
+  const TerrainScene scene(in);
+  const Eigen::Vector3f down(0, 0, -1);
+  Hit west, east;
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(4.0, -16.0, 500.0)), down, west));
+  ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(28.0, -16.0, 500.0)), down, east));
+  EXPECT_NEAR(scene.origin().z() + west.position.z(), 101.5, 1e-3);
+  EXPECT_NEAR(scene.origin().z() + east.position.z(), 101.0, 1e-3);
 }

@@ -11,6 +11,7 @@
 #include "snow/snowfall_directions.h"
 #include "terrain/error.h"
 #include "terrain/mesh_io.h"
+#include "terrain/products.h"
 
 namespace {
 
@@ -74,6 +75,21 @@ TEST(SnowfallOcclusion, OpenFlatGroundGetsExactlyRateTimesHoursAndMassAddsUp) {
   EXPECT_GT(r.object_volume, 0.7 * 5.0 * 4.4 * 0.21);
   EXPECT_NEAR(r.ground_volume + r.object_volume + r.lost_volume, r.fallen_volume,
               1e-9 * r.fallen_volume);
+}
+
+TEST(SnowfallOcclusion, SnowyObjectsHaveTheDeclaredFormInItsOrder) {
+  // The writer of the snowy objects and their reader ([snow] objects) meet in
+  // terrain::products::kSnowyObjects: the mesh carries exactly its attributes.
+  const HeightField g = flat_ground();
+  SnowfallOptions o;
+  o.spread_deg = 0.0;
+  o.maps = 1;
+  const auto r = simulate_snowfall(g, hut(g), o);
+  const auto& form = drift::terrain::products::kSnowyObjects;
+  ASSERT_EQ(r.objects.vertex_attributes.size(), form.attributes.size());
+  for (std::size_t a = 0; a < form.attributes.size(); ++a)
+    EXPECT_EQ(r.objects.vertex_attributes[a].first, form.attributes[a]);
+  EXPECT_EQ(drift::terrain::products::split_objects(r.objects, form, "hut.ply").size(), 1u);
 }
 
 TEST(SnowfallOcclusion, SpreadGivesPartialSnowAtTheRoofEdgeAndNoneDeepUnder) {
