@@ -177,10 +177,11 @@ void check_sections(const toml::table& root, const fs::path& path) {
   for (const auto& [k, node] : root) {
     const std::string key(k.str());
     if (std::find(sections.begin(), sections.end(), key) != sections.end()) continue;
-    std::string known;
-    for (const std::string& s : sections) known += (known.empty() ? "" : ", ") + s;
-    throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
-                ": unknown section '" + key + "' (known: " + known + ")");
+    std::string message = path.string() + ":" + std::to_string(node.source().begin.line);
+    message.append(": unknown section '").append(key).append("' (known: ");
+    for (std::size_t i = 0; i < sections.size(); ++i)
+      message.append(i ? ", " : "").append(sections[i]);
+    throw Error(message + ")");
   }
 }
 

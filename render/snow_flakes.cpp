@@ -111,11 +111,10 @@ float clumped_coverage(double u, double v, float coverage, unsigned seed, double
   return coverage + kFlakeClumping * std::min(coverage, 1.0f - coverage) * m;
 }
 
-float flake_cover(const Eigen::Vector3d& p, const Eigen::Vector3f& normal, float coverage,
-                  double footprint) {
-  if (!(coverage > 0.0f)) return 0.0f;
-  if (!(coverage < 1.0f)) return 1.0f;
-  const PlanePoint q = project(p, normal);
+namespace {
+
+// The pattern at plane point q for a round footprint `footprint` wide.
+float cover_at(const PlanePoint& q, float coverage, double footprint) {
   const float local = clumped_coverage(q.u, q.v, coverage, q.seed, footprint);
   // Flakes are kept whole while the footprint is below two diameters and
   // gone above four, where it holds a dozen flake areas and their covered
@@ -127,6 +126,39 @@ float flake_cover(const Eigen::Vector3d& p, const Eigen::Vector3f& normal, float
   if (keep <= 0.0f) return local;
   const float flakes = flake_covers(q.u, q.v, local, q.seed) ? 1.0f : 0.0f;
   return local + keep * (flakes - local);
+}
+
+// How many times longer than wide the footprint is on the surface (1 seen
+// head-on or with no ray), and the unit direction of its long axis.
+double stretch(const Eigen::Vector3f& normal, const Eigen::Vector3f& ray, Eigen::Vector3d& along) {
+  const Eigen::Vector3f n = normal.normalized();
+  const float cos_in = std::abs(ray.dot(n));
+  const Eigen::Vector3f t = ray - ray.dot(n) * n;  // the ray projected onto the surface
+  if (!(t.norm() > 1e-6f) || !(cos_in > 0.0f)) return 1.0;
+  along = t.normalized().cast<double>();
+  return std::min(1.0 / cos_in, 1e6);
+}
+
+}  // namespace
+
+float flake_cover(const Eigen::Vector3d& p, const Eigen::Vector3f& normal, float coverage,
+                  double footprint, const Eigen::Vector3f& ray) {
+  if (!(coverage > 0.0f)) return 0.0f;
+  if (!(coverage < 1.0f)) return 1.0f;
+  Eigen::Vector3d along = Eigen::Vector3d::Zero();
+  const double s = footprint > 0.0 ? stretch(normal, ray, along) : 1.0;
+  if (s < 1.5) return cover_at(project(p, normal), coverage, footprint);
+  // Probes spaced evenly along the long axis, each as wide as the footprint
+  // (wider when kMaxProbes do not reach along it).
+  const double length = footprint * s;
+  const int probes = std::min(static_cast<int>(std::ceil(s)), kMaxProbes);
+  const double width = std::max(footprint, length / probes);
+  float sum = 0.0f;
+  for (int k = 0; k < probes; ++k) {
+    const double offset = ((k + 0.5) / probes - 0.5) * length;
+    sum += cover_at(project(p + offset * along, normal), coverage, width);
+  }
+  return sum / static_cast<float>(probes);
 }
 
 }  // namespace drift::render

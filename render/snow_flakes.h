@@ -23,6 +23,16 @@
 // clumps' octaves fade likewise. Far away the value is c exactly (no shimmer,
 // no aliasing, the mean kept at every footprint).
 //
+// At grazing angles the footprint on the surface is an ellipse, `footprint`
+// wide across the ray and footprint / cos(incidence) long along it (the ray
+// cone cut by the surface, as ray-differential texture filtering has it;
+// Igehy 1999): the pattern is then the mean of probes spaced along the long
+// axis, each filtered at the footprint's width (or at the long axis over
+// kMaxProbes, when more would be needed), as anisotropic texture filtering
+// takes several probes along the axis. Each probe keeps the mean, so the
+// average stays the coverage, and the flakes a long footprint spans are
+// averaged, not point-sampled (no shimmer).
+//
 // On steep faces (stuck flakes) the pattern lies in the plane that faces the
 // surface most squarely (x-y, y-z or x-z by the normal's largest component),
 // so flakes stay round on walls; the planes use their own seeds.
@@ -51,8 +61,13 @@ constexpr float kFlakeDepth = 0.01f;
 // below 2 diameters), the local coverage where it spans many (above 4), c
 // exactly beyond the clumps' scale.
 // 0 for c <= 0, 1 for c >= 1.
+// `ray` (unit; zero: seen head-on) is the ray's direction: the footprint
+// stretches along it at grazing angles.
 float flake_cover(const Eigen::Vector3d& p, const Eigen::Vector3f& normal, float coverage,
-                  double footprint);
+                  double footprint, const Eigen::Vector3f& ray = Eigen::Vector3f::Zero());
+
+// Most probes along a stretched footprint.
+constexpr int kMaxProbes = 8;
 
 // The pattern's parts, for tests: whether flakes landed by tau(c) cover point
 // (u, v) of a plane with seed `seed` (no clumping, no filtering) ...

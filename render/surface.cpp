@@ -108,7 +108,7 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
     const MaterialLayer& layer = surface.layers[i];
     const float mask = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f);
     const float w = mask * layer.opacity;
-    put_on_top(layer.material, layer.flakes ? flake_cover({x, y, relief.z}, normal, w, footprint) : w,
+    put_on_top(layer.material, layer.flakes ? flake_cover({x, y, relief.z}, normal, w, footprint, relief.ray) : w,
                &CoverageChannels::layers, i);
   }
 }
@@ -171,7 +171,7 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
     snow.albedo = layer_albedo(snow.albedo, ground.albedo, surface.snow_scattering * lying);
   }
   // Coverage below full shows as flakes (render/snow_flakes.h).
-  p.snow = flake_cover({x, y, relief.z}, normal, p.snow, footprint);
+  p.snow = flake_cover({x, y, relief.z}, normal, p.snow, footprint, relief.ray);
   p.material = mix(ground, snow, p.snow);
   if (channels) cover(p.coverage, channels->snow, p.snow);
   if (normal.z() > 1e-3f)

@@ -108,6 +108,9 @@ struct Relief {
   // The point's rendered height (CRS metres, exaggerated): with (x, y) it
   // places world-space patterns (render/snow_flakes.h).
   double z = 0.0;
+  // The ray's direction (unit; zero: unknown): at grazing angles the
+  // footprint stretches along it (render/snow_flakes.h).
+  Eigen::Vector3f ray{0, 0, 0};
 };
 
 // Evaluates the layers at CRS point (x, y) with the smooth terrain normal

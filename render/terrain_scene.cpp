@@ -275,6 +275,7 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;
+  hit.direction = d;
   const bool surround = rh.hit.geomID == surround_geometry_;
   std::optional<Eigen::Vector3f> facet;  // beyond the DEM: its smooth normal, facing up
   if (surround) facet = surround_normal(rh.hit.primID, rh.hit.u, rh.hit.v);
@@ -308,6 +309,7 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
   relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
                      static_cast<float>(180.0 / std::numbers::pi);
   relief.z = world.z();
+  relief.ray = hit.direction;
   const SurfacePoint surface =
       shade_terrain(surface_, world.x(), world.y(), n, footprint(cone, hit), relief, &coverage_);
   hit.material = surface.material;
@@ -330,7 +332,8 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
         (1.0f - u - v) * cover[tri[0]] + u * cover[tri[1]] + v * cover[tri[2]], 0.0f, 1.0f);
     // Below full coverage, flakes (render/snow_flakes.h).
     const float c =
-        flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean, footprint);
+        flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean, footprint,
+                    hit.direction);
     hit.material = mix(hit.material, surface_.snow, c);
     hit.snow = c;
     hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel

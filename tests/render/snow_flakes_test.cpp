@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -262,6 +264,50 @@ TEST(SnowFlakes, StuckFlakesOnAWallWithoutDepthReadWhite) {
     brightest = std::max(brightest, p.material.albedo.minCoeff());
   }
   EXPECT_GT(brightest, 0.7f);
+}
+
+// Mean and standard deviation of flake_cover on flat ground seen along `ray`.
+Moments sample_along(float coverage, double footprint, const Eigen::Vector3f& ray, int n) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 200.0);
+  double s = 0, s2 = 0;
+  for (int i = 0; i < n; ++i) {
+    const double f =
+        flake_cover({746000.0 + u(rng), 4030000.0 + u(rng), 2000.0}, kUp, coverage, footprint, ray);
+    s += f, s2 += f * f;
+  }
+  Moments m;
+  m.mean = s / n;
+  m.std = std::sqrt(std::max(0.0, s2 / n - m.mean * m.mean));
+  return m;
+}
+
+TEST(SnowFlakes, GrazingFootprintsStretchAlongTheRay) {
+  // A ray 3 degrees above flat ground: a footprint 3 mm across is 5.7 cm (19
+  // times) long on the ground. Filtered as a round 3 mm it would point-sample
+  // the flakes (0 or 1: shimmer from pixel to pixel and frame to frame);
+  // stretched along the ray it averages the flakes it spans, keeping the mean.
+  const float elevation = 3.0f * static_cast<float>(std::numbers::pi / 180.0);
+  const Eigen::Vector3f grazing(std::cos(elevation), 0.0f, -std::sin(elevation));
+  for (const float c : {0.1f, 0.3f, 0.7f}) {
+    SCOPED_TRACE(testing::Message() << "coverage " << c);
+    const double binary = std::sqrt(c * (1.0 - c));
+    const Moments round = sample_along(c, 0.003, Eigen::Vector3f::Zero(), 40000);
+    const Moments stretched = sample_along(c, 0.003, grazing, 40000);
+    std::printf("coverage %.1f: spread %.3f stretched, %.3f round\n", c, stretched.std, round.std);
+    EXPECT_NEAR(round.std, binary, 0.01);  // what the round footprint does
+    EXPECT_NEAR(stretched.mean, c, 0.01);
+    EXPECT_LT(stretched.std, 0.6 * binary);
+    // Far away (a footprint 0.4 m across, 7.6 m along): the coverage exactly.
+    const Moments far = sample_along(c, 0.4, grazing, 2000);
+    EXPECT_NEAR(far.mean, c, 1e-6);
+    EXPECT_LT(far.std, 1e-6);
+  }
+  // Seen head-on the footprint is round: the same value as without a ray.
+  const Eigen::Vector3d p(746001.3, 4030002.7, 2000.0);
+  for (const double footprint : {0.0, 0.003, 0.02})
+    EXPECT_EQ(flake_cover(p, kUp, 0.4f, footprint, Eigen::Vector3f(0, 0, -1)),
+              flake_cover(p, kUp, 0.4f, footprint));
 }
 
 TEST(SnowFlakes, NoneAndFullCoverage) {
