@@ -17,7 +17,7 @@ namespace drift::pipeline {
 namespace {
 
 struct CompareCommandOptions {
-  std::string a, b, diff, metric = "relmse", channels;
+  std::string a, b, diff, metric = "relmse", channels, region;
   double threshold = 1e-2;
   double pixel_threshold = -1.0;
   double fail_percent = 100.0;
@@ -40,8 +40,17 @@ void run_compare(const CompareCommandOptions& o) {
     }
   }
   OutputSet outputs({o.diff}, {o.a, o.b});
-  const render::Image a = render::read_image(o.a);
-  const render::Image b = render::read_image(o.b);
+  render::Image a = render::read_image(o.a);
+  render::Image b = render::read_image(o.b);
+  if (!o.region.empty()) {
+    int x = 0, y = 0, w = 0, h = 0;
+    char tail = 0;
+    if (std::sscanf(o.region.c_str(), "%d,%d,%d,%d%c", &x, &y, &w, &h, &tail) != 4) {
+      usage_error("--region '" + o.region + "' is not X,Y,W,H (pixels, e.g. 0,40,120,50)");
+    }
+    a = render::crop(a, x, y, w, h);
+    b = render::crop(b, x, y, w, h);
+  }
   const render::ComparisonResult r = render::compare_images(a, b, options);
   if (!o.diff.empty()) {
     render::write_image(render::difference_image(r), o.diff,
@@ -92,6 +101,8 @@ void add_compare_command(CLI::App& root) {
   sub->add_option("--diff", o->diff, "write a false-colour per-pixel error map (.png or .exr)");
   sub->add_option("--channels", o->channels,
                   "comma-separated channels to compare (default R,G,B, else all)");
+  sub->add_option("--region", o->region,
+                  "compare only the rectangle X,Y,W,H (pixels from the top left) of both images");
 }
 
 DRIFT_COMMAND(90, add_compare_command);

@@ -9,6 +9,8 @@
 #include <memory>
 #include <mutex>
 
+#include "terrain/temp_registry.h"
+
 namespace drift::pipeline {
 
 namespace {
@@ -32,9 +34,7 @@ std::string format_seconds(double s) {
   return buf;
 }
 
-}  // namespace
-
-ProgressFn terminal_progress(const std::string& label) {
+ProgressFn draw_bar(const std::string& label) {
   if (!isatty(STDERR_FILENO)) return no_progress;
   auto state = std::make_shared<BarState>();
   state->label = label;
@@ -61,6 +61,18 @@ ProgressFn terminal_progress(const std::string& label) {
     if (done) std::fputc('\n', stderr);
     std::fflush(stderr);
     return true;
+  };
+}
+
+}  // namespace
+
+ProgressFn terminal_progress(const std::string& label) {
+  ProgressFn bar = draw_bar(label);
+  if (!stop_wanted_for_tests(TestPoint::progress)) return bar;
+  // Test hook (terrain/temp_registry.h): a stop point during the computation.
+  return [bar](double fraction, std::string_view message) {
+    stop_here_for_tests(TestPoint::progress);
+    return bar(fraction, message);
   };
 }
 

@@ -148,6 +148,8 @@ render::MaterialRule read_rule(const toml::table* table, const fs::path& file, s
   rule.position = read_range(s, "position", -5000.0, 5000.0, 10.0);
   rule.altitude_jitter = static_cast<float>(s.number("altitude_jitter", 0.0, 0.0, 5000.0));
   rule.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
+  rule.clump_size = static_cast<float>(s.number("clump_size", 0.0, 0.0, 1e4));
+  rule.clump_cover = static_cast<float>(s.number("clump_cover", 1.0, 0.0, 1.0));
   s.finish();
   require_material(s, rule.material);
   return rule;

@@ -67,6 +67,24 @@ double ozone_cross_section(double nm) {
 }
 double ozone_density(double h) { return std::max(0.0, 1.0 - std::abs(h - 25000.0) / 15000.0); }
 
+// Each band's Rayleigh coefficient and ozone cross section, worked out once:
+// the tables' integrals ask for them millions of times (same values, same bits).
+struct BandCoefficients {
+  double rayleigh[kBands];
+  double ozone[kBands];
+};
+const BandCoefficients& band_coefficients() {
+  static const BandCoefficients c = [] {
+    BandCoefficients out{};
+    for (int b = 0; b < kBands; ++b) {
+      out.rayleigh[b] = Atmosphere::rayleigh_coefficient(Atmosphere::wavelength_nm(b));
+      out.ozone[b] = ozone_cross_section(Atmosphere::wavelength_nm(b));
+    }
+    return out;
+  }();
+  return c;
+}
+
 // Distance from radius r along cosine-zenith mu to the top of the atmosphere,
 // and to the ground (negative if the ray misses it).
 double distance_to_top(double r, double mu) {
@@ -144,8 +162,8 @@ double Atmosphere::rayleigh_coefficient(double nm) {
 Spectrum Atmosphere::rayleigh_scattering(double h) const {
   Spectrum s{};
   const double density = std::exp(-std::max(h, 0.0) / kRayleighScaleHeight);
-  for (int b = 0; b < kBands; ++b)
-    s[b] = static_cast<float>(rayleigh_coefficient(wavelength_nm(b)) * density);
+  const BandCoefficients& k = band_coefficients();
+  for (int b = 0; b < kBands; ++b) s[b] = static_cast<float>(k.rayleigh[b] * density);
   return s;
 }
 
@@ -163,11 +181,9 @@ Spectrum Atmosphere::extinction(double h) const {
   const double rayleigh = std::exp(-hh / kRayleighScaleHeight);
   const double mie = kMieExtinction * parameters_.aerosol_scale * std::exp(-hh / kMieScaleHeight);
   const double ozone = kMaxOzoneDensity * ozone_density(hh);
-  for (int b = 0; b < kBands; ++b) {
-    const double nm = wavelength_nm(b);
-    s[b] = static_cast<float>(rayleigh_coefficient(nm) * rayleigh + mie +
-                              ozone_cross_section(nm) * ozone);
-  }
+  const BandCoefficients& k = band_coefficients();
+  for (int b = 0; b < kBands; ++b)
+    s[b] = static_cast<float>(k.rayleigh[b] * rayleigh + mie + k.ozone[b] * ozone);
   return s;
 }
 
@@ -206,12 +222,9 @@ double Atmosphere::optical_depth_to_space(double nm, double h, double mu) const 
 }
 
 Spectrum Atmosphere::transmittance_to_space_exact(double h, double mu) const {
-  double rayleigh[kBands], ozone[kBands], depth[kBands];
-  for (int b = 0; b < kBands; ++b) {
-    rayleigh[b] = rayleigh_coefficient(wavelength_nm(b));
-    ozone[b] = ozone_cross_section(wavelength_nm(b));
-  }
-  optical_depths(h, mu, rayleigh, ozone, kBands, depth);
+  const BandCoefficients& k = band_coefficients();
+  double depth[kBands];
+  optical_depths(h, mu, k.rayleigh, k.ozone, kBands, depth);
   Spectrum t{};
   for (int b = 0; b < kBands; ++b) t[b] = static_cast<float>(std::exp(-depth[b]));
   return t;
@@ -305,10 +318,11 @@ void Atmosphere::second_order_light(double r, const Eigen::Vector3d& w, const Ei
     const Spectrum sun_t = transmittance_to_space(hx, x.dot(sun) / rx);
     for (int b = 0; b < kBands; ++b) {
       const double sigma_s = sr[b] + sm[b];
-      const double seg = (1.0 - std::exp(-ext[b] * dt)) / std::max<double>(ext[b], 1e-12);
+      const double step_t = std::exp(-ext[b] * dt);
+      const double seg = (1.0 - step_t) / std::max<double>(ext[b], 1e-12);
       l2[b] += trans[b] * sigma_s * sun_t[b] / (4.0 * kPi) * seg;
       f[b] += trans[b] * sigma_s * seg;
-      trans[b] *= std::exp(-ext[b] * dt);
+      trans[b] *= step_t;
     }
   }
   if (ground >= 0.0) {  // Lambertian ground lit by the sun

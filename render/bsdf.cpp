@@ -1,6 +1,7 @@
 #include "render/bsdf.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -102,12 +103,21 @@ float snow_single(const Eigen::Vector3f& n, const Eigen::Vector3f& wi, const Eig
 // tests/render/bsdf_test.cpp holds to 3e-3).
 const AlbedoTable& snow_table() {
   static const AlbedoTable table([](const Eigen::Vector3f& wo) {
-    const Eigen::Vector3f n(0, 0, 1);
     constexpr int cells = 256;
+    // wi.wo = sin_i sin_o cos(phi) + cos_i cos_o for wo in the x-z plane:
+    // the cosines of the cells' azimuths once, not a direction per cell.
+    static const std::array<float, cells> cos_phi = [] {
+      std::array<float, cells> c{};
+      for (int b = 0; b < cells; ++b) c[b] = std::cos(2.0f * kPi * (b + 0.5f) / cells);
+      return c;
+    }();
+    const float cos_o = wo.z(), sin_o = wo.x();
     const double sum = grid_sum(cells, [&](int a, int b) {
       const float cos_i = (a + 0.5f) / cells;
-      const Eigen::Vector3f wi = around(n, cos_i, 2.0f * kPi * (b + 0.5f) / cells);
-      return snow_single(n, wi, wo) * cos_i;  // dw = dcos dphi
+      const float sin_i = std::sqrt(1.0f - cos_i * cos_i);
+      const float wi_wo = sin_i * sin_o * cos_phi[b] + cos_i * cos_o;
+      // snow_single's value at this wi, times cos_i (dw = dcos dphi).
+      return henyey_greenstein(-wi_wo, kSnowAsymmetry) / (cos_i + cos_o) * cos_i;
     });
     return static_cast<float>(sum * 2.0 * std::numbers::pi / (cells * cells));
   });
@@ -169,6 +179,17 @@ GroundBsdf::GroundBsdf(const Eigen::Vector3f& n, const Eigen::Vector3f& wo,
   m_.wetness = std::clamp(m_.wetness, 0.0f, 1.0f);
   m_.forward_scattering = std::clamp(m_.forward_scattering, 0.0f, 1.0f);
   cos_o_ = n_.dot(wo_);
+  // Snow's single scattering peaks where wi and wo face each other at grazing
+  // angles (P(-wi.wo) / (cos_i + cos_o)): cosine sampling alone finds that
+  // peak rarely and with huge weights, the grain of snow in low light. The
+  // lobe is sampled in proportion to its share R(cos_o) of what snow
+  // reflects towards wo, faded out between grazing views and cos_o = 0.5,
+  // where the peak is mild and cosine samples do better (the lobe about -wo
+  // then points mostly into the ground).
+  if (m_.forward_scattering > 0.0f && cos_o_ > 0.0f) {
+    const float grazing = std::clamp((0.5f - cos_o_) / 0.4f, 0.0f, 1.0f);
+    p_fwd_ = std::min(0.75f, m_.forward_scattering * snow_single_albedo(cos_o_)) * grazing;
+  }
   if (m_.wetness <= 0.0f) return;
   albedo_wet_ = wet_albedo(m_.albedo);
   const float e_o = coat_albedo(cos_o_);
@@ -200,10 +221,27 @@ Eigen::Vector3f GroundBsdf::dry(const Eigen::Vector3f& wi, float on) const {
   return m_.albedo * ((1.0f - s) * on / kPi + s * snow_reflectance(n_, wi, wo_));
 }
 
+Eigen::Vector3f GroundBsdf::diffuse_sample(float u1, float u2) const {
+  if (p_fwd_ <= 0.0f) return cosine_sample(n_, u1, u2);
+  if (u1 >= p_fwd_) return cosine_sample(n_, (u1 - p_fwd_) / (1.0f - p_fwd_), u2);
+  // Henyey-Greenstein about -wo by inversion of its cdf in the scattering
+  // cosine c = -wi.wo (PBRT 3, eq. 15.14 in this sign convention).
+  const float g = kSnowAsymmetry, u = u1 / p_fwd_;
+  const float k = (1.0f - g * g) / (1.0f + g - 2.0f * g * u);
+  const float c = std::clamp((1.0f + g * g - k * k) / (2.0f * g), -1.0f, 1.0f);
+  return around(-wo_, c, 2.0f * kPi * u2);
+}
+
+float GroundBsdf::diffuse_pdf(const Eigen::Vector3f& wi, float cos_i) const {
+  const float cosine = cos_i / kPi;
+  if (p_fwd_ <= 0.0f) return cosine;
+  return (1.0f - p_fwd_) * cosine + p_fwd_ * henyey_greenstein(-wi.dot(wo_), kSnowAsymmetry);
+}
+
 float GroundBsdf::pdf(const Eigen::Vector3f& wi) const {
   const float cos_i = n_.dot(wi);
   if (cos_i <= 0.0f) return 0.0f;
-  float p = (1.0f - p_spec_) * cos_i / kPi;
+  float p = (1.0f - p_spec_) * diffuse_pdf(wi, cos_i);
   if (p_spec_ > 0.0f) {
     // Walter et al. 2007, eqs. 14 and 38: p(wi) = D(h) cos_h / (4 |wo.h|).
     const Eigen::Vector3f h = (wi + wo_).normalized();
@@ -214,15 +252,15 @@ float GroundBsdf::pdf(const Eigen::Vector3f& wi) const {
 }
 
 bool GroundBsdf::sample(float u_lobe, float u1, float u2, Sample& s) const {
-  if (p_spec_ <= 0.0f) {
+  if (p_spec_ <= 0.0f && p_fwd_ <= 0.0f) {
     // Dry: cosine-weighted, so f cos / pdf = pi f: the albedo times the
-    // Oren-Nayar factor, or with snow's lobe its share of pi f_snow.
+    // Oren-Nayar factor.
     s.wi = cosine_sample(n_, u1, u2);
     s.pdf = std::max(n_.dot(s.wi), 0.0f) / kPi;
     s.weight = dry(s.wi, oren_nayar_factor(n_, s.wi, wo_, m_.roughness)) * kPi;
     return true;
   }
-  if (u_lobe < p_spec_) {
+  if (p_spec_ > 0.0f && u_lobe < p_spec_) {
     // A microfacet normal from D(h) cos_h (Walter et al. 2007, eqs. 35-36),
     // then the mirror direction about it.
     if (cos_o_ <= 0.0f) return false;
@@ -231,7 +269,7 @@ bool GroundBsdf::sample(float u_lobe, float u1, float u2, Sample& s) const {
         around(n_, 1.0f / std::sqrt(1.0f + tan2), 2.0f * std::numbers::pi_v<float> * u2);
     s.wi = 2.0f * wo_.dot(h) * h - wo_;
   } else {
-    s.wi = cosine_sample(n_, u1, u2);
+    s.wi = diffuse_sample(u1, u2);
   }
   const float cos_i = n_.dot(s.wi);
   if (cos_i <= 0.0f) return false;

@@ -97,11 +97,16 @@ class GroundBsdf {
     float pdf = 0.0f;
   };
   // Picks the coat with probability specular_probability() (by u_lobe), else
-  // a cosine-weighted diffuse direction (u1, u2). False: no direction (below
-  // the surface).
+  // a diffuse direction (u1, u2): cosine-weighted, or for snow from its
+  // forward lobe with probability forward_probability(). False: no direction
+  // (below the surface).
   bool sample(float u_lobe, float u1, float u2, Sample& s) const;
   // 0 for a dry material (snow included), whose sample() does not look at u_lobe.
   float specular_probability() const { return p_spec_; }
+  // Snow: the share of the diffuse strategy's samples drawn from the
+  // forward-scattering lobe (Henyey-Greenstein about -wo) rather than by
+  // cosine; 0 for other materials.
+  float forward_probability() const { return p_fwd_; }
 
  private:
   Eigen::Vector3f n_, wo_;
@@ -110,8 +115,13 @@ class GroundBsdf {
   float cos_o_ = 0.0f;
   float t_o_ = 1.0f;  // 1 - E(cos_o): what the coat passes towards wo
   float p_spec_ = 0.0f;
+  float p_fwd_ = 0.0f;
   // The part of eval() without the wet coat: rough diffuse and snow.
   Eigen::Vector3f dry(const Eigen::Vector3f& wi, float on) const;
+  // The diffuse strategy: cosine-weighted, mixed for snow with its forward
+  // lobe (u1 picks which and is reused); and its solid-angle density.
+  Eigen::Vector3f diffuse_sample(float u1, float u2) const;
+  float diffuse_pdf(const Eigen::Vector3f& wi, float cos_i) const;
 };
 
 }  // namespace drift::render

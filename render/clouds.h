@@ -16,13 +16,23 @@
 //   function (Henyey & Greenstein 1941, ApJ 93, 70), which gives the bright
 //   rims of thin cloud towards the sun;
 // - the sky from above and the ground from below, through the same slab;
-// - self-shadowing: the sun's path into the layer is taken through the
-//   optical depth half a thickness towards the sun as well as the point's own,
-//   so the sides of thick cloud away from the sun are darker.
+// - a 2.5-D cloud: each column's top stands thickness x tau / density above
+//   the layer's base, so seen from above the sun falls on sloping tops
+//   (sunward flanks bright, lee sides darker), and the sun's ray into a
+//   column is marched over its neighbours towards the sun: where their tops
+//   stand higher it runs through them (self-shadowing);
+// - beneath the layer the air receives less sun: its in-scattering is
+//   scaled by the layer's mean transmittance towards the sun (the ground's
+//   own cloud shadows are exact, per point); and where the layer lies below
+//   the peaks, the terrain's shadow falls on it (render/path_tracer.cpp).
 // The field is filtered by the ray's footprint: octaves finer than it are
 // dropped and the threshold of what they carried is smoothed by their
 // variance (the expected optical depth under Gaussian octaves), so distant
-// cloud keeps its mean and does not shimmer.
+// cloud keeps its mean and does not shimmer. A ray meeting the layer at
+// cosine mu to its vertical covers width / mu of it along its direction:
+// the filter takes that long axis (grazing_footprint), so cloud near the
+// horizon is smooth instead of streaked (an isotropic filter's trade:
+// blurred across rather than aliased along).
 #pragma once
 
 #include <Eigen/Core>
@@ -47,6 +57,14 @@ struct CloudCrossing {
   Eigen::Vector3f up{0, 0, 1};     // the local vertical there (Earth's curvature)
 };
 
+// The layer over a footprint: the share of it under cloud and the
+// (vertical) optical depth of that cloudy share.
+struct CloudSample {
+  float cover = 0.0f;
+  float tau = 0.0f;
+  float mean() const { return cover * tau; }
+};
+
 class CloudLayer {
  public:
   // `origin`: CRS coordinates of local (0, 0, 0) (z: metres above sea level),
@@ -55,8 +73,24 @@ class CloudLayer {
 
   const CloudOptions& options() const { return options_; }
   // Vertical optical depth at local (x, y) for a footprint (metres; 0: every
-  // octave).
-  float optical_depth(double x, double y, double footprint) const;
+  // octave), and with `gradient` its gradient per metre in x, y.
+  float optical_depth(double x, double y, double footprint,
+                      Eigen::Vector2f* gradient = nullptr) const;
+  // The footprint's cloudy share and its optical depth (optical_depth is
+  // their product, the mean).
+  CloudSample covered(double x, double y, double footprint,
+                      Eigen::Vector2f* gradient = nullptr) const;
+  // The 2.5-D cloud: a column of optical depth tau stands this high above the
+  // layer's base (thickness x tau / density: the densest cores the thickest).
+  float top_height(float tau) const;
+  // What reaches the top of the column at `point` (optical depth tau) of the
+  // sun's direct light after the neighbouring columns it passes through on
+  // its way in (1: none in the way); `up` the local vertical.
+  float sun_shadow(const Eigen::Vector3f& point, const Eigen::Vector3f& up,
+                   const Eigen::Vector3f& sun_dir, float tau, float footprint) const;
+  // The layer's direct transmittance towards the sun averaged over the
+  // ground (its mean shadow): what the air beneath it keeps of the sun.
+  float mean_sun_transmittance(const Eigen::Vector3f& sun_dir) const;
   // The first crossing of the ray within (0, max_distance); false if none.
   bool cross(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float max_distance,
              CloudCrossing& crossing) const;
@@ -70,7 +104,8 @@ class CloudLayer {
   float threshold() const { return threshold_; }
 
  private:
-  float field(double x, double y, double footprint, float& lost_std) const;
+  float field(double x, double y, double footprint, float& lost_std,
+              Eigen::Vector2f* gradient) const;
 
   CloudOptions options_;
   Eigen::Vector3d origin_;
@@ -94,6 +129,10 @@ struct CloudLook {
   Eigen::Vector3f radiance{0, 0, 0};
   float transmittance = 1.0f;
 };
+
+// The footprint on the layer of a ray `width` wide meeting it at cosine mu
+// to its vertical: the long axis of its ellipse, width / mu (mu >= 0.02).
+float grazing_footprint(float width, float mu);
 
 CloudLook cloud_look(const CloudLayer& layer, const CloudCrossing& crossing,
                      const Eigen::Vector3f& dir, const CloudLight& light, float footprint);

@@ -25,4 +25,20 @@ int Image::channel_index(std::string_view name) const {
   return it == channels.end() ? -1 : static_cast<int>(it - channels.begin());
 }
 
+Image crop(const Image& image, int x, int y, int w, int h) {
+  if (x < 0 || y < 0 || w < 1 || h < 1 || x + w > image.width || y + h > image.height) {
+    throw Error("the region " + std::to_string(w) + "x" + std::to_string(h) + " at (" +
+                std::to_string(x) + ", " + std::to_string(y) + ") is not inside the " +
+                std::to_string(image.width) + "x" + std::to_string(image.height) + " image");
+  }
+  Image out(w, h, image.channels);
+  const std::size_t row = static_cast<std::size_t>(w) * image.channels.size();
+  for (int r = 0; r < h; ++r) {
+    const float* from =
+        &image.pixels[(static_cast<std::size_t>(y + r) * image.width + x) * image.channels.size()];
+    std::copy(from, from + row, out.pixels.begin() + static_cast<std::ptrdiff_t>(r * row));
+  }
+  return out;
+}
+
 }  // namespace drift::render

@@ -46,4 +46,8 @@ struct Image {
   }
 };
 
+// The pixels of `image` in the rectangle at (x, y) of w x h, every channel
+// kept; throws drift::Error naming the rectangle when it leaves the image.
+Image crop(const Image& image, int x, int y, int w, int h);
+
 }  // namespace drift::render

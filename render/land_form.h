@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "terrain/grid.h"
 
@@ -29,5 +30,14 @@ terrain::HeightField topographic_position(const terrain::HeightField& dem, doubl
 // the terrain raggedly. One field for all rules, so zones shift together
 // (a warm, sheltered slope lifts the forest line and the meadows alike).
 float raggedness(double x, double y);
+
+// Clumps: where a sparse plant cover grows as separate bushes or groups of
+// them (autumn rowan and birch scrub), a rule covers `cover` of the ground in
+// blobs about `size` metres across instead of tinting all of it. The mask
+// is 1 inside a clump and 0 between, with soft edges; the ray's footprint
+// fades it into its mean (`cover`) once the clumps are smaller than a
+// footprint, as the ground detail's octaves fade, so distant scrub keeps its
+// share of the colour and does not shimmer. `seed` tells rules apart.
+float clump_mask(double x, double y, float size, float cover, std::uint64_t seed, double footprint);
 
 }  // namespace drift::render

@@ -91,6 +91,10 @@ struct MaterialRule {
   SoftRange position;
   float altitude_jitter = 0.0f;  // metres: ragged altitude bounds (render/land_form.h)
   float opacity = 1.0f;
+  // Clumps (render/land_form.h: clump_mask): size 0 covers the whole range;
+  // else blobs about clump_size metres across cover clump_cover of it.
+  float clump_size = 0.0f;
+  float clump_cover = 1.0f;
   float weight(float altitude_m, float slope_deg, float position_m = 0.0f) const;
 };
 

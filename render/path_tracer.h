@@ -101,6 +101,13 @@ class PathTracer {
   std::optional<SkySampler> sky_sampler_;
   std::optional<CloudLayer> clouds_;
   CloudLight cloud_light_;
+  float air_under_clouds_ = 1.0f;  // the layer's mean transmittance towards the sun
+  float cloud_altitude_ = 0.0f;    // the layer's altitude in local z
+  // The light on the layer at a crossing (the terrain's shadow where it
+  // lies below the peaks), and the share of in-scattering left to the air
+  // between local heights z0 and z1 beneath it.
+  CloudLight light_on_clouds(const CloudCrossing& c, std::uint64_t& rays) const;
+  float air_shade(float z0, float z1) const;
   float sun_penumbra_ = 0.0f;  // the sun disc's angular diameter (radians)
 };
 

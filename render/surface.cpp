@@ -101,8 +101,10 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
     const float altitude = rule.altitude_jitter > 0.0f
                                ? relief.altitude + rule.altitude_jitter * ragged
                                : relief.altitude;
-    put_on_top(rule.material, rule.weight(altitude, relief.slope_deg, position),
-               &CoverageChannels::rules, i);
+    float w = rule.weight(altitude, relief.slope_deg, position);
+    if (rule.clump_size > 0.0f && w > 0.0f)
+      w *= clump_mask(x, y, rule.clump_size, rule.clump_cover, 0xc1u + 7919u * i, footprint);
+    put_on_top(rule.material, w, &CoverageChannels::rules, i);
   }
   for (std::size_t i = 0; i < surface.layers.size(); ++i) {
     const MaterialLayer& layer = surface.layers[i];

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
+#include <thread>
 
 #include "terrain/error.h"
 
@@ -15,8 +16,9 @@ namespace drift {
 
 namespace {
 
-// A fixed table, no allocation: the handler may only read plain memory and call
-// async-signal-safe functions (unlink, write, _exit).
+// A fixed table, no allocation: the cleanup runs while other threads may be in
+// the middle of anything, so it only reads plain memory and calls unlink,
+// write and _exit.
 constexpr int kSlots = 64;
 enum : int { kFree = 0, kFilling = 1, kLive = 2 };
 struct Slot {
@@ -24,9 +26,10 @@ struct Slot {
   char path[PATH_MAX];
 };
 Slot g_slots[kSlots];
-std::atomic<int> g_deferring{0};  // > 0 while outputs are being renamed into place
-std::atomic<int> g_pending{0};    // a signal that came meanwhile
-static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
+// Held by DeferSignals; the cleanup takes it before touching any file.
+std::recursive_mutex g_defer;
+std::atomic<int> g_renaming{0};  // > 0 while outputs are being renamed into place
+static_assert(std::atomic<int>::is_always_lock_free, "the cleanup reads these without a lock");
 
 void write_text(const char* s) {
   const ssize_t ignored = write(STDERR_FILENO, s, std::strlen(s));
@@ -45,14 +48,6 @@ void write_text(const char* s) {
   _exit(128 + sig);
 }
 
-extern "C" void on_cleanup_signal(int sig) {
-  if (g_deferring.load() > 0) {
-    g_pending.store(sig);
-    return;
-  }
-  clean_up_and_exit(sig, "; temporary files removed, existing outputs left as they were\n");
-}
-
 sigset_t cleanup_signals() {
   sigset_t set;
   sigemptyset(&set);
@@ -62,15 +57,35 @@ sigset_t cleanup_signals() {
   return set;
 }
 
+// The one thread that receives the signals (all others block them). It waits
+// for any creation or renaming in progress (the DeferSignals lock), then cleans
+// up while holding the lock, so no thread can create or rename a file meanwhile.
+void await_signals(sigset_t set) {
+  int sig = 0;
+  while (sigwait(&set, &sig) != 0) {
+  }
+  const bool renaming = g_renaming.load() > 0;
+  g_defer.lock();
+  clean_up_and_exit(sig, renaming
+                             ? " while the outputs were moved into place; they are all complete\n"
+                             : "; temporary files removed, existing outputs left as they were\n");
+}
+
+int wanted_count(TestPoint point) {
+  static const char* write = std::getenv("DRIFT_TEST_STOP_AT_WRITE");
+  static const char* progress = std::getenv("DRIFT_TEST_STOP_AT_PROGRESS");
+  const char* wanted = point == TestPoint::write ? write : progress;
+  return wanted ? std::atoi(wanted) : 0;
+}
+
 }  // namespace
 
 void install_signal_cleanup() {
   static std::once_flag once;
   std::call_once(once, [] {
-    struct sigaction action {};
-    action.sa_handler = on_cleanup_signal;
-    action.sa_mask = cleanup_signals();  // one handler at a time
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &action, nullptr);
+    const sigset_t set = cleanup_signals();
+    pthread_sigmask(SIG_BLOCK, &set, nullptr);
+    std::thread(await_signals, set).detach();
   });
 }
 
@@ -96,22 +111,28 @@ void forget_temp(int slot) {
   if (slot >= 0 && slot < kSlots) g_slots[slot].state.store(kFree, std::memory_order_release);
 }
 
-void stop_here_for_tests() {
-  static const char* wanted = std::getenv("DRIFT_TEST_STOP_AT_WRITE");
-  static std::atomic<int> writes{0};
-  if (wanted && writes.fetch_add(1) + 1 == std::atoi(wanted)) raise(SIGSTOP);
+bool stop_wanted_for_tests(TestPoint point) { return wanted_count(point) > 0; }
+
+void stop_here_for_tests(TestPoint point) {
+  static std::atomic<int> writes{0}, reports{0};
+  const int wanted = wanted_count(point);
+  if (wanted <= 0) return;
+  std::atomic<int>& count = point == TestPoint::write ? writes : reports;
+  if (count.fetch_add(1) + 1 != wanted) return;
+  raise(SIGSTOP);
+  if (std::getenv("DRIFT_TEST_AWAIT_SIGNAL")) {
+    for (;;) pause();  // the signal thread ends the process
+  }
 }
 
-DeferSignals::DeferSignals(bool renaming) : renaming_(renaming) { g_deferring.fetch_add(1); }
+DeferSignals::DeferSignals(bool renaming) : renaming_(renaming) {
+  g_defer.lock();
+  if (renaming_) g_renaming.fetch_add(1);
+}
 
 DeferSignals::~DeferSignals() {
-  if (g_deferring.fetch_sub(1) == 1) {
-    if (const int sig = g_pending.exchange(0)) {
-      clean_up_and_exit(
-          sig, renaming_ ? " while the outputs were moved into place; they are all complete\n"
-                         : "; temporary files removed, existing outputs left as they were\n");
-    }
-  }
+  if (renaming_) g_renaming.fetch_sub(1);
+  g_defer.unlock();
 }
 
 }  // namespace drift

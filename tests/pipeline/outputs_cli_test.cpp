@@ -12,13 +12,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
 #include <sstream>
-#include <thread>
 
 #include "terrain/raster_io.h"
 #include "tests/test_files.h"
@@ -46,12 +44,20 @@ std::vector<std::string> split(const std::string& args) {
   return v;
 }
 
-// Runs drift with `args` (split at spaces). With `stop_at` > 0 the run stops
-// itself as its stop_at-th output starts being written (DRIFT_TEST_STOP_AT_WRITE);
-// `at_stop` then runs, `sig` is sent and the run continued. With `after` > 0 ms
-// and no stop_at, `sig` is sent after that delay.
-Result drift(const std::string& args, const fs::path& dir, int stop_at = 0, int sig = 0,
-             int after_ms = 0, const std::function<void()>& at_stop = {}) {
+// Where a run stops itself so that a test acts at exactly that point
+// (terrain/temp_registry.h): at the n-th output write or the n-th progress
+// report of the computation. n = 0: no stop.
+struct Stop {
+  enum Point { write, progress } point = write;
+  int n = 0;
+};
+
+// Runs drift with `args` (split at spaces). With a stop, `at_stop` runs once
+// the run has stopped itself, then `sig` (if any) is sent and the run continued;
+// with a signal the run waits for it there (DRIFT_TEST_AWAIT_SIGNAL) rather than
+// racing on. No sleeps: where the run is when the signal comes is fixed.
+Result drift(const std::string& args, const fs::path& dir, Stop stop = {}, int sig = 0,
+             const std::function<void()>& at_stop = {}) {
   std::vector<std::string> words = split(args);
   words.insert(words.begin(), DRIFT_EXECUTABLE);
   std::vector<char*> argv;
@@ -59,7 +65,12 @@ Result drift(const std::string& args, const fs::path& dir, int stop_at = 0, int 
   argv.push_back(nullptr);
   std::vector<std::string> env_strings;
   for (char** e = environ; *e; ++e) env_strings.emplace_back(*e);
-  if (stop_at > 0) env_strings.push_back("DRIFT_TEST_STOP_AT_WRITE=" + std::to_string(stop_at));
+  if (stop.n > 0) {
+    env_strings.push_back(std::string(stop.point == Stop::write ? "DRIFT_TEST_STOP_AT_WRITE="
+                                                                : "DRIFT_TEST_STOP_AT_PROGRESS=") +
+                          std::to_string(stop.n));
+    if (sig) env_strings.push_back("DRIFT_TEST_AWAIT_SIGNAL=1");
+  }
   std::vector<char*> envp;
   for (auto& e : env_strings) envp.push_back(e.data());
   envp.push_back(nullptr);
@@ -73,17 +84,15 @@ Result drift(const std::string& args, const fs::path& dir, int stop_at = 0, int 
   posix_spawn_file_actions_destroy(&actions);
   int status = 0;
   bool ended = false;
-  if (stop_at > 0) {
+  if (stop.n > 0) {
     waitpid(pid, &status, WUNTRACED);
     ended = !WIFSTOPPED(status);
+    EXPECT_FALSE(ended) << args << ": ended before its stop point";
     if (!ended) {
       if (at_stop) at_stop();
       if (sig) kill(pid, sig);
       kill(pid, SIGCONT);
     }
-  } else if (sig) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
-    kill(pid, sig);
   }
   if (!ended) waitpid(pid, &status, 0);
   Result r;
@@ -317,7 +326,7 @@ TEST(OutputsCli, SeveralOutputsAreAllOrNothing) {
       }
     }
   };
-  r = drift(render + a.string() + " -o " + b.string(), d, 2, 0, 0, sabotage);
+  r = drift(render + a.string() + " -o " + b.string(), d, {Stop::write, 2}, 0, sabotage);
   EXPECT_EQ(r.status, 1) << r.log;
   EXPECT_EQ(slurp(a), "old a");
   EXPECT_EQ(slurp(b), "old b");
@@ -342,19 +351,23 @@ TEST(OutputsCli, SignalsRemoveTemporaryFilesAndKeepOutputs) {
       const fs::path d = test_dir(), a = d / "a.png", b = d / "b.exr";
       put(a, "old a");
       put(b, "old b");
-      const Result r = drift(render + a.string() + " -o " + b.string(), d, at, sig);
+      const Result r = drift(render + a.string() + " -o " + b.string(), d, {Stop::write, at}, sig);
       EXPECT_EQ(r.status, 128 + sig) << "signal " << sig << " at write " << at << ": " << r.log;
       EXPECT_NE(r.log.find("interrupted by SIG"), std::string::npos) << r.log;
       EXPECT_EQ(slurp(a), "old a");
       EXPECT_EQ(slurp(b), "old b");
       EXPECT_TRUE(hidden_files(d).empty()) << "signal " << sig << " at write " << at;
     }
-    // During the computation (a long dune run), with snapshots already written.
+    // During the computation (a dune run, at its third progress report), with
+    // snapshots already written.
     const fs::path d = test_dir(), out = d / "dunes.tif";
     put(out, "old");
-    const Result r = drift("dunes --size 256 --steps 100000 --snapshot-every 1 -o " + out.string(),
-                           d, 0, sig, 1500);
+    const Result r = drift("dunes --size 64 --steps 100 --snapshot-every 4 -o " + out.string(), d,
+                           {Stop::progress, 3}, sig);
     EXPECT_EQ(r.status, 128 + sig) << r.log;
+    EXPECT_NE(r.log.find("interrupted by SIG"), std::string::npos) << r.log;
+    EXPECT_TRUE(fs::exists(d / "dunes_00016.tif")) << "no snapshot before the stop";
+    EXPECT_FALSE(fs::exists(d / "dunes_00020.tif")) << "went on past the stop";
     EXPECT_EQ(slurp(out), "old");
     EXPECT_TRUE(hidden_files(d).empty()) << "signal " << sig << " during the computation";
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include "render/image.h"
 #include "render/image_compare.h"
 #include "terrain/error.h"
 
@@ -132,6 +133,26 @@ TEST(Compare, DifferenceImageMarksTheChangedPixels) {
   const Image d = difference_image(compare_images(a, b, o));
   EXPECT_EQ(d.at(0, 0, 0) + d.at(0, 0, 1) + d.at(0, 0, 2), 0.0f);
   EXPECT_GT(d.at(8, 8, 0), 0.5f);  // over the tolerance: the warm end of the ramp
+}
+
+TEST(Compare, CropKeepsTheRectangleAndRefusesOneOutside) {
+  Image img(4, 3, {"R", "G"});
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 4; ++x) {
+      img.at(x, y, 0) = static_cast<float>(10 * y + x);
+      img.at(x, y, 1) = -static_cast<float>(10 * y + x);
+    }
+  const Image c = crop(img, 1, 1, 2, 2);
+  ASSERT_EQ(c.width, 2);
+  ASSERT_EQ(c.height, 2);
+  EXPECT_EQ(c.channels, img.channels);
+  EXPECT_EQ(c.at(0, 0, 0), 11.0f);
+  EXPECT_EQ(c.at(1, 0, 0), 12.0f);
+  EXPECT_EQ(c.at(0, 1, 0), 21.0f);
+  EXPECT_EQ(c.at(1, 1, 1), -22.0f);
+  EXPECT_THROW(crop(img, 3, 0, 2, 1), Error);
+  EXPECT_THROW(crop(img, 0, 0, 0, 1), Error);
+  EXPECT_THROW(crop(img, -1, 0, 1, 1), Error);
 }
 
 }  // namespace

@@ -192,6 +192,38 @@ TEST(LandForm, RaggednessIsSmoothBoundedNoise) {
   EXPECT_EQ(raggedness(1.0, 2.0), raggedness(1.0, 2.0));
 }
 
+TEST(LandForm, ClumpsCoverTheirShareAsSeparateBushesAndFadeToItFarAway) {
+  // Scrub in clumps of 20 m over 35 % of the ground: close up the mask is
+  // mostly all or nothing (bushes and gaps, not a tint) and covers 35 %; at
+  // any footprint its mean over the ground stays 35 % (no shift of colour
+  // with distance), and past two clump sizes a footprint sees the mean alone.
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(0.0, 50000.0);
+  const int n = 40000;
+  for (const double footprint : {0.0, 8.0, 15.0, 30.0}) {
+    double sum = 0;
+    int between = 0;
+    for (int i = 0; i < n; ++i) {
+      const float m = clump_mask(u(rng), u(rng), 20.0f, 0.35f, 5, footprint);
+      sum += m;
+      between += m > 0.05f && m < 0.95f;
+    }
+    std::printf("clumps at footprint %.0f m: mean %.3f, %.1f %% neither bush nor gap\n", footprint,
+                sum / n, 100.0 * between / n);
+    EXPECT_NEAR(sum / n, 0.35, 0.03) << "footprint " << footprint;
+    if (footprint == 0.0) EXPECT_LT(static_cast<double>(between) / n, 0.2);
+  }
+  EXPECT_EQ(clump_mask(123.0, 456.0, 20.0f, 0.35f, 5, 45.0), 0.35f);
+  // Another seed, other bushes.
+  int differ = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const double x = u(rng), y = u(rng);
+    differ += (clump_mask(x, y, 20.0f, 0.35f, 5, 0.0) > 0.5f) !=
+              (clump_mask(x, y, 20.0f, 0.35f, 6, 0.0) > 0.5f);
+  }
+  EXPECT_GT(differ, 200);
+}
+
 }  // namespace
 }  // namespace drift::render
 
