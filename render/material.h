@@ -58,9 +58,7 @@ struct MaterialOverride {
   std::optional<float> wetness;
   std::optional<float> forward_scattering;
   std::optional<GroundDetail> detail;
-  bool empty() const {
-    return !albedo && !roughness && !wetness && !forward_scattering && !detail;
-  }
+  bool empty() const { return !albedo && !roughness && !wetness && !forward_scattering && !detail; }
 };
 // A preset as an override that sets every field.
 MaterialOverride full_override(const Material& m);

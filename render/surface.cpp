@@ -85,8 +85,8 @@ Material base_material(const TerrainSurface& surface, double x, double y) {
 // The rules and layers over the base, each over what lies beneath in order
 // (so later ones win where they overlap), and their coverage shares.
 void stack_layers(const TerrainSurface& surface, double x, double y, const Relief& relief,
-                  const Eigen::Vector3f& normal, double footprint,
-                  const CoverageChannels* channels, Material& ground, SurfacePoint& p) {
+                  const Eigen::Vector3f& normal, double footprint, const CoverageChannels* channels,
+                  Material& ground, SurfacePoint& p) {
   auto put_on_top = [&](const MaterialOverride& material, float w,
                         const std::vector<int> CoverageChannels::*entries, std::size_t i) {
     if (!(w > 0.0f)) return;
@@ -110,7 +110,8 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
     const MaterialLayer& layer = surface.layers[i];
     const float mask = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f);
     const float w = mask * layer.opacity;
-    put_on_top(layer.material, layer.flakes ? flake_cover({x, y, relief.z}, normal, w, footprint, relief.ray) : w,
+    put_on_top(layer.material,
+               layer.flakes ? flake_cover({x, y, relief.z}, normal, w, footprint, relief.ray) : w,
                &CoverageChannels::layers, i);
   }
 }

@@ -331,9 +331,8 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
     const float mean = std::clamp(
         (1.0f - u - v) * cover[tri[0]] + u * cover[tri[1]] + v * cover[tri[2]], 0.0f, 1.0f);
     // Below full coverage, flakes (render/snow_flakes.h).
-    const float c =
-        flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean, footprint,
-                    hit.direction);
+    const float c = flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean,
+                                footprint, hit.direction);
     hit.material = mix(hit.material, surface_.snow, c);
     hit.snow = c;
     hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel

@@ -19,12 +19,12 @@ namespace drift::render {
 
 struct Hit {
   float distance = 0.0f;
-  Eigen::Vector3f position{0, 0, 0};  // local (origin-shifted) coordinates
+  Eigen::Vector3f position{0, 0, 0};   // local (origin-shifted) coordinates
   Eigen::Vector3f direction{0, 0, 0};  // the ray's (unit): footprints stretch along it
-  Eigen::Vector3f normal{0, 0, 1};    // unit shading normal, facing the ray
-  Material material{{0, 0, 0}};       // what the BSDF sees (render/bsdf.h)
-  float snow = 0.0f;                  // snow coverage of the surface, [0, 1]
-  Coverage coverage{};                // by TerrainScene::coverage_names()
+  Eigen::Vector3f normal{0, 0, 1};     // unit shading normal, facing the ray
+  Material material{{0, 0, 0}};        // what the BSDF sees (render/bsdf.h)
+  float snow = 0.0f;                   // snow coverage of the surface, [0, 1]
+  Coverage coverage{};                 // by TerrainScene::coverage_names()
 };
 
 // A ray's footprint as a cone (Akenine-Moller et al. 2019, "Texture level of

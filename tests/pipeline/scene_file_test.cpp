@@ -406,18 +406,18 @@ TEST(RenderCommand, SunTimeOverridesTheScenesSun) {
 }
 
 TEST(SceneFile, ReadsMaterialRulesAndLayers) {
-  const fs::path p = write_scene("materials.toml",
-                                 std::string(kTerrain) +
-                                     "material = \"rock\"\nwetness = 0.2\n"
-                                     "[[terrain.rule]]\nmaterial = \"grass\"\naltitude_max = 2400\n"
-                                     "altitude_blend = 200\nslope_max = 30\n"
-                                     "[[terrain.rule]]\ncolor = [0.5, 0.4, 0.3]\nslope_min = 40\n"
-                                     "opacity = 0.5\n"
-                                     "[[terrain.layer]]\nmask = \"wet.tif\"\nwetness = 1\n"
-                                     "name = \"puddles\"\n"
-                                     "[[terrain.layer]]\nmask = \"drift.tif\"\nmaterial = \"snow\"\n"
-                                     "[[terrain.layer]]\nmask = \"film.tif\"\nmaterial = \"snow\"\n"
-                                     "flakes = false\n");
+  const fs::path p = write_scene(
+      "materials.toml", std::string(kTerrain) +
+                            "material = \"rock\"\nwetness = 0.2\n"
+                            "[[terrain.rule]]\nmaterial = \"grass\"\naltitude_max = 2400\n"
+                            "altitude_blend = 200\nslope_max = 30\n"
+                            "[[terrain.rule]]\ncolor = [0.5, 0.4, 0.3]\nslope_min = 40\n"
+                            "opacity = 0.5\n"
+                            "[[terrain.layer]]\nmask = \"wet.tif\"\nwetness = 1\n"
+                            "name = \"puddles\"\n"
+                            "[[terrain.layer]]\nmask = \"drift.tif\"\nmaterial = \"snow\"\n"
+                            "[[terrain.layer]]\nmask = \"film.tif\"\nmaterial = \"snow\"\n"
+                            "flakes = false\n");
   const auto s = drift::pipeline::read_scene_file(p);
   const auto& surface = s.input.surface;
   EXPECT_EQ(surface.ground.albedo, drift::render::material_preset("rock")->albedo);
