@@ -112,11 +112,10 @@ Vector3f PathTracer::shaft_loss(const Path& path, float distance, std::uint64_t&
 }
 
 Vector3f PathTracer::cloudy_sky(const Vector3f& origin, const Vector3f& dir, const Vector3f& behind,
-                                bool from_camera, const RayCone& cone) const {
+                                bool from_camera, const RayCone& cone, std::uint64_t& rays) const {
   CloudCrossing c;
   if (!clouds_ || !clouds_->cross(origin, dir, 1e30f, c)) return behind;
   const float footprint = cone.width_at(c.distance);
-  std::uint64_t rays = 0;
   const CloudLook look = cloud_look(*clouds_, c, dir, light_on_clouds(c, rays), footprint);
   if (look.transmittance >= 1.0f) return behind;
   // The sky's light is the air before the layer, the layer, and what lies
@@ -130,13 +129,13 @@ Vector3f PathTracer::cloudy_sky(const Vector3f& origin, const Vector3f& dir, con
          air.transmittance.cwiseProduct(look.radiance);
 }
 
-void PathTracer::cross_clouds(Path& path, float distance, int depth, PixelSample& out) const {
+void PathTracer::cross_clouds(Path& path, float distance, int depth, PixelSample& out,
+                              std::uint64_t& rays) const {
   // Ground seen through the layer: the same composition as cloudy_sky's,
   // with the air and ground behind added by cross_air through the throughput.
   CloudCrossing c;
   if (!clouds_->cross(path.origin, path.dir, distance, c)) return;
   const float footprint = path.cone.width_at(c.distance);
-  std::uint64_t rays = 0;
   const CloudLook look = cloud_look(*clouds_, c, path.dir, light_on_clouds(c, rays), footprint);
   if (look.transmittance >= 1.0f) return;
   const AirSegment air =
@@ -176,7 +175,7 @@ PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& 
       escape_to_sky(path, depth, out, rays);
       break;
     }
-    if (clouds_) cross_clouds(path, hit.distance, depth, out);
+    if (clouds_) cross_clouds(path, hit.distance, depth, out, rays);
     if (air_) cross_air(path, hit, depth, out, rays);
     if (depth == settings_.max_depth) break;
     if (depth == 0) {
@@ -210,7 +209,7 @@ void PathTracer::escape_to_sky(const Path& path, int depth, PixelSample& out,
   }
   if (clouds_) {
     const RayCone cone{path.cone.width, depth == 0 ? path.cone.spread : kCloudLightingSpread};
-    light = cloudy_sky(path.origin, path.dir, light, depth == 0, cone);
+    light = cloudy_sky(path.origin, path.dir, light, depth == 0, cone, rays);
   }
   const float w = depth > 0 && sky_sampler_
                       ? power_heuristic(path.bounce_pdf, sky_sampler_->pdf(path.dir))
@@ -267,7 +266,7 @@ void PathTracer::sample_sky(const Path& path, const Hit& hit, const Vector3f& p,
     Vector3f sky = sky_light(light.dir);
     if (clouds_) {
       const RayCone cone{path.cone.width_at(hit.distance), kCloudLightingSpread};
-      sky = cloudy_sky(p, light.dir, sky, false, cone);
+      sky = cloudy_sky(p, light.dir, sky, false, cone, rays);
     }
     out.radiance += path.throughput.cwiseProduct(f).cwiseProduct(sky) * (cos_l * w / light.pdf);
   }

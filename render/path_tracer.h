@@ -63,11 +63,13 @@ class PathTracer {
   Eigen::Vector3f shaft_loss(const Path& path, float distance, std::uint64_t& rays) const;
   // The cloud layer (render/clouds.h): what a ray from `origin` sees of the
   // sky `behind` the layer, and the layer's light and loss on a path that
-  // crosses it before reaching `distance`.
+  // crosses it before reaching `distance`; `rays` counts the shadow rays
+  // towards the sun from a layer below the peaks (light_on_clouds).
   Eigen::Vector3f cloudy_sky(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
-                             const Eigen::Vector3f& behind, bool from_camera,
-                             const RayCone& cone) const;
-  void cross_clouds(Path& path, float distance, int depth, PixelSample& out) const;
+                             const Eigen::Vector3f& behind, bool from_camera, const RayCone& cone,
+                             std::uint64_t& rays) const;
+  void cross_clouds(Path& path, float distance, int depth, PixelSample& out,
+                    std::uint64_t& rays) const;
   void init_clouds(const SceneInput& input);
   // The steps of trace(), each adding its light to `out`.
   void escape_to_sky(const Path& path, int depth, PixelSample& out, std::uint64_t& rays) const;
