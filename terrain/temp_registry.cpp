@@ -28,7 +28,8 @@ struct Slot {
 Slot g_slots[kSlots];
 // Held by DeferSignals; the cleanup takes it before touching any file.
 std::recursive_mutex g_defer;
-std::atomic<int> g_renaming{0};  // > 0 while outputs are being renamed into place
+std::atomic<int> g_renaming{0};      // > 0 while outputs are being renamed into place
+std::atomic<unsigned> g_renames{0};  // how many renamings have begun
 static_assert(std::atomic<int>::is_always_lock_free, "the cleanup reads these without a lock");
 
 void write_text(const char* s) {
@@ -64,8 +65,12 @@ void await_signals(sigset_t set) {
   int sig = 0;
   while (sigwait(&set, &sig) != 0) {
   }
-  const bool renaming = g_renaming.load() > 0;
+  // A renaming under way when the signal came, or begun before the lock was
+  // ours, has finished by then: its outputs are all complete.
+  const unsigned renames = g_renames.load();
+  const bool renaming_now = g_renaming.load() > 0;
   g_defer.lock();
+  const bool renaming = renaming_now || g_renames.load() != renames;
   clean_up_and_exit(sig, renaming
                              ? " while the outputs were moved into place; they are all complete\n"
                              : "; temporary files removed, existing outputs left as they were\n");
@@ -127,7 +132,10 @@ void stop_here_for_tests(TestPoint point) {
 
 DeferSignals::DeferSignals(bool renaming) : renaming_(renaming) {
   g_defer.lock();
-  if (renaming_) g_renaming.fetch_add(1);
+  if (renaming_) {
+    g_renaming.fetch_add(1);
+    g_renames.fetch_add(1);
+  }
 }
 
 DeferSignals::~DeferSignals() {
