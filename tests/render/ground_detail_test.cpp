@@ -211,7 +211,9 @@ TEST(LandForm, ClumpsCoverTheirShareAsSeparateBushesAndFadeToItFarAway) {
     std::printf("clumps at footprint %.0f m: mean %.3f, %.1f %% neither bush nor gap\n", footprint,
                 sum / n, 100.0 * between / n);
     EXPECT_NEAR(sum / n, 0.35, 0.03) << "footprint " << footprint;
-    if (footprint == 0.0) EXPECT_LT(static_cast<double>(between) / n, 0.2);
+    if (footprint == 0.0) {
+      EXPECT_LT(static_cast<double>(between) / n, 0.2);
+    }
   }
   EXPECT_EQ(clump_mask(123.0, 456.0, 20.0f, 0.35f, 5, 45.0), 0.35f);
   // Another seed, other bushes.
