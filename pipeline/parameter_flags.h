@@ -42,7 +42,7 @@ class ParameterFlags {
       const terrain::Parameter<Options>& p = table_[i];
       if (!p.has_own_flag() || !sub.count(p.flag)) continue;
       if (!p.admits(values_[i]))
-        usage_error(std::string(p.flag) + " is " + terrain::format_value(values_[i]) +
+        usage_error(std::string(p.flag) + " is " + terrain::refused_value(values_[i]) +
                     "; it must lie in " + p.range());
       p.set(o, values_[i]);
     }

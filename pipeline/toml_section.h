@@ -57,7 +57,9 @@ class Section {
     std::optional<double> v = node->value<double>();
     if (!v || node->is_boolean()) fail(key, *node, "must be a number");
     if (!std::isfinite(*v) || *v < lo || *v > hi) {
-      fail(key, *node, "is " + fmt(*v) + "; it must lie in [" + fmt(lo) + ", " + fmt(hi) + "]");
+      fail(key, *node,
+           "is " + terrain::refused_value(*v) + "; it must lie in [" + fmt(lo) + ", " + fmt(hi) +
+               "]");
     }
     return *v;
   }
@@ -208,7 +210,9 @@ class Section {
     const std::optional<double> v = node->value<double>();
     if (!v || node->is_boolean()) fail(key.c_str(), *node, "must be a number");
     if (p.integer && !node->is_integer()) fail(key.c_str(), *node, "must be an integer");
-    if (!p.admits(*v)) fail(key.c_str(), *node, "is " + fmt(*v) + "; it must lie in " + p.range());
+    if (!p.admits(*v))
+      fail(key.c_str(), *node,
+           "is " + terrain::refused_value(*v) + "; it must lie in " + p.range());
     p.set(o, *v);
   }
   const toml::node* take(const char* key) {

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "terrain/error.h"
@@ -34,12 +35,28 @@ inline std::string format_value(double value) {
   return buf;
 }
 
+// A refused value as messages give it: %g, or as many digits as it takes
+// where %g would round it onto a bound ("20.0000001", not "20", beside
+// "[0, 20]").
+inline std::string refused_value(double value) {
+  std::string text = format_value(value);
+  // The fewest digits that read back as the value (at most 17 do).
+  for (int digits = 7;
+       digits <= 17 && std::isfinite(value) && std::strtod(text.c_str(), nullptr) != value;
+       ++digits) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+    text = buf;
+  }
+  return text;
+}
+
 // Throws ParameterError(field, "is VALUE; it must lie in RANGE") unless `ok`
 // (write the check so that NaN fails it). `range` in words: "[1, 32]",
 // "(0, 10] m".
 inline void require_field(bool ok, const std::string& field, double value,
                           const std::string& range) {
-  if (!ok) throw ParameterError(field, "is " + format_value(value) + "; it must lie in " + range);
+  if (!ok) throw ParameterError(field, "is " + refused_value(value) + "; it must lie in " + range);
 }
 
 // Which ends of a range belong to it: [lo, hi], (lo, hi], [lo, hi) or (lo, hi).

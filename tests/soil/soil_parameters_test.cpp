@@ -19,3 +19,18 @@ TEST(SoilParameters, ThePresetsAreValid) {
     EXPECT_NO_THROW(o.validate()) << name;
   }
 }
+
+// A value just past a bound is shown with the digits that tell it from the
+// bound, not rounded onto it ("is 20; it must lie in [0, 20]").
+TEST(SoilParameters, ARefusedValueIsShownAsGiven) {
+  SoilOptions o;
+  o.soil.cohesion = 20.0000001;
+  try {
+    o.validate();
+    ADD_FAILURE() << "cohesion 20.0000001 passed";
+  } catch (const drift::terrain::ParameterError& e) {
+    EXPECT_NE(std::string(e.what()).find("is 20.0000001;"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(drift::terrain::refused_value(40.0), "40");
+  EXPECT_EQ(drift::terrain::refused_value(0.1), "0.1");
+}
