@@ -187,6 +187,24 @@ TEST(Ripples, RotationTurnsTheBumpsAndSlipFacesLoseThem) {
   EXPECT_NEAR((shade_terrain(s, 0.05, -0.05, face, 0.0).normal - face).norm(), 0.0f, 1e-6f);
 }
 
+TEST(Ripples, SnowBuriesThemAndALayerOfColourDoesNot) {
+  TerrainSurface s;
+  NormalDetail ripples;
+  ripples.slopes = SlopePyramid(sine_tile(64, 0.1, 2, 0.05), 0.1);
+  s.normal_details = {ripples};
+  const Eigen::Vector3f up(0, 0, 1);
+  const HeightField everywhere(4, 4, 1.0f, local_georeference(10.0));
+  MaterialLayer wet;
+  wet.material.wetness = 1.0f;
+  wet.mask = everywhere;
+  s.layers = {wet};
+  EXPECT_GT(std::abs(shade_terrain(s, 0.05, -0.05, up, 0.0).normal.x()), 0.05f);
+  Material snow = *material_preset("snow");
+  snow.detail = {};  // the snow's own relief would tilt the normal too
+  s.layers.push_back(drift::testing::snow_layer(everywhere, {}, snow));
+  EXPECT_NEAR((shade_terrain(s, 0.05, -0.05, up, 0.0).normal - up).norm(), 0.0f, 1e-6f);
+}
+
 TEST(OrenNayar, LambertAtZeroRoughnessReciprocalAndBackscattering) {
   const Eigen::Vector3f n(0, 0, 1);
   const Eigen::Vector3f wi = Eigen::Vector3f(0.6f, 0.1f, 0.5f).normalized();
