@@ -51,12 +51,15 @@ struct Preset {
 //   0.95-0.98 (Warren 1982, Rev. Geophys. 20(1)); a little blue. Half of its
 //   reflection through the forward-scattering lobe of render/bsdf.h.
 // Detail (render/ground_detail.h): albedo variation (relative standard
-// deviation), rms slope of the sub-cell relief and its largest wavelength.
+// deviation), rms slope of the sub-cell relief, its largest wavelength and
+// the share of it in jointed blocks (rock; Selby 1980, Z. Geomorph. 24,
+// 31-51: joint spacing of 0.3-3 m and more in hard rock, the blocks'
+// faces the facets a photograph of a ridge shows).
 constexpr float kRough = 0.35f;
 const std::array<Preset, 10> kPresets = {{
-    // name        albedo                  rough wet  fwd   variation bump scale
-    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f}}},
-    {"dark_rock", {{0.135f, 0.118f, 0.098f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f}}},
+    // name        albedo                  rough wet  fwd   variation bump scale fracture
+    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f, 0.5f}}},
+    {"dark_rock", {{0.13f, 0.118f, 0.102f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f, 0.3f}}},
     {"scree", {{0.18f, 0.17f, 0.155f}, 0.5f, 0.0f, 0.0f, {0.2f, 0.35f, 2.0f}}},
     {"meadow", {{0.11f, 0.10f, 0.05f}, 0.7f, 0.0f, 0.0f, {0.3f, 0.2f, 3.0f}}},
     {"dwarf_pine", {{0.028f, 0.042f, 0.022f}, 0.9f, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f}}},
@@ -101,7 +104,7 @@ Material blend(const Material& under, const MaterialOverride& over, float t) {
     const GroundDetail& a = under.detail;
     const GroundDetail& b = *over.detail;
     out.detail = {a.variation * (1 - t) + b.variation * t, a.bump * (1 - t) + b.bump * t,
-                  a.scale * (1 - t) + b.scale * t};
+                  a.scale * (1 - t) + b.scale * t, a.fracture * (1 - t) + b.fracture * t};
   }
   return out;
 }

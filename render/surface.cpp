@@ -104,6 +104,8 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
     float w = rule.weight(altitude, relief.slope_deg, position);
     if (rule.clump_size > 0.0f && w > 0.0f)
       w *= clump_mask(x, y, rule.clump_size, rule.clump_cover, 0xc1u + 7919u * i, footprint);
+    if (rule.patch_size > 0.0f && w > 0.0f && w < 1.0f)
+      w = clump_mask(x, y, rule.patch_size, w, 0x9a7u + 7919u * i, footprint);
     put_on_top(rule.material, w, &CoverageChannels::rules, i);
   }
   for (std::size_t i = 0; i < surface.layers.size(); ++i) {
