@@ -2,8 +2,11 @@
 // material mask for the snow material (cover), a height change that is also
 // the snow's thickness (depth), and the snowy objects, an attributed mesh of
 // the declared form terrain::products::kSnowyObjects (objects).
+#include <optional>
+
 #include "pipeline/scene_products.h"
 #include "render/material.h"
+#include "render/surface.h"
 #include "terrain/error.h"
 #include "terrain/mesh_io.h"
 #include "terrain/products.h"
@@ -32,33 +35,62 @@ void place_snowy_objects(SceneFile& scene, const std::filesystem::path& file) {
   }
 }
 
-void load_snow(SceneFile& scene) {
-  render::TerrainSurface& surface = scene.input.surface;
+// The snow's look, from [snow]'s keys.
+struct SnowLook {
+  render::Material material = *render::material_preset("snow");
+  // Kubelka-Munk scattering coefficient of the snowpack, per metre
+  // (render::LayerThickness): 400/m is fresh snow of about 0.1 mm grains at
+  // 300 kg/m^3 (reduced scattering ~500/m, Wiscombe & Warren 1980); 1 cm over
+  // black rock then reflects 0.79 where deep snow reflects 0.90.
+  float scattering = 400.0f;
+  float cover_outside = 0.0f;  // the cover beyond its raster (a cropped snowfall)
+};
+
+// Snow cover as a material mask of the snow material, laid last over the
+// ground's layers; with a depth it is translucent where thin, and it buries
+// normal details (ripples).
+render::MaterialLayer snow_layer(const SnowLook& look, terrain::HeightField cover,
+                                 const std::optional<terrain::HeightField>& depth) {
+  render::MaterialLayer layer;
+  layer.name = "snow";
+  layer.material = render::full_override(look.material);
+  layer.mask = std::move(cover);
+  layer.outside = look.cover_outside;
+  layer.flakes = true;  // thin snow and stuck flakes (paper 003, 2.1(4))
+  if (depth) layer.thickness = render::LayerThickness{*depth, look.scattering};
+  layer.buries_details = true;
+  return layer;
+}
+
+void load_snow(SceneFile& scene, const SnowLook& look) {
   if (const auto objects = scene.product_file("snow.objects"); !objects.empty())
     place_snowy_objects(scene, objects);
-  if (const auto cover = scene.product_file("snow.cover"); !cover.empty())
-    surface.snow_cover = read_metric_raster(cover);
-  if (const auto depth = scene.product_file("snow.depth"); !depth.empty()) {
+  std::optional<terrain::HeightField> depth;
+  if (const auto file = scene.product_file("snow.depth"); !file.empty()) {
     // The snow's depth both raises the surface and sets its translucency.
-    surface.snow_depth = read_metric_raster(depth);
-    scene.input.height_changes.push_back({"snow depth", *surface.snow_depth});
+    depth = read_metric_raster(file);
+    scene.input.height_changes.push_back({"snow depth", *depth});
   }
+  if (const auto cover = scene.product_file("snow.cover"); !cover.empty())
+    scene.input.surface.layers.push_back(snow_layer(look, read_metric_raster(cover), depth));
 }
 
 // The snow's look; its products load whether or not the scene has [snow]
-// (the flags may give them).
+// (the flags may give them). Objects whose meshes carry snow coverage take
+// the snow material whatever the scene gives.
 SceneFile::Loader read_snow(Section& snow, SceneFile& scene) {
-  render::TerrainSurface& surface = scene.input.surface;
-  surface.snow.albedo = snow.color("color", surface.snow.albedo);
-  surface.snow.roughness = static_cast<float>(
-      snow.number("roughness", surface.snow.roughness, 0.0, render::kMaxRoughness));
-  surface.snow.forward_scattering = static_cast<float>(
-      snow.number("forward_scattering", surface.snow.forward_scattering, 0.0, 1.0));
-  surface.snow_scattering =
-      static_cast<float>(snow.number("scattering", surface.snow_scattering, 1.0, 1e5));
-  surface.snow_cover_outside =
-      static_cast<float>(snow.number("cover_outside", surface.snow_cover_outside, 0.0, 1.0));
-  return load_snow;
+  SnowLook look;
+  render::Material& m = look.material;
+  m.albedo = snow.color("color", m.albedo);
+  m.roughness =
+      static_cast<float>(snow.number("roughness", m.roughness, 0.0, render::kMaxRoughness));
+  m.forward_scattering =
+      static_cast<float>(snow.number("forward_scattering", m.forward_scattering, 0.0, 1.0));
+  look.scattering = static_cast<float>(snow.number("scattering", look.scattering, 1.0, 1e5));
+  look.cover_outside =
+      static_cast<float>(snow.number("cover_outside", look.cover_outside, 0.0, 1.0));
+  scene.input.surface.object_layers.push_back({products::kSnowCoverage, "snow", m, true});
+  return [look](SceneFile& s) { load_snow(s, look); };
 }
 
 }  // namespace

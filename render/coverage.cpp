@@ -23,7 +23,8 @@ CoverageChannels coverage_channels(const TerrainSurface& surface) {
   c.ground = channel(surface.ground_name);
   for (const MaterialRule& rule : surface.rules) c.rules.push_back(channel(rule.name));
   for (const MaterialLayer& layer : surface.layers) c.layers.push_back(channel(layer.name));
-  c.snow = channel("snow");
+  for (const ObjectLayer& layer : surface.object_layers)
+    c.object_layers.push_back(channel(layer.name));
   return c;
 }
 

@@ -3,7 +3,7 @@
 // not the rock").
 //
 // The ground's material is a stack (render/surface.h): the base, then rules,
-// then layers, then snow, each entry blended over what lies beneath with a
+// then layers (snow cover among them, last), each entry blended over what lies beneath with a
 // weight w. An entry's coverage is its visible share in that stack, as in an
 // image editor's layer stack: putting an entry of weight w on top takes w of
 // every share beneath it and gives it to the entry. The shares of a terrain
@@ -30,12 +30,12 @@ inline void cover(Coverage& shares, int slot, float w) {
 struct TerrainSurface;
 
 // The channels of a surface's stack: its distinct names in stack order (the
-// base first, snow last) and the channel of every entry.
+// base first), then those of the object layers, and the channel of every
+// entry. On objects only their object layers' channels are set.
 struct CoverageChannels {
   std::vector<std::string> names;
   int ground = 0;
-  std::vector<int> rules, layers;
-  int snow = 0;
+  std::vector<int> rules, layers, object_layers;
 };
 
 // Throws drift::Error if the stack has more than kMaxCoverage distinct names.

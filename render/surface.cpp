@@ -82,17 +82,19 @@ Material base_material(const TerrainSurface& surface, double x, double y) {
   return ground;
 }
 
-// The rules and layers over the base, each over what lies beneath in order
-// (so later ones win where they overlap), and their coverage shares.
-void stack_layers(const TerrainSurface& surface, double x, double y, const Relief& relief,
-                  const Eigen::Vector3f& normal, double footprint, const CoverageChannels* channels,
-                  Material& ground, SurfacePoint& p) {
-  auto put_on_top = [&](const MaterialOverride& material, float w,
-                        const std::vector<int> CoverageChannels::*entries, std::size_t i) {
-    if (!(w > 0.0f)) return;
-    ground = blend(ground, material, w);
-    if (channels) cover(p.coverage, (channels->*entries)[i], w);
-  };
+// A weight in [0, 1] put on top of the stack: the material blended over the
+// ground beneath, and its coverage share.
+void put_on_top(const MaterialOverride& material, float w, int channel,
+                const CoverageChannels* channels, Material& ground, SurfacePoint& p) {
+  if (!(w > 0.0f)) return;
+  ground = blend(ground, material, w);
+  if (channels) cover(p.coverage, channel, w);
+}
+
+// The rules over the base, in order (so later ones win where they overlap).
+void stack_rules(const TerrainSurface& surface, double x, double y, const Relief& relief,
+                 double footprint, const CoverageChannels* channels, Material& ground,
+                 SurfacePoint& p) {
   const float position = surface.position ? sample_raster(*surface.position, x, y, 0.0f) : 0.0f;
   float ragged = NAN;  // raggedness(x, y), evaluated once if a rule asks
   for (std::size_t i = 0; i < surface.rules.size(); ++i) {
@@ -106,21 +108,49 @@ void stack_layers(const TerrainSurface& surface, double x, double y, const Relie
       w *= clump_mask(x, y, rule.clump_size, rule.clump_cover, 0xc1u + 7919u * i, footprint);
     if (rule.patch_size > 0.0f && w > 0.0f && w < 1.0f)
       w = clump_mask(x, y, rule.patch_size, w, 0x9a7u + 7919u * i, footprint);
-    put_on_top(rule.material, w, &CoverageChannels::rules, i);
+    put_on_top(rule.material, w, channels ? channels->rules[i] : 0, channels, ground, p);
   }
+}
+
+// A thin layer lets the ground beneath show through (translucency): where
+// it lies it is metres / w deep (w is its share of the ground), flakes
+// (w below 1) at least a flake deep.
+MaterialOverride with_thickness(const MaterialLayer& layer, const Material& beneath, float w,
+                                double x, double y) {
+  MaterialOverride material = layer.material;
+  if (!layer.thickness || !material.albedo || !(w > 0.0f)) return material;
+  // Beyond the thickness raster (a layer's `outside` share, e.g. the storm's
+  // snow on the surround) the layer is as deep as it needs to be: opaque,
+  // not a film 0 m thick through which the bare ground showed.
+  const float raster = sample_raster(layer.thickness->metres, x, y, NAN);
+  if (std::isnan(raster)) return material;
+  const float metres = std::max(raster, 0.0f);
+  const float lying = w < 1.0f ? std::max(metres / w, kFlakeDepth) : metres;
+  material.albedo =
+      layer_albedo(*material.albedo, beneath.albedo, layer.thickness->scattering * lying);
+  return material;
+}
+
+// The layers over the rules, in order, each by its mask.
+void stack_layers(const TerrainSurface& surface, double x, double y, const Relief& relief,
+                  const Eigen::Vector3f& normal, double footprint, const CoverageChannels* channels,
+                  Material& ground, SurfacePoint& p) {
   for (std::size_t i = 0; i < surface.layers.size(); ++i) {
     const MaterialLayer& layer = surface.layers[i];
-    const float mask = std::clamp(sample_raster(layer.mask, x, y, 0.0f), 0.0f, 1.0f);
+    const float mask = std::clamp(sample_raster(layer.mask, x, y, layer.outside), 0.0f, 1.0f);
     const float w = mask * layer.opacity;
-    put_on_top(layer.material,
-               layer.flakes ? flake_cover({x, y, relief.z}, normal, w, footprint, relief.ray) : w,
-               &CoverageChannels::layers, i);
+    const MaterialOverride material = with_thickness(layer, ground, w, x, y);
+    // Below full weight, flakes (render/snow_flakes.h) where the layer asks.
+    const float shown =
+        layer.flakes ? flake_cover({x, y, relief.z}, normal, w, footprint, relief.ray) : w;
+    put_on_top(material, shown, channels ? channels->layers[i] : 0, channels, ground, p);
+    if (layer.buries_details && shown > 0.0f) p.buried += shown * (1.0f - p.buried);
   }
 }
 
 // A normal-detail tile as bump mapping (ripples: paper 002, section 5): the
 // tile's slope at the footprint's level tilts the shading normal p.normal and
-// its unresolved variance roughens the surface; it fades under snow and on
+// its unresolved variance roughens the surface; it fades under buried ground and on
 // steep slopes of the smooth terrain `normal`.
 void apply_normal_detail(const NormalDetail& r, double x, double y, const Eigen::Vector3f& normal,
                          double footprint, SurfacePoint& p) {
@@ -128,7 +158,7 @@ void apply_normal_detail(const NormalDetail& r, double x, double y, const Eigen:
   const float slope_deg =
       std::acos(std::clamp(normal.z(), -1.0f, 1.0f)) * static_cast<float>(180.0 / std::numbers::pi);
   const float keep =
-      (1.0f - p.snow) * (1.0f - smoothstep(r.fade_start_deg, r.fade_end_deg, slope_deg));
+      (1.0f - p.buried) * (1.0f - smoothstep(r.fade_start_deg, r.fade_end_deg, slope_deg));
   if (keep <= 0.0f) return;
   // Ground (x, y) -> tile (u, v): turn by -rotation (the tile is turned clockwise).
   const double a = r.rotation_deg * std::numbers::pi / 180.0;
@@ -159,26 +189,11 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
                            const CoverageChannels* channels) {
   SurfacePoint p;
   p.normal = normal;
-  p.snow = surface.snow_cover
-               ? std::clamp(sample_raster(*surface.snow_cover, x, y, surface.snow_cover_outside),
-                            0.0f, 1.0f)
-               : 0.0f;
   Material ground = base_material(surface, x, y);
   if (channels) p.coverage[channels->ground] = 1.0f;
+  stack_rules(surface, x, y, relief, footprint, channels, ground, p);
   stack_layers(surface, x, y, relief, normal, footprint, channels, ground, p);
-  Material snow = surface.snow;
-  if (surface.snow_depth && p.snow > 0.0f) {
-    // Thin snow lets the ground show through (translucency). Where it lies
-    // it is depth / coverage deep (the coverage is its share of the ground);
-    // flakes (coverage below 1) are at least a flake deep.
-    const float depth = std::max(sample_raster(*surface.snow_depth, x, y, 0.0f), 0.0f);
-    const float lying = p.snow < 1.0f ? std::max(depth / p.snow, kFlakeDepth) : depth;
-    snow.albedo = layer_albedo(snow.albedo, ground.albedo, surface.snow_scattering * lying);
-  }
-  // Coverage below full shows as flakes (render/snow_flakes.h).
-  p.snow = flake_cover({x, y, relief.z}, normal, p.snow, footprint, relief.ray);
-  p.material = mix(ground, snow, p.snow);
-  if (channels) cover(p.coverage, channels->snow, p.snow);
+  p.material = ground;
   if (normal.z() > 1e-3f)
     for (const NormalDetail& tile : surface.normal_details)
       apply_normal_detail(tile, x, y, normal, footprint, p);

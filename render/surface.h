@@ -1,7 +1,8 @@
 // What covers the terrain: materials and the products that place them, by
 // their declared form (terrain/products.h), never by the stage that made
-// them: material masks (MaterialLayer, and the snow's cover), the snow's
-// depth, and normal-detail tiles (NormalDetail). Every raster is sampled by
+// them: material masks (MaterialLayer, such as snow cover, with a thickness
+// such as snow depth), normal-detail tiles (NormalDetail) and the materials
+// objects' per-vertex attributes place (ObjectLayer). Every raster is sampled by
 // CRS coordinates, so it need not share the DEM's grid, only its CRS.
 #pragma once
 
@@ -18,18 +19,49 @@
 
 namespace drift::render {
 
-// A material placed by a raster in the DEM's CRS: the mask's value in [0, 1]
-// (clamped; outside the raster and nodata 0) times `opacity` blends the fields
-// `material` sets over what lies beneath.
+// A material layer's thickness (a height change it also is, e.g. snow depth):
+// thin, it lets what lies beneath show through. Where the layer lies it is
+// metres / weight deep (the weight is its share of the ground), at least
+// kFlakeDepth where it shows as flakes, and reflects layer_albedo(its albedo,
+// the albedo beneath, scattering x that depth) (render/material.h).
+struct LayerThickness {
+  terrain::HeightField metres;  // outside, nodata and below zero: none
+  // Kubelka-Munk scattering coefficient S, per metre (snow's, with its
+  // source: pipeline/scene_snow.cpp).
+  float scattering = 400.0f;
+};
+
+// A material placed by a raster in the DEM's CRS (a material mask,
+// terrain/products.h): the mask's value in [0, 1] (clamped; nodata counts as
+// `outside`, as does everything beyond the raster) times `opacity` blends the
+// fields `material` sets over what lies beneath.
 struct MaterialLayer {
   std::string name = "layer";  // its coverage channel (render/coverage.h)
   MaterialOverride material;
   terrain::HeightField mask;
   float opacity = 1.0f;
+  // The mask's value where the raster does not reach (beyond a cropped
+  // snowfall, on the ground around the DEM: render/surround.h).
+  float outside = 0.0f;
   // Snow placed by a mask: a weight below 1 shows as flakes covering that
-  // share of the ground (render/snow_flakes.h), as snow cover does, not as a
-  // pale film. The scene file sets it for layers of the `snow` preset.
+  // share of the ground (render/snow_flakes.h), not as a pale film. The scene
+  // file sets it for layers of the `snow` preset.
   bool flakes = false;
+  std::optional<LayerThickness> thickness;  // none: opaque however thin
+  // Whether normal details (ripples) fade under it by its weight: snow buries
+  // them, a change of colour does not.
+  bool buries_details = false;
+};
+
+// A material placed on objects by a per-vertex attribute of their meshes
+// (an attributed mesh, terrain/products.h): the attribute's value in [0, 1],
+// interpolated over each triangle, blends `material` over the object's
+// colour, e.g. snow by terrain::products::kSnowCoverage.
+struct ObjectLayer {
+  std::string attribute;  // the meshes' per-vertex attribute
+  std::string name;       // its coverage channel (render/coverage.h)
+  Material material;
+  bool flakes = true;  // a value below 1 shows as flakes (render/snow_flakes.h)
 };
 
 // A normal-detail tile: a periodic height tile bump-mapped on the ground,
@@ -45,27 +77,15 @@ struct NormalDetail {
 
 // The ground's material, bottom to top: `ground` (its albedo from
 // `albedo_map` where that covers the point), then `rules` by altitude and
-// slope, then `layers` by their masks, each over what lies beneath in order,
-// then snow by its cover; then the normal details, in order.
+// slope, then `layers` by their masks (a stage's material masks, such as snow
+// cover, last), each over what lies beneath in order; then the normal
+// details, in order. Objects take `object_layers` by their meshes'
+// attributes.
 struct TerrainSurface {
   Material ground;
   std::string ground_name = "ground";  // its coverage channel (render/coverage.h)
   std::vector<MaterialRule> rules;
   std::vector<MaterialLayer> layers;
-  Material snow = *material_preset("snow");
-  // Kubelka-Munk scattering coefficient S of the snowpack, per metre: with a
-  // depth raster, snow of depth d over the ground reflects layer_albedo(snow,
-  // ground, S d) (render/material.h). 400/m: fresh snow of about 0.1 mm grains
-  // at 300 kg/m^3 (reduced scattering ~500/m, Wiscombe & Warren 1980); 1 cm
-  // over black rock then reflects 0.79 where deep snow reflects 0.90.
-  float snow_scattering = 400.0f;
-  std::optional<terrain::HeightField> snow_cover;  // [0, 1]: snow's share of the surface
-  // The cover where the raster does not reach (beyond a cropped snowfall,
-  // on the ground around the DEM: render/surround.h).
-  float snow_cover_outside = 0.0f;
-  // Metres of snow, for its translucency (layer_albedo above). The surface
-  // traced is raised by SceneInput::height_changes, which hold it too.
-  std::optional<terrain::HeightField> snow_depth;
   std::vector<NormalDetail> normal_details;
   // The ground's albedo draped from an image in the DEM's CRS (an orthophoto
   // or a land-cover colour map): linear R, G, B in [0, 1]; outside it the
@@ -74,6 +94,7 @@ struct TerrainSurface {
   // Topographic position index (render/land_form.h) for rules that use
   // `position`, in the DEM's CRS; made from the DEM when the scene is loaded.
   std::optional<terrain::HeightField> position;
+  std::vector<ObjectLayer> object_layers;
 };
 
 // Reads a draped albedo image (GeoTIFF or any GDAL raster): 3 bands (or 1,
@@ -85,8 +106,10 @@ std::array<terrain::HeightField, 3> read_albedo_map(const std::filesystem::path&
 struct SurfacePoint {
   Material material;
   Eigen::Vector3f normal{0, 0, 1};  // unit shading normal (bumped)
-  float snow = 0.0f;                // snow coverage, for the AOV
-  Coverage coverage{};              // shares by CoverageChannels (if asked for)
+  // The share of the ground under layers that bury details (snow), for
+  // the normal details.
+  float buried = 0.0f;
+  Coverage coverage{};  // shares by CoverageChannels (if asked for)
 };
 
 // Bilinear sample of `raster` at CRS coordinates (x, y); cells outside or

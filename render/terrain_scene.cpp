@@ -162,8 +162,7 @@ void TerrainScene::attach_terrain_grids() {
   rtcReleaseGeometry(grid_geometry);
   terrain_geometries_ = 1;
   mesh_albedo_.push_back(surface_.ground.albedo);
-  mesh_snow_.emplace_back();
-  mesh_snow_triangles_.emplace_back();
+  mesh_covers_.emplace_back();
 }
 
 void TerrainScene::attach_surround(const SurroundOptions& options) {
@@ -187,8 +186,7 @@ void TerrainScene::attach_surround(const SurroundOptions& options) {
   surround_reach_ = ring.reach;
   // Keep the per-geometry tables indexed by id.
   mesh_albedo_.resize(surround_geometry_ + 1, surface_.ground.albedo);
-  mesh_snow_.resize(surround_geometry_ + 1);
-  mesh_snow_triangles_.resize(surround_geometry_ + 1);
+  mesh_covers_.resize(surround_geometry_ + 1);
 }
 
 void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
@@ -213,16 +211,21 @@ void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
   rtcReleaseGeometry(geom);
   if (mesh_albedo_.size() <= id) {
     mesh_albedo_.resize(id + 1);
-    mesh_snow_.resize(id + 1);
-    mesh_snow_triangles_.resize(id + 1);
+    mesh_covers_.resize(id + 1);
   }
   mesh_albedo_[id] = placed.albedo;
-  // An attributed mesh (terrain/products.h) may carry snow coverage.
-  if (const std::vector<float>* cover = placed.mesh.attribute(terrain::products::kSnowCoverage)) {
-    if (cover->size() != placed.mesh.positions.size())
-      throw Error("a mesh's snow coverage must have one value per vertex");
-    mesh_snow_[id] = *cover;
-    mesh_snow_triangles_[id] = placed.mesh.triangles;
+  // An attributed mesh (terrain/products.h) may carry the attributes the
+  // object layers place their materials by (snow coverage).
+  MeshCover& covers = mesh_covers_[id];
+  covers.values.resize(surface_.object_layers.size());
+  for (std::size_t i = 0; i < surface_.object_layers.size(); ++i) {
+    const std::string& name = surface_.object_layers[i].attribute;
+    if (const std::vector<float>* values = placed.mesh.attribute(name)) {
+      if (values->size() != placed.mesh.positions.size())
+        throw Error("a mesh's '" + name + "' attribute must have one value per vertex");
+      covers.values[i] = *values;
+      covers.triangles = placed.mesh.triangles;
+    }
   }
 }
 
@@ -313,7 +316,6 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
   const SurfacePoint surface =
       shade_terrain(surface_, world.x(), world.y(), n, footprint(cone, hit), relief, &coverage_);
   hit.material = surface.material;
-  hit.snow = surface.snow;
   hit.coverage = surface.coverage;
   return surface.normal;
 }
@@ -322,22 +324,26 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
                                              const Eigen::Vector3f& ng, Hit& hit,
                                              double footprint) const {
   hit.material = Material{mesh_albedo_[geometry]};
-  hit.snow = 0.0f;
-  hit.coverage = {};
-  if (geometry < mesh_snow_.size() && !mesh_snow_[geometry].empty()) {
-    // Snow coverage interpolated over the triangle (Embree's barycentrics).
-    const std::vector<float>& cover = mesh_snow_[geometry];
-    const std::array<int, 3>& tri = mesh_snow_triangles_[geometry][triangle];
+  hit.coverage = {};  // the objects themselves have no channel
+  const Eigen::Vector3f n = ng.normalized();
+  if (geometry >= mesh_covers_.size()) return n;
+  const MeshCover& covers = mesh_covers_[geometry];
+  for (std::size_t i = 0; i < covers.values.size(); ++i) {
+    if (covers.values[i].empty()) continue;
+    // The attribute interpolated over the triangle (Embree's barycentrics).
+    const std::vector<float>& values = covers.values[i];
+    const std::array<int, 3>& tri = covers.triangles[triangle];
     const float mean = std::clamp(
-        (1.0f - u - v) * cover[tri[0]] + u * cover[tri[1]] + v * cover[tri[2]], 0.0f, 1.0f);
-    // Below full coverage, flakes (render/snow_flakes.h).
-    const float c = flake_cover(origin_ + hit.position.cast<double>(), ng.normalized(), mean,
-                                footprint, hit.direction);
-    hit.material = mix(hit.material, surface_.snow, c);
-    hit.snow = c;
-    hit.coverage[coverage_.snow] = c;  // the objects themselves have no channel
+        (1.0f - u - v) * values[tri[0]] + u * values[tri[1]] + v * values[tri[2]], 0.0f, 1.0f);
+    // Below full coverage, flakes (render/snow_flakes.h) where the layer asks.
+    const ObjectLayer& layer = surface_.object_layers[i];
+    const float c = layer.flakes ? flake_cover(origin_ + hit.position.cast<double>(), n, mean,
+                                               footprint, hit.direction)
+                                 : mean;
+    hit.material = mix(hit.material, layer.material, c);
+    cover(hit.coverage, coverage_.object_layers[i], c);
   }
-  return ng.normalized();
+  return n;
 }
 
 bool TerrainScene::occluded(const Eigen::Vector3f& o, const Eigen::Vector3f& d,

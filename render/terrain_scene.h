@@ -23,7 +23,6 @@ struct Hit {
   Eigen::Vector3f direction{0, 0, 0};  // the ray's (unit): footprints stretch along it
   Eigen::Vector3f normal{0, 0, 1};     // unit shading normal, facing the ray
   Material material{{0, 0, 0}};        // what the BSDF sees (render/bsdf.h)
-  float snow = 0.0f;                   // snow coverage of the surface, [0, 1]
   Coverage coverage{};                 // by TerrainScene::coverage_names()
 };
 
@@ -83,7 +82,7 @@ class TerrainScene {
   void attach_terrain_grids();
   void attach_mesh(const terrain::PlacedMesh& placed);
 
-  // The hit's material, snow and coverage on the terrain (a footprint from
+  // The hit's material and coverage on the terrain (a footprint from
   // `cone`) or on mesh `geometry`'s `triangle` at barycentrics (u, v) with
   // geometric normal `ng` (seen by a footprint `footprint` metres wide);
   // each returns the shading normal, not yet facing the ray.
@@ -106,11 +105,16 @@ class TerrainScene {
   std::vector<Eigen::Vector3f> vertices_;
   TerrainSurface surface_;
   CoverageChannels coverage_;
+  // What an object's per-vertex attributes place on it (surface_.object_layers):
+  // each layer's values (empty: the mesh lacks the attribute) and the
+  // triangles to interpolate them over.
+  struct MeshCover {
+    std::vector<std::vector<float>> values;  // by object layer
+    std::vector<std::array<int, 3>> triangles;
+  };
   std::vector<Eigen::Vector3f> mesh_albedo_;  // by Embree geometry id
-  // Per-vertex snow coverage and the triangles to interpolate it, by geometry id.
-  std::vector<std::vector<float>> mesh_snow_;
-  std::vector<std::vector<std::array<int, 3>>> mesh_snow_triangles_;
-  unsigned terrain_geometries_ = 0;  // geometry ids [0, n) are terrain grids
+  std::vector<MeshCover> mesh_covers_;        // likewise
+  unsigned terrain_geometries_ = 0;           // geometry ids [0, n) are terrain grids
   // The ground beyond the DEM's edge (render/surround.h): its vertex buffer,
   // grids and Embree geometry id (none: -1).
   void attach_surround(const SurroundOptions& options);

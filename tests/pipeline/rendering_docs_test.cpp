@@ -20,7 +20,9 @@
 #include <vector>
 
 #include "pipeline/scene_file.h"
+#include "render/surface.h"
 #include "terrain/error.h"
+#include "terrain/raster_io.h"
 #include "tests/markdown_table.h"
 
 namespace fs = std::filesystem;
@@ -140,6 +142,21 @@ SceneFile read(const std::string& text) {
   return drift::pipeline::read_scene_file(p);
 }
 
+// The snow as the scene's loaders lay it, given a cover and a depth raster:
+// the layer that holds the [snow] keys' values.
+drift::render::MaterialLayer loaded_snow(SceneFile s) {
+  const drift::terrain::HeightField tiny(2, 2, 0.5f, drift::terrain::local_georeference(1.0));
+  drift::terrain::write_geotiff(tiny, scene_dir() / "snow.tif");
+  s.product_files["snow.cover"] = s.product_files["snow.depth"] = scene_dir() / "snow.tif";
+  for (const auto& [section, load] : s.product_loaders) load(s);
+  return s.input.surface.layers.back();
+}
+
+// The snow material objects take ([snow]'s look).
+const drift::render::Material& object_snow(const SceneFile& s) {
+  return s.input.surface.object_layers.at(0).material;
+}
+
 // The value the reader leaves for a key the scene does not give.
 using Getter = std::function<double(const SceneFile&)>;
 const std::map<std::string, Getter>& getters() {
@@ -150,11 +167,11 @@ const std::map<std::string, Getter>& getters() {
       {"terrain.wetness", [](const SceneFile& s) { return s.input.surface.ground.wetness; }},
       {"terrain.surround_reach", [](const SceneFile& s) { return s.input.surround.reach; }},
       {"terrain.position_radius", [](const SceneFile& s) { return s.position_radius; }},
-      {"snow.roughness", [](const SceneFile& s) { return s.input.surface.snow.roughness; }},
-      {"snow.cover_outside", [](const SceneFile& s) { return s.input.surface.snow_cover_outside; }},
+      {"snow.roughness", [](const SceneFile& s) { return object_snow(s).roughness; }},
+      {"snow.cover_outside", [](const SceneFile& s) { return loaded_snow(s).outside; }},
       {"snow.forward_scattering",
-       [](const SceneFile& s) { return s.input.surface.snow.forward_scattering; }},
-      {"snow.scattering", [](const SceneFile& s) { return s.input.surface.snow_scattering; }},
+       [](const SceneFile& s) { return object_snow(s).forward_scattering; }},
+      {"snow.scattering", [](const SceneFile& s) { return loaded_snow(s).thickness->scattering; }},
       {"sun.azimuth", [](const SceneFile& s) { return s.input.sun.azimuth_deg; }},
       {"sun.elevation", [](const SceneFile& s) { return s.input.sun.elevation_deg; }},
       {"sun.angular_diameter", [](const SceneFile& s) { return s.input.sun.angular_diameter_deg; }},

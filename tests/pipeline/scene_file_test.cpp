@@ -16,6 +16,8 @@
 #include "render/surface.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/products.h"
+#include "terrain/raster_io.h"
 
 namespace fs = std::filesystem;
 
@@ -276,6 +278,40 @@ TEST(SceneFile, ReadsSnowAndRippleLayers) {
   EXPECT_DOUBLE_EQ(s.input.surface.normal_details[0].rotation_deg, 30.0);
   EXPECT_FLOAT_EQ(s.input.surface.normal_details[0].fade_end_deg, 30.0f);
   EXPECT_FLOAT_EQ(s.input.surface.ground.roughness, 0.4f);
+}
+
+TEST(SceneFile, SnowProductsBecomeTheLastMaterialLayerWithTheSnowsLook) {
+  // [snow] cover is a material mask of the snow material laid over the
+  // scene's own layers, translucent by the depth that also raises the
+  // ground, in flakes where thin, burying ripples; objects take the same
+  // snow by their snow-coverage attribute.
+  const fs::path p =
+      write_scene("snow.toml", std::string(kTerrain) +
+                                   "[[terrain.layer]]\nmask = \"wet.tif\"\nwetness = 1\n"
+                                   "[snow]\ncover = \"snow.tif\"\ndepth = \"snow.tif\"\n"
+                                   "color = [0.8, 0.85, 0.9]\nroughness = 0.3\nscattering = 250\n"
+                                   "cover_outside = 1\n");
+  drift::terrain::write_geotiff(
+      drift::terrain::HeightField(2, 2, 0.5f, drift::terrain::local_georeference(1.0)),
+      p.parent_path() / "snow.tif");
+  auto s = drift::pipeline::read_scene_file(p);
+  for (const auto& [section, load] : s.product_loaders) load(s);
+  const auto& surface = s.input.surface;
+  ASSERT_EQ(surface.layers.size(), 2u);
+  const drift::render::MaterialLayer& snow = surface.layers.back();
+  EXPECT_EQ(snow.name, "snow");
+  EXPECT_EQ(*snow.material.albedo, Eigen::Vector3f(0.8f, 0.85f, 0.9f));
+  EXPECT_FLOAT_EQ(*snow.material.roughness, 0.3f);
+  EXPECT_FLOAT_EQ(snow.mask(0, 0), 0.5f);
+  EXPECT_FLOAT_EQ(snow.outside, 1.0f);
+  EXPECT_TRUE(snow.flakes);
+  EXPECT_TRUE(snow.buries_details);
+  ASSERT_TRUE(snow.thickness.has_value());
+  EXPECT_FLOAT_EQ(snow.thickness->scattering, 250.0f);
+  ASSERT_EQ(s.input.height_changes.size(), 1u);
+  ASSERT_EQ(surface.object_layers.size(), 1u);
+  EXPECT_EQ(surface.object_layers[0].attribute, drift::terrain::products::kSnowCoverage);
+  EXPECT_EQ(surface.object_layers[0].material.albedo, *snow.material.albedo);
 }
 
 TEST(SceneFile, BadLayerKeysAreErrors) {

@@ -10,6 +10,7 @@
 #include "render/surface.h"
 #include "render/terrain_scene.h"
 #include "terrain/error.h"
+#include "tests/render/snow_layer.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -68,7 +69,8 @@ TEST(MaterialRules, SoftRangesAndLaterRulesWin) {
   surface.rules = {grass, rock};
   const Material& base = surface.ground;
   auto apply_rules = [&](float altitude, float slope) {
-    return shade_terrain(surface, 0.0, 0.0, Eigen::Vector3f(0, 0, 1), kWholeDetail, {altitude, slope})
+    return shade_terrain(surface, 0.0, 0.0, Eigen::Vector3f(0, 0, 1), kWholeDetail,
+                         {altitude, slope})
         .material;
   };
   EXPECT_EQ(apply_rules(1500.0f, 10.0f).albedo, material_preset("grass")->albedo);
@@ -169,10 +171,12 @@ TEST(MaterialLayers, MasksBlendInOrderUnderSnow) {
   EXPECT_FLOAT_EQ(west.wetness, 0.6f);
   EXPECT_EQ(east.albedo, s.ground.albedo);
   EXPECT_FLOAT_EQ(east.wetness, 0.6f);
-  EXPECT_EQ(shade_terrain(s, 500.0, -15.0, up, kWholeDetail).material.wetness, 0.0f);  // off the masks
+  EXPECT_EQ(shade_terrain(s, 500.0, -15.0, up, kWholeDetail).material.wetness,
+            0.0f);  // off the masks
   // Snow covers everything.
-  s.snow_cover = HeightField(4, 4, 1.0f, local_georeference(10.0));
-  EXPECT_EQ(shade_terrain(s, 5.0, -15.0, up, kWholeDetail).material.albedo, s.snow.albedo);
+  s.layers.push_back(drift::testing::snow_layer(HeightField(4, 4, 1.0f, local_georeference(10.0))));
+  EXPECT_EQ(shade_terrain(s, 5.0, -15.0, up, kWholeDetail).material.albedo,
+            material_preset("snow")->albedo);
 }
 
 TEST(Coverage, SharesFollowTheStackAndSumToOne) {
@@ -193,8 +197,7 @@ TEST(Coverage, SharesFollowTheStackAndSumToOne) {
   wet.material.wetness = 1.0f;
   wet.mask = HeightField(4, 4, 1.0f, local_georeference(10.0));
   wet.opacity = 0.5f;
-  s.layers = {wet};
-  s.snow_cover = HeightField(4, 4, 0.2f, local_georeference(10.0));
+  s.layers = {wet, drift::testing::snow_layer(HeightField(4, 4, 0.2f, local_georeference(10.0)))};
   const CoverageChannels c = coverage_channels(s);
   ASSERT_EQ(c.names, (std::vector<std::string>{"rock", "grass", "wet", "snow"}));
   EXPECT_EQ(c.rules, (std::vector<int>{1, 0}));
@@ -251,13 +254,14 @@ TEST(SnowLayer, ADepthRasterMakesThinSnowGrey) {
   // Full cover everywhere; depth 2 mm in the west, 20 cm in the east.
   TerrainSurface s;
   s.ground.albedo = Eigen::Vector3f::Constant(0.05f);
-  s.snow_cover = HeightField(4, 4, 1.0f, drift::terrain::local_georeference(1.0));
-  s.snow_depth = HeightField(4, 4, 0.002f, drift::terrain::local_georeference(1.0));
-  for (int row = 0; row < 4; ++row) (*s.snow_depth)(3, row) = (*s.snow_depth)(2, row) = 0.2f;
+  HeightField depth(4, 4, 0.002f, drift::terrain::local_georeference(1.0));
+  for (int row = 0; row < 4; ++row) depth(3, row) = depth(2, row) = 0.2f;
+  s.layers.push_back(drift::testing::snow_layer(
+      HeightField(4, 4, 1.0f, drift::terrain::local_georeference(1.0)), depth));
   const Eigen::Vector3f up(0, 0, 1);
   const float thin = shade_terrain(s, 0.5, -1.5, up, kWholeDetail).material.albedo.x();
   const float deep = shade_terrain(s, 3.5, -1.5, up, kWholeDetail).material.albedo.x();
-  EXPECT_NEAR(deep, s.snow.albedo.x(), 1e-3f);
+  EXPECT_NEAR(deep, material_preset("snow")->albedo.x(), 1e-3f);
   EXPECT_LT(thin, 0.6f * deep);
   EXPECT_GT(thin, s.ground.albedo.x());
 }

@@ -14,6 +14,7 @@
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "tests/dem_fixture.h"
+#include "tests/render/snow_layer.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -284,7 +285,8 @@ TEST(Camera, ThinLensRaysMeetOnTheFocalPlane) {
 TEST(Renderer, SkyMaskAndSnowCoverageAovs) {
   SceneInput in;
   in.terrain = make_dem(64, 10.0, [](double, double) { return 0.0; });
-  in.surface.snow_cover = make_dem(64, 10.0, [](double, double) { return 0.25; });
+  in.surface.layers.push_back(
+      drift::testing::snow_layer(make_dem(64, 10.0, [](double, double) { return 0.25; })));
   in.sky.model = SkyModel::Simple;
   const TerrainScene scene(in);
   Camera c;  // level, looking north across the plane: sky above, ground below

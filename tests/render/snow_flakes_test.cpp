@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "render/surface.h"
+#include "tests/render/snow_layer.h"
 
 namespace drift::render {
 namespace {
@@ -51,7 +52,7 @@ TEST(SnowFlakes, CloseUpTheCoveredAreaIsTheCoverage) {
   for (const Eigen::Vector3f& normal :
        {kUp, Eigen::Vector3f(0.95f, 0.1f, 0.3f), Eigen::Vector3f(0.1f, -0.9f, -0.4f)}) {
     for (const float c : kCoverages) {
-      SCOPED_TRACE(testing::Message() << "coverage " << c << " normal " << normal.transpose());
+      SCOPED_TRACE(::testing::Message() << "coverage " << c << " normal " << normal.transpose());
       const Moments m = sample(c, 0.0, normal, 100000, 11);
       EXPECT_NEAR(m.mean, c, 0.006);
       // Binary: the standard deviation of a 0/1 variable of mean c.
@@ -78,7 +79,7 @@ TEST(SnowFlakes, AtDistanceTheAverageIsTheCoverage) {
   // (what a pixel would see shimmer is filtered away), and from the clumps'
   // scale on every point is the coverage exactly.
   for (const float c : {0.05f, 0.3f, 0.6f, 0.95f}) {
-    SCOPED_TRACE(testing::Message() << "coverage " << c);
+    SCOPED_TRACE(::testing::Message() << "coverage " << c);
     double previous_std = 1.0;
     for (const double footprint : {0.01, 0.02, 0.03, 0.06, 0.1, 0.2}) {
       const Moments m = sample(c, footprint, kUp, 50000, 17);
@@ -186,13 +187,20 @@ TEST(SnowFlakes, DeterministicAndOrderFree) {
 // A flat surface 100 m square (local coordinates, origin north-west) of dark
 // rock under snow of coverage `cover` and depth `depth`, without sub-cell
 // detail so that albedos compare exactly.
+// The snow material without its sub-cell detail.
+Material plain_snow() {
+  Material snow = *material_preset("snow");
+  snow.detail = {};
+  return snow;
+}
+
 TerrainSurface thin_snow(float cover, float depth) {
   TerrainSurface s;
   s.ground = *material_preset("dark_rock");
   s.ground.detail = {};
-  s.snow.detail = {};
-  s.snow_cover = terrain::HeightField(100, 100, cover, terrain::local_georeference(1.0));
-  s.snow_depth = terrain::HeightField(100, 100, depth, terrain::local_georeference(1.0));
+  s.layers.push_back(testing::snow_layer(
+      terrain::HeightField(100, 100, cover, terrain::local_georeference(1.0)),
+      terrain::HeightField(100, 100, depth, terrain::local_georeference(1.0)), plain_snow()));
   return s;
 }
 
@@ -201,8 +209,8 @@ TEST(SnowFlakes, ThinSnowShadesAsFlakesUpCloseAndAsTheBlendFarAway) {
   // 3 cm over 0.3 of it): up close each point is bare rock or a flake whose
   // snow lies 3 cm deep (white), 0.3 of them flakes; far away the blend.
   const TerrainSurface s = thin_snow(0.3f, 0.009f);
-  const Eigen::Vector3f flake =
-      layer_albedo(s.snow.albedo, s.ground.albedo, s.snow_scattering * 0.03f);
+  const Eigen::Vector3f flake = layer_albedo(plain_snow().albedo, s.ground.albedo,
+                                             s.layers.back().thickness->scattering * 0.03f);
   std::mt19937_64 rng(41);
   std::uniform_real_distribution<double> u(1.0, 99.0);
   int flakes = 0;
@@ -210,15 +218,15 @@ TEST(SnowFlakes, ThinSnowShadesAsFlakesUpCloseAndAsTheBlendFarAway) {
   for (int i = 0; i < n; ++i) {
     const double x = u(rng), y = -u(rng);
     const SurfacePoint p = shade_terrain(s, x, y, kUp, 0.0);
-    const bool on_flake = p.snow == 1.0f;
-    ASSERT_TRUE(on_flake || p.snow == 0.0f) << p.snow;
+    const bool on_flake = p.buried == 1.0f;
+    ASSERT_TRUE(on_flake || p.buried == 0.0f) << p.buried;
     ASSERT_LT((p.material.albedo - (on_flake ? flake : s.ground.albedo)).norm(), 1e-5f);
     flakes += on_flake;
   }
   EXPECT_NEAR(static_cast<double>(flakes) / n, 0.3, 0.015);
   EXPECT_GT(flake.minCoeff(), 0.85f);  // 3 cm of snow over dark rock reads white
   const SurfacePoint far = shade_terrain(s, 50.0, -50.0, kUp, 5.0);
-  EXPECT_EQ(far.snow, 0.3f);
+  EXPECT_EQ(far.buried, 0.3f);
   EXPECT_LT((far.material.albedo - mix(s.ground, Material{flake}, 0.3f).albedo).norm(), 1e-5f);
 }
 
@@ -228,13 +236,14 @@ TEST(SnowFlakes, SnowPlacedByAMaskShadesAsFlakesToo) {
   // rule as snow cover); far away the even blend, exactly. Without `flakes`
   // the layer stays a film (the blend up close too).
   TerrainSurface s = thin_snow(0.0f, 0.0f);
-  s.snow_cover.reset(), s.snow_depth.reset();
+  s.layers.clear();
+  const Material snow = plain_snow();
   MaterialLayer layer;
-  layer.material.albedo = s.snow.albedo;
+  layer.material.albedo = snow.albedo;
   layer.mask = terrain::HeightField(100, 100, 0.3f, terrain::local_georeference(1.0));
   layer.flakes = true;
   s.layers.push_back(layer);
-  const Eigen::Vector3f film = mix(s.ground, s.snow, 0.3f).albedo;
+  const Eigen::Vector3f film = mix(s.ground, snow, 0.3f).albedo;
   std::mt19937_64 rng(43);
   std::uniform_real_distribution<double> u(1.0, 99.0);
   int flakes = 0;
@@ -242,7 +251,7 @@ TEST(SnowFlakes, SnowPlacedByAMaskShadesAsFlakesToo) {
   for (int i = 0; i < n; ++i) {
     const double x = u(rng), y = -u(rng);
     const Eigen::Vector3f a = shade_terrain(s, x, y, kUp, 0.0).material.albedo;
-    const bool on_flake = (a - s.snow.albedo).norm() < 1e-5f;
+    const bool on_flake = (a - snow.albedo).norm() < 1e-5f;
     ASSERT_TRUE(on_flake || (a - s.ground.albedo).norm() < 1e-5f) << a.transpose();
     flakes += on_flake;
   }
@@ -290,7 +299,7 @@ TEST(SnowFlakes, GrazingFootprintsStretchAlongTheRay) {
   const float elevation = 3.0f * static_cast<float>(std::numbers::pi / 180.0);
   const Eigen::Vector3f grazing(std::cos(elevation), 0.0f, -std::sin(elevation));
   for (const float c : {0.1f, 0.3f, 0.7f}) {
-    SCOPED_TRACE(testing::Message() << "coverage " << c);
+    SCOPED_TRACE(::testing::Message() << "coverage " << c);
     const double binary = std::sqrt(c * (1.0 - c));
     const Moments round = sample_along(c, 0.003, Eigen::Vector3f::Zero(), 40000);
     const Moments stretched = sample_along(c, 0.003, grazing, 40000);

@@ -5,9 +5,11 @@
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <stdexcept>
 
 #include "render/oren_nayar.h"
 #include "render/renderer.h"
@@ -15,6 +17,7 @@
 #include "render/tonemap.h"
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
+#include "tests/render/snow_layer.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -26,6 +29,14 @@ using drift::terrain::local_georeference;
 constexpr double kWholeDetail = 1e6;
 
 namespace {
+
+// The channel of Hit::coverage that snow covers.
+int snow_channel(const TerrainScene& scene) {
+  const auto& names = scene.coverage_names();
+  const auto found = std::find(names.begin(), names.end(), "snow");
+  if (found == names.end()) throw std::runtime_error("the scene has no snow channel");
+  return static_cast<int>(found - names.begin());
+}
 
 constexpr double kPi = std::numbers::pi;
 
@@ -176,6 +187,24 @@ TEST(Ripples, RotationTurnsTheBumpsAndSlipFacesLoseThem) {
   EXPECT_NEAR((shade_terrain(s, 0.05, -0.05, face, 0.0).normal - face).norm(), 0.0f, 1e-6f);
 }
 
+TEST(Ripples, SnowBuriesThemAndALayerOfColourDoesNot) {
+  TerrainSurface s;
+  NormalDetail ripples;
+  ripples.slopes = SlopePyramid(sine_tile(64, 0.1, 2, 0.05), 0.1);
+  s.normal_details = {ripples};
+  const Eigen::Vector3f up(0, 0, 1);
+  const HeightField everywhere(4, 4, 1.0f, local_georeference(10.0));
+  MaterialLayer wet;
+  wet.material.wetness = 1.0f;
+  wet.mask = everywhere;
+  s.layers = {wet};
+  EXPECT_GT(std::abs(shade_terrain(s, 0.05, -0.05, up, 0.0).normal.x()), 0.05f);
+  Material snow = *material_preset("snow");
+  snow.detail = {};  // the snow's own relief would tilt the normal too
+  s.layers.push_back(drift::testing::snow_layer(everywhere, {}, snow));
+  EXPECT_NEAR((shade_terrain(s, 0.05, -0.05, up, 0.0).normal - up).norm(), 0.0f, 1e-6f);
+}
+
 TEST(OrenNayar, LambertAtZeroRoughnessReciprocalAndBackscattering) {
   const Eigen::Vector3f n(0, 0, 1);
   const Eigen::Vector3f wi = Eigen::Vector3f(0.6f, 0.1f, 0.5f).normalized();
@@ -194,20 +223,21 @@ TEST(Snow, CoverBlendsTheMaterialAndDepthRaisesTheSurface) {
   HeightField depth(32, 32, 0.0f, local_georeference(1.0));
   for (int row = 0; row < 32; ++row)
     for (int x = 0; x < 16; ++x) cover(x, row) = 1.0f, depth(x, row) = 2.0f;
-  in.surface.snow_cover = cover;
-  in.surface.snow_depth = depth;
+  Material snow = *material_preset("snow");
+  snow.detail = {};  // the snow's own albedo, without its variation
+  in.surface.layers.push_back(drift::testing::snow_layer(cover, depth, snow));
   in.height_changes = {{"snow depth", depth}};  // a height change raises the traced surface
-  in.surface.snow.detail = {};                  // the snow's own albedo, without its variation
   in.sky.constant = true;
   const TerrainScene scene(in);
   Hit west, east;
   const Eigen::Vector3f down(0, 0, -1);
   ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(4.0, -16.0, 500.0)), down, west));
   ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(28.0, -16.0, 500.0)), down, east));
-  EXPECT_FLOAT_EQ(west.snow, 1.0f);
-  EXPECT_FLOAT_EQ(east.snow, 0.0f);
+  const int snowy = snow_channel(scene);
+  EXPECT_FLOAT_EQ(west.coverage[snowy], 1.0f);
+  EXPECT_FLOAT_EQ(east.coverage[snowy], 0.0f);
   // 2 m of snow is opaque: the snow's own albedo (Kubelka-Munk, to rounding).
-  EXPECT_NEAR((west.material.albedo - in.surface.snow.albedo).norm(), 0.0f, 1e-5f);
+  EXPECT_NEAR((west.material.albedo - snow.albedo).norm(), 0.0f, 1e-5f);
   EXPECT_NEAR((east.material.albedo - in.surface.ground.albedo).norm(), 0.0f, 1e-6f);
   EXPECT_NEAR(east.distance - west.distance, 2.0f, 1e-3f);
 }
@@ -254,14 +284,16 @@ TEST(Snow, MeshCoverageBlendsTheObjectsMaterial) {
   roof.albedo = {0.3f, 0.2f, 0.1f};
   roof.mesh.vertex_attributes = {{drift::terrain::products::kSnowCoverage, {1, 1, 1, 0}}};
   in.meshes.push_back(roof);
+  in.surface.object_layers.push_back(drift::testing::snow_on_objects());
   const TerrainScene scene(in);
   const Eigen::Vector3f down(0, 0, -1);
   Hit near_snowy, near_bare;
   ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(6.2, -9.8, 50.0)), down, near_snowy));
   ASSERT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(9.9, -6.1, 50.0)), down, near_bare));
-  EXPECT_GT(near_snowy.snow, 0.95f);
-  EXPECT_LT(near_bare.snow, 0.1f);
-  EXPECT_NEAR((near_snowy.material.albedo - in.surface.snow.albedo).norm(), 0.0f, 0.05f);
+  const int snowy = snow_channel(scene);
+  EXPECT_GT(near_snowy.coverage[snowy], 0.95f);
+  EXPECT_LT(near_bare.coverage[snowy], 0.1f);
+  EXPECT_NEAR((near_snowy.material.albedo - material_preset("snow")->albedo).norm(), 0.0f, 0.05f);
   EXPECT_NEAR((near_bare.material.albedo - roof.albedo).norm(), 0.0f, 0.1f);
 }
 
