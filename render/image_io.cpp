@@ -159,6 +159,10 @@ void write_exr(const Image& image, const std::filesystem::path& path) {
     spec.full_height = image.frame.full_height;
   }
   for (const auto& [name, value] : image.attributes) spec.attribute("drift:" + name, value);
+  // No creation date: OpenImageIO stamps the current time into capDate when
+  // none is given, and two runs of one scene would differ in their bits
+  // (same inputs and seed, same output). The file's time says when.
+  spec.attribute("DateTime", "");
   write_with_oiio(path, file.temp_path(), spec, OIIO::TypeDesc::FLOAT, image.pixels.data());
   file.commit();
 }

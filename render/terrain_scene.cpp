@@ -325,7 +325,7 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
                                              double footprint) const {
   hit.material = Material{mesh_albedo_[geometry]};
   hit.coverage = {};  // the objects themselves have no channel
-  const Eigen::Vector3f n = ng.normalized();
+  Eigen::Vector3f n = ng.normalized();
   if (geometry >= mesh_covers_.size()) return n;
   const MeshCover& covers = mesh_covers_[geometry];
   for (std::size_t i = 0; i < covers.values.size(); ++i) {
