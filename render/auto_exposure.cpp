@@ -50,8 +50,7 @@ struct Reading {
 
 // The readings of the nearer half of the ground (all if no depth was read):
 // far ground's light is inflated by the air's (auto_exposure.h).
-std::vector<std::pair<double, double>> nearer_half(std::vector<Reading> readings,
-                                                   bool has_depth) {
+std::vector<std::pair<double, double>> nearer_half(std::vector<Reading> readings, bool has_depth) {
   std::vector<std::pair<double, double>> out;
   if (readings.empty()) return out;
   double cut = std::numeric_limits<double>::infinity();
@@ -92,7 +91,8 @@ Metering meter_exposure(const Image& linear, const std::array<float, 3>& white_b
       if (!has_aovs || linear.at(x, y, sky) >= 0.5f) continue;
       const float a = luminance({linear.at(x, y, ar), linear.at(x, y, ag), linear.at(x, y, ab)});
       const float d = depth >= 0 ? linear.at(x, y, depth) : 0.0f;
-      if (a >= kMinAlbedo) readings.push_back(
+      if (a >= kMinAlbedo)
+        readings.push_back(
             {std::log(l / a), w, std::isnan(d) ? std::numeric_limits<double>::infinity() : d});
     }
   }

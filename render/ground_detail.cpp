@@ -63,9 +63,9 @@ constexpr float kMassTone = 0.12f;
 
 // A uniform number in [0, 1) from a hash of (i, j, k).
 float unit_hash(std::int64_t i, std::int64_t j, std::uint64_t k) {
-  const std::uint64_t h = terrain::mix64(kJointSeed ^ (static_cast<std::uint64_t>(i) * 0xd1b54a32d192ed03ULL) ^
-                                         (static_cast<std::uint64_t>(j) * 0x9e3779b97f4a7c15ULL) ^
-                                         (k * 0xbf58476d1ce4e5b9ULL));
+  const std::uint64_t h = terrain::mix64(
+      kJointSeed ^ (static_cast<std::uint64_t>(i) * 0xd1b54a32d192ed03ULL) ^
+      (static_cast<std::uint64_t>(j) * 0x9e3779b97f4a7c15ULL) ^ (k * 0xbf58476d1ce4e5b9ULL));
   return static_cast<float>(h >> 40) * (1.0f / 16777216.0f);
 }
 
@@ -152,8 +152,7 @@ float joint_darkening(const Block& b, double length, double rows, double footpri
                              : std::exp(-(d * d) / (width * width)));
   }
   // Mean of the lines over a block: perimeter x width x sqrt(pi) / 2 / area / 3.
-  const double mean =
-      (length + rows) * width * std::sqrt(std::numbers::pi) / (length * rows) / 3.0;
+  const double mean = (length + rows) * width * std::sqrt(std::numbers::pi) / (length * rows) / 3.0;
   const double dark = std::min(1.0, kJointDarkness * (keep * line + (1.0 - keep) * mean));
   return static_cast<float>((1.0 - dark) / (1.0 - kJointDarkness * mean));
 }
@@ -197,9 +196,9 @@ float joint_tone(double u, double v, float scale, bool layered, double footprint
   const double rows = (layered ? 0.5 : 0.8) * length;
   const float keep = kept(rows, footprint);
   if (keep <= 0.0f) return 1.0f;
-  const Block b =
-      locate_block(u + 5171.3, v + 2237.9, length, rows, layered ? -0.27 : 1.13, 11);
-  const float tone = kMassTone * std::sqrt(3.0f) * (2.0f * unit_hash(b.col.index, b.row.index, 12) - 1.0f);
+  const Block b = locate_block(u + 5171.3, v + 2237.9, length, rows, layered ? -0.27 : 1.13, 11);
+  const float tone =
+      kMassTone * std::sqrt(3.0f) * (2.0f * unit_hash(b.col.index, b.row.index, 12) - 1.0f);
   return (1.0f + keep * tone) * joint_darkening(b, length, rows, footprint, keep);
 }
 
@@ -229,13 +228,11 @@ DetailSlope detail_slope(const GroundDetail& detail, double x, double y, double 
   out.slope = n.gradient;
   out.lost_variance = n.lost_slope_variance;
   if (fracture > 0.0f) {
-    const JointedBlocks b =
-        jointed_blocks(x, y, kBlockLength * detail.scale, std::sqrt(fracture) * detail.bump,
-                       layered, footprint);
+    const JointedBlocks b = jointed_blocks(x, y, kBlockLength * detail.scale,
+                                           std::sqrt(fracture) * detail.bump, layered, footprint);
     out.slope += b.slope;
     out.lost_variance += b.lost_variance;
-    out.joint_factor =
-        b.albedo_factor * joint_tone(x, y, detail.scale, layered, footprint);
+    out.joint_factor = b.albedo_factor * joint_tone(x, y, detail.scale, layered, footprint);
   }
   return out;
 }
@@ -284,8 +281,8 @@ Eigen::Vector2d plane_uv(int i, double x, double y, double z) {
 // The albedo factors (variation, joints) and the bumped normal of a face
 // steep enough for the vertical planes, whose second axis is up the face.
 void triplanar_detail(const GroundDetail& d, const Planes& planes, double x, double y, double z,
-                      const Eigen::Vector3f& normal, double footprint, float& factor,
-                      float& joints, DetailedGround& out) {
+                      const Eigen::Vector3f& normal, double footprint, float& factor, float& joints,
+                      DetailedGround& out) {
   float f = 0.0f, lost = 0.0f, dark = 0.0f;
   Eigen::Vector3f tilt(0, 0, 0);
   const float axis[3] = {std::abs(normal.z()), std::abs(normal.x()), std::abs(normal.y())};
