@@ -1,26 +1,256 @@
 #include "snow/stabilise_grid.h"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "terrain/error.h"
+#include "terrain/memory.h"
 #include "terrain/slope_relax.h"
 
 namespace drift::snow {
 
 namespace {
 
-terrain::SlopeRule snow_rule(double repose_deg) {
-  return {std::tan(repose_deg * std::numbers::pi / 180.0), 0.5, terrain::SlopeShare::HalfSteepest};
+constexpr int kTile = 16;
+// Tiles below which a phase runs on the calling thread (same result either way).
+constexpr std::size_t kParallelTiles = 32;
+// Neighbour k and neighbour 7 - k are opposite (the order of terrain/slope_relax,
+// so that sums are formed in the same order and give the same bits).
+constexpr std::array<int, 8> kDx{-1, 0, 1, -1, 1, -1, 0, 1};
+constexpr std::array<int, 8> kDy{-1, -1, -1, 0, 0, 1, 1, 1};
+
+double tan_deg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
+
+template <class Fn>
+void for_list(const std::vector<int>& items, const Fn& fn) {
+  if (items.size() < kParallelTiles) {
+    for (int t : items) fn(t);
+    return;
+  }
+  tbb::parallel_for(std::size_t{0}, items.size(), [&](std::size_t k) { fn(items[k]); });
 }
 
-// Snow depth on the ground: slopes of ground + snow, snow never below 0.
-terrain::SlopeCells snow_cells(const terrain::SlopeRule& rule, const terrain::Grid<float>& ground) {
-  terrain::SlopeCells cells{{&rule, 1}};
-  cells.base = &ground;
-  cells.min_value = 0.0;
-  return cells;
-}
+// The HalfSteepest passes of terrain/slope_relax, specialised for snow on
+// ground (one rule, floor 0, no ceiling) and written for speed: the snow surface
+// is kept as one array, inner cells skip the edge tests and the repose drop to
+// each neighbour is computed once. Every operation and its order are those of
+// terrain/slope_relax, so the result is the same to the bit.
+class SnowPasses {
+ public:
+  SnowPasses(const terrain::Grid<float>& ground, terrain::Grid<double>& snow, double dx, double dy,
+             double tan_repose, double tolerance)
+      : g_(ground.values().data()),
+        h_(snow.values().data()),
+        w_(snow.width()),
+        hgt_(snow.height()),
+        tol_(tolerance) {
+    for (int k = 0; k < 8; ++k) {
+      drop_[k] = tan_repose * std::hypot(kDx[k] * dx, kDy[k] * dy);
+      offset_[k] = static_cast<std::ptrdiff_t>(kDy[k]) * w_ + kDx[k];
+    }
+    tiles_x_ = (w_ + kTile - 1) / kTile, tiles_y_ = (hgt_ + kTile - 1) / kTile;
+    const std::size_t cells = static_cast<std::size_t>(w_) * hgt_;
+    surface_.resize(cells);
+    for (std::size_t i = 0; i < cells; ++i) surface_[i] = static_cast<double>(g_[i]) + h_[i];
+    give_.assign(cells, 0.0), take_.assign(cells, 0.0), delta_.assign(cells, 0.0);
+    active_.assign(cells, 1), touched_.assign(cells, 0);
+    const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
+    tile_active_.assign(tiles, 1), tile_touched_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
+  }
+
+  // Bytes a grid of `cells` needs on top of the snow and the ground.
+  static std::uint64_t bytes_per_cell() { return 4 * sizeof(double) + 2; }
+
+  // Passes until nothing moves or max_passes; on_pass(passes, active share).
+  template <class OnPass>
+  StabiliseReport run(int max_passes, const OnPass& on_pass) {
+    StabiliseReport report;
+    std::vector<int> active;
+    for (int t = 0; t < tiles_x_ * tiles_y_; ++t) active.push_back(t);
+    while (!active.empty() && report.iterations < max_passes) {
+      ++report.iterations;
+      pass(active);
+      active = next_active(active);
+      on_pass(report.iterations, static_cast<double>(active.size()) / tile_active_.size());
+    }
+    report.converged = active.empty();
+    return report;
+  }
+
+ private:
+  // Calls fn(i, edge) for the cells of a tile; edge: a neighbour may be outside.
+  template <class Fn>
+  void for_cells(int tile, const Fn& fn) const {
+    const int x0 = tile % tiles_x_ * kTile, y0 = tile / tiles_x_ * kTile;
+    const int x1 = std::min(x0 + kTile, w_), y1 = std::min(y0 + kTile, hgt_);
+    for (int y = y0; y < y1; ++y) {
+      const bool edge_row = y == 0 || y == hgt_ - 1;
+      for (int x = x0; x < x1; ++x)
+        fn(static_cast<std::size_t>(y) * w_ + x, edge_row || x == 0 || x == w_ - 1);
+    }
+  }
+  bool inside(std::size_t i, int k) const {
+    const int x = static_cast<int>(i % w_) + kDx[k], y = static_cast<int>(i / w_) + kDy[k];
+    return x >= 0 && y >= 0 && x < w_ && y < hgt_;
+  }
+  // Excess of the slope from cell i down to its neighbour n in direction k.
+  double excess(std::size_t i, std::size_t n, int k) const {
+    return surface_[i] - surface_[n] - drop_[k];
+  }
+
+  // Phase 1, paper 003 2.1(3): a giver gives min(held, e_max / 2), shared among
+  // its steeper neighbours in proportion to their excess; the factor per excess.
+  double give_factor(std::size_t i, bool edge) const {
+    double sum = 0.0, largest = 0.0;
+    for (int k = 0; k < 8; ++k) {
+      if (edge && !inside(i, k)) continue;
+      const double e = excess(i, i + offset_[k], k);
+      if (e <= tol_) continue;
+      sum += e;
+      largest = std::max(largest, e);
+    }
+    if (sum <= 0.0) return 0.0;
+    const double room = std::max(h_[i] - 0.0, 0.0);
+    return room > tol_ ? std::min(room, 0.5 * largest) / sum : 0.0;
+  }
+  // Phase 2: the share of its offers a taker takes (half the largest excess it
+  // is offered from).
+  double take_share(std::size_t i, bool edge) const {
+    double in = 0.0, largest = 0.0;
+    for (int k = 0; k < 8; ++k) {
+      if (edge && !inside(i, k)) continue;
+      const std::size_t n = i + offset_[k];
+      if (!active_[n]) continue;
+      const double e = excess(n, i, 7 - k);
+      if (e <= tol_) continue;
+      in += give_[n] * e;
+      largest = std::max(largest, e);
+    }
+    if (!(in > 0.0)) return 0.0;
+    return std::min(1.0, 0.5 * largest / in);
+  }
+  // Phase 3: the change of cell i, taken - given; marks it touched if it moved.
+  void change(std::size_t i, bool edge) {
+    double out = 0.0, in = 0.0;
+    bool moved = false;
+    if (give_[i] > 0.0 && active_[i])
+      for (int k = 0; k < 8; ++k) {
+        if (edge && !inside(i, k)) continue;
+        const std::size_t n = i + offset_[k];
+        const double e = excess(i, n, k);
+        if (e <= tol_) continue;
+        const double f = give_[i] * e * take_[n];
+        if (f > 0.0) out += f, moved = true;
+      }
+    if (take_[i] > 0.0)
+      for (int k = 0; k < 8; ++k) {
+        if (edge && !inside(i, k)) continue;
+        const std::size_t n = i + offset_[k];
+        if (!active_[n]) continue;
+        const double e = excess(n, i, 7 - k);
+        if (e <= tol_) continue;
+        const double f = give_[n] * e * take_[i];
+        if (f > 0.0) in += f, moved = true;
+      }
+    delta_[i] = in - out;
+    touched_[i] = moved;
+  }
+
+  // One Jacobi pass: every flow from the state before it.
+  void pass(const std::vector<int>& active) {
+    for_list(active, [&](int t) {
+      for_cells(t, [&](std::size_t i, bool edge) {
+        if (active_[i]) give_[i] = give_factor(i, edge);
+      });
+    });
+    near_ = with_neighbours(active);
+    for_list(near_, [&](int t) {
+      for_cells(t, [&](std::size_t i, bool edge) { take_[i] = take_share(i, edge); });
+    });
+    for_list(near_, [&](int t) {
+      bool any = false;
+      for_cells(t, [&](std::size_t i, bool edge) {
+        change(i, edge);
+        any = any || touched_[i];
+      });
+      tile_touched_[static_cast<std::size_t>(t)] = any;
+    });
+    for_list(near_, [&](int t) {
+      for_cells(t, [&](std::size_t i, bool) {
+        h_[i] += delta_[i];
+        surface_[i] = static_cast<double>(g_[i]) + h_[i];
+        give_[i] = take_[i] = delta_[i] = 0.0;
+      });
+    });
+  }
+
+  // The tiles of `tiles` and their 8 neighbours, ascending.
+  std::vector<int> with_neighbours(const std::vector<int>& tiles) {
+    std::vector<int> out;
+    for (int t : tiles) {
+      const int tx = t % tiles_x_, ty = t / tiles_x_;
+      for (int j = std::max(ty - 1, 0); j <= std::min(ty + 1, tiles_y_ - 1); ++j)
+        for (int i = std::max(tx - 1, 0); i <= std::min(tx + 1, tiles_x_ - 1); ++i) {
+          std::uint8_t& mark = tile_mark_[static_cast<std::size_t>(j) * tiles_x_ + i];
+          if (!mark) mark = 1, out.push_back(j * tiles_x_ + i);
+        }
+    }
+    for (int t : out) tile_mark_[static_cast<std::size_t>(t)] = 0;
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  void clear_active(int t) {
+    for_cells(t, [&](std::size_t i, bool) { active_[i] = 0; });
+    tile_active_[static_cast<std::size_t>(t)] = 0;
+  }
+  // A cell is active next pass if it or a neighbour gave or took in this one.
+  void mark_active(int t) {
+    bool any = false;
+    for_cells(t, [&](std::size_t i, bool edge) {
+      bool a = touched_[i] != 0;
+      for (int k = 0; k < 8 && !a; ++k) a = (!edge || inside(i, k)) && touched_[i + offset_[k]];
+      active_[i] = a;
+      any = any || a;
+    });
+    tile_active_[static_cast<std::size_t>(t)] = any;
+  }
+  // The tiles with active cells after a pass; clears the pass's marks.
+  std::vector<int> next_active(const std::vector<int>& was_active) {
+    std::vector<int> touched;
+    for (int t : near_)
+      if (tile_touched_[static_cast<std::size_t>(t)]) touched.push_back(t);
+    const std::vector<int> candidates = with_neighbours(touched);
+    for (int t : candidates) tile_mark_[static_cast<std::size_t>(t)] = 1;
+    for (int t : was_active)
+      if (!tile_mark_[static_cast<std::size_t>(t)]) clear_active(t);
+    for (int t : candidates) tile_mark_[static_cast<std::size_t>(t)] = 0;
+    for_list(candidates, [&](int t) { mark_active(t); });
+    for_list(touched, [&](int t) {
+      for_cells(t, [&](std::size_t i, bool) { touched_[i] = 0; });
+      tile_touched_[static_cast<std::size_t>(t)] = 0;
+    });
+    std::vector<int> next;
+    for (int t : candidates)
+      if (tile_active_[static_cast<std::size_t>(t)]) next.push_back(t);
+    return next;
+  }
+
+  const float* g_;
+  double* h_;
+  int w_, hgt_, tiles_x_ = 0, tiles_y_ = 0;
+  double tol_;
+  std::array<double, 8> drop_{};
+  std::array<std::ptrdiff_t, 8> offset_{};
+  std::vector<double> surface_, give_, take_, delta_;
+  std::vector<std::uint8_t> active_, touched_;
+  std::vector<std::uint8_t> tile_active_, tile_touched_, tile_mark_;
+  std::vector<int> near_;  // this pass: active tiles and their neighbours
+};
 
 }  // namespace
 
@@ -29,23 +259,25 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
                                const ProgressFn& progress) {
   if (!(options.repose_deg > 0.0 && options.repose_deg < 90.0))
     throw Error("the angle of repose of snow must lie in (0, 90) degrees");
-  const terrain::SlopeRule rule = snow_rule(options.repose_deg);
-  const terrain::SlopeRelaxOptions o{dx, dy, options.tolerance, options.max_iterations};
-  const auto r = terrain::relax_slopes_everywhere(
-      snow, snow_cells(rule, ground), o, nullptr, [&](int, double active_share) {
-        if (!progress(1.0 - active_share, "stabilising snow")) throw Cancelled();
-      });
+  if (ground.width() != snow.width() || ground.height() != snow.height())
+    throw Error("stabilise_grid: the ground and the snow grids differ in size");
+  require_memory(snow.size() * SnowPasses::bytes_per_cell(), "snow stabilisation's workspace",
+                 "use a smaller or coarser ground raster");
+  SnowPasses passes(ground, snow, dx, dy, tan_deg(options.repose_deg), options.tolerance);
+  const StabiliseReport report = passes.run(options.max_iterations, [&](int, double active_share) {
+    if (!progress(1.0 - active_share, "stabilising snow")) throw Cancelled();
+  });
   progress(1.0, "stabilising snow");
-  StabiliseReport report;
-  report.iterations = r.passes;
-  report.converged = r.converged;
   return report;
 }
 
 double max_repose_excess(const terrain::Grid<float>& ground, const terrain::Grid<double>& snow,
                          double dx, double dy, double repose_deg, double min_snow) {
-  const terrain::SlopeRule rule = snow_rule(repose_deg);
-  return terrain::max_slope_excess(snow, snow_cells(rule, ground), {dx, dy}, {}, min_snow);
+  const terrain::SlopeRule rule{tan_deg(repose_deg), 0.5, terrain::SlopeShare::HalfSteepest};
+  terrain::SlopeCells cells{{&rule, 1}};
+  cells.base = &ground;
+  cells.min_value = 0.0;
+  return terrain::max_slope_excess(snow, cells, {dx, dy}, {}, min_snow);
 }
 
 }  // namespace drift::snow

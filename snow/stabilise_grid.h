@@ -18,15 +18,24 @@
 // repose angle is 40. A settled pile is an octagonal cone whose flanks along the
 // 8 grid directions stand at the repose angle.
 //
-// The passes are terrain/slope_relax's (SlopeShare::HalfSteepest), shared with
-// marks' erosion: Jacobi passes over the cells next to whatever moved, each flow
-// leaving one cell and entering another as the same double, so mass is
-// conserved to double rounding and the result does not depend on the thread
-// count; the grid's edges are closed (no flow out). Only the cells next to
-// whatever moved in the last pass are looked at, so the cost of a pass follows
-// the snow that is still moving, not the grid. A coarse-to-fine start (settle
-// on 2 x 2 blocks first) was tried and dropped: averaging a block spreads a
-// column before it may slide, so piles ended up to 23 % lower.
+// The passes are terrain/slope_relax's SlopeShare::HalfSteepest passes (shared
+// with marks' erosion), specialised here to snow on ground and written for
+// speed (the surface kept as one array, inner cells without edge tests): the
+// same operations in the same order, so the same bits (a test holds them to
+// it). Jacobi passes over the cells next to whatever moved, each flow leaving
+// one cell and entering another as the same double, so mass is conserved to
+// double rounding and the result does not depend on the thread count; the
+// grid's edges are closed (no flow out). Only the cells next to whatever moved
+// in the last pass are looked at, so the cost of a pass follows the snow that
+// is still moving, not the grid.
+//
+// Why a field takes many passes (docs/snowfall.md): a pass moves at most half a
+// pair's excess across it, so a slope standing at repose that is drained at its
+// foot or fed at its top shifts in parallel only as fast as a diffusion, in
+// O(L^2) passes for a slope L cells long. A coarse-to-fine start, a multilevel
+// tail correction, an envelope-and-heap shortcut and extrapolation of the tail
+// were tried and dropped (they change the settled state or do not shorten the
+// tail).
 #pragma once
 
 #include "terrain/grid.h"
