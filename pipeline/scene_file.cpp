@@ -150,6 +150,7 @@ render::MaterialRule read_rule(const toml::table* table, const fs::path& file, s
   rule.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
   rule.clump_size = static_cast<float>(s.number("clump_size", 0.0, 0.0, 1e4));
   rule.clump_cover = static_cast<float>(s.number("clump_cover", 1.0, 0.0, 1.0));
+  rule.patch_size = static_cast<float>(s.number("patch_size", 0.0, 0.0, 1e4));
   s.finish();
   require_material(s, rule.material);
   return rule;

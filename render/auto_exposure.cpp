@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -42,6 +43,29 @@ double centre_weight(const Image& im, int x, int y) {
   return std::exp(-r * r / (2.0 * kCentreSigma * kCentreSigma));
 }
 
+// Incident readings (log light, weight) with the depth of their pixel.
+struct Reading {
+  double log_light, weight, depth;
+};
+
+// The readings of the nearer half of the ground (all if no depth was read):
+// far ground's light is inflated by the air's (auto_exposure.h).
+std::vector<std::pair<double, double>> nearer_half(std::vector<Reading> readings, bool has_depth) {
+  std::vector<std::pair<double, double>> out;
+  if (readings.empty()) return out;
+  double cut = std::numeric_limits<double>::infinity();
+  if (has_depth) {
+    std::vector<double> depths;
+    for (const Reading& r : readings) depths.push_back(r.depth);
+    auto mid = depths.begin() + static_cast<std::ptrdiff_t>((depths.size() - 1) / 2);
+    std::nth_element(depths.begin(), mid, depths.end());
+    cut = *mid;
+  }
+  for (const Reading& r : readings)
+    if (r.depth <= cut) out.emplace_back(r.log_light, r.weight);
+  return out;
+}
+
 }  // namespace
 
 Metering meter_exposure(const Image& linear, const std::array<float, 3>& white_balance) {
@@ -49,10 +73,12 @@ Metering meter_exposure(const Image& linear, const std::array<float, 3>& white_b
             b = linear.channel_index("B");
   if (r < 0 || g < 0 || b < 0) throw Error("cannot meter an image without R, G, B channels");
   const int ar = linear.channel_index("albedo.R"), ag = linear.channel_index("albedo.G"),
-            ab = linear.channel_index("albedo.B"), sky = linear.channel_index("mask.sky");
+            ab = linear.channel_index("albedo.B"), sky = linear.channel_index("mask.sky"),
+            depth = linear.channel_index("depth");
   const bool has_aovs = ar >= 0 && ag >= 0 && ab >= 0 && sky >= 0;
   // log(light) and weight per metered pixel, incident (ground) and reflected (all).
-  std::vector<std::pair<double, double>> incident, reflected;
+  std::vector<std::pair<double, double>> reflected;
+  std::vector<Reading> readings;
   for (int y = 0; y < linear.height; ++y) {
     for (int x = 0; x < linear.width; ++x) {
       const Eigen::Vector3f rgb(linear.at(x, y, r) * white_balance[0],
@@ -64,12 +90,16 @@ Metering meter_exposure(const Image& linear, const std::array<float, 3>& white_b
       reflected.emplace_back(std::log(l / kMiddleGrey), w);
       if (!has_aovs || linear.at(x, y, sky) >= 0.5f) continue;
       const float a = luminance({linear.at(x, y, ar), linear.at(x, y, ag), linear.at(x, y, ab)});
-      if (a >= kMinAlbedo) incident.emplace_back(std::log(l / a), w);
+      const float d = depth >= 0 ? linear.at(x, y, depth) : 0.0f;
+      if (a >= kMinAlbedo)
+        readings.push_back(
+            {std::log(l / a), w, std::isnan(d) ? std::numeric_limits<double>::infinity() : d});
     }
   }
   Metering m;
   const std::size_t pixels = static_cast<std::size_t>(linear.width) * linear.height;
-  m.incident = !incident.empty() && incident.size() * 100 >= pixels;
+  m.incident = !readings.empty() && readings.size() * 100 >= pixels;
+  const auto incident = nearer_half(std::move(readings), depth >= 0);
   const auto& chosen = m.incident ? incident : reflected;
   if (chosen.empty()) return m;  // black: nothing to meter
   m.light = std::exp(weighted_quantile(chosen, kQuantile));

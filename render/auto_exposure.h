@@ -13,7 +13,12 @@
 // centre-weighted upper quartile over the ground (weight exp(-r^2 / 2
 // 0.35^2), r the distance from the centre over the half diagonal): the light
 // of the sunlit ground, as a photographer takes an incident reading in the
-// sun, so that shadows fall darker and not the other way round. Without AOVs
+// sun, so that shadows fall darker and not the other way round. With a depth
+// channel only the nearer half of the ground (by depth) is read: the light
+// held to the meter is the light where one stands, and far ground's radiance
+// over its albedo counts the air's own light too (aerial perspective: dark
+// forest 15 km off reads 2-3x the light of the sunlit ground in front, which
+// pulled the default view's meter 0.4 EV dark). Without AOVs
 // (or with under 1 % ground) the meter reads reflected light: the
 // centre-weighted upper quartile of the luminance is taken to middle grey.
 #pragma once
@@ -30,7 +35,7 @@ struct Metering {
   bool incident = false;     // true: from the albedo AOV (ground only); false: reflected
 };
 
-// Meters `linear` (channels R, G, B, optionally albedo.R/G/B and mask.sky)
+// Meters `linear` (channels R, G, B, optionally albedo.R/G/B, mask.sky, depth)
 // after `white_balance`. A black frame meters to 0 EV. Throws drift::Error if
 // the image has no R, G, B channels.
 Metering meter_exposure(const Image& linear, const std::array<float, 3>& white_balance);

@@ -20,6 +20,11 @@
 // weight on the large ones (Hurst exponent 0.3), so a far range shows
 // patches of lighter and darker rock and near ground a finer mottle; the
 // variation is a factor of mean 1, so a material's mean albedo is kept.
+// Rock (GroundDetail::fracture > 0) breaks into jointed blocks: small ones
+// (0.4 x scale) carry that share of the relief as creased facets whose
+// slope averages to 0 over each block, larger ones (2.5 x scale) a tone
+// each, both with dark joints between; on cliffs in dipping rows (ledges).
+// See ground_detail.cpp and docs/rendering.md.
 #pragma once
 
 #include "render/material.h"
@@ -43,11 +48,16 @@ DetailedGround ground_detail(const Material& material, double x, double y, doubl
 
 // The relief's slope (dh/dx, dh/dy) and the slope variance the footprint
 // filtered away (for tests and the shading above).
+// `layered`: the plane's second axis is up a cliff (jointed blocks stand in
+// rows, their tops ledges); false for the map's plane. joint_factor is the
+// albedo factor (mean 1) of the dark joints between blocks.
 struct DetailSlope {
   Eigen::Vector2f slope{0, 0};
   float lost_variance = 0.0f;
+  float joint_factor = 1.0f;
 };
-DetailSlope detail_slope(const GroundDetail& detail, double x, double y, double footprint);
+DetailSlope detail_slope(const GroundDetail& detail, double x, double y, double footprint,
+                         bool layered = false);
 
 // The albedo factor (mean 1) at (x, y) for a footprint.
 float albedo_factor(const GroundDetail& detail, double x, double y, double footprint);

@@ -195,7 +195,10 @@ static std::vector<std::uint8_t> to_srgb8(const Image& linear, const DisplayTran
 DisplayTransform resolve_exposure(const Image& linear, const DisplayTransform& display) {
   if (!display.auto_exposure) return display;
   DisplayTransform fixed = display;
-  fixed.exposure_ev += meter_exposure(linear, display.white_balance).exposure_ev;
+  // The meter brings a grey card to 0.18 before the curve; a camera shows it
+  // at 0.18 after it (ISO 12232 standard output, render/tonemap.h).
+  fixed.exposure_ev +=
+      meter_exposure(linear, display.white_balance).exposure_ev + middle_grey_ev(display.curve);
   fixed.auto_exposure = false;
   return fixed;
 }

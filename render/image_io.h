@@ -23,7 +23,8 @@ void write_png(const Image& linear, const std::filesystem::path& path,
                const DisplayTransform& display = {});
 
 // `display` with a metered exposure (render/auto_exposure.h) made fixed:
-// its exposure_ev added to the meter's when auto_exposure is on.
+// its exposure_ev added to the meter's, and the tone curve's middle_grey_ev
+// (render/tonemap.h), when auto_exposure is on.
 DisplayTransform resolve_exposure(const Image& linear, const DisplayTransform& display);
 
 // Chooses by extension: .exr or .png (case-insensitive); anything else is an

@@ -21,8 +21,10 @@ struct Preset {
 //   USGS spectral library (Kokaly et al. 2017); basalt is far darker (~0.08).
 // - dark_rock: the andesite, welded tuff and hornfels of the Hotaka and
 //   Yarigatake massifs (Harayama et al. 2000, GSJ 1:50,000 geological sheet "Kamikochi"),
-//   grey to dark grey with lichen: visible reflectance 0.08-0.18 for andesites
-//   and lichen-covered rock in the USGS library (Kokaly et al. 2017); strongly
+//   dark grey-brown with lichen and oxide films: visible reflectance
+//   0.08-0.18 for andesites and lichen-covered rock in the USGS library
+//   (Kokaly et al. 2017), rising gently from blue to red (weathering iron
+//   oxides), so a little warmer than neutral at the same luminance; strongly
 //   varied (fresh faces, oxide stains, lichen), fractured relief.
 // - scree: talus of the same rock below the cliffs, fresher broken faces and
 //   no soil: a little lighter (0.15-0.22), granular relief of blocks of
@@ -49,12 +51,15 @@ struct Preset {
 //   0.95-0.98 (Warren 1982, Rev. Geophys. 20(1)); a little blue. Half of its
 //   reflection through the forward-scattering lobe of render/bsdf.h.
 // Detail (render/ground_detail.h): albedo variation (relative standard
-// deviation), rms slope of the sub-cell relief and its largest wavelength.
+// deviation), rms slope of the sub-cell relief, its largest wavelength and
+// the share of it in jointed blocks (rock; Selby 1980, Z. Geomorph. 24,
+// 31-51: joint spacing of 0.3-3 m and more in hard rock, the blocks'
+// faces the facets a photograph of a ridge shows).
 constexpr float kRough = 0.35f;
 const std::array<Preset, 10> kPresets = {{
-    // name        albedo                  rough wet  fwd   variation bump scale
-    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f}}},
-    {"dark_rock", {{0.125f, 0.12f, 0.113f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f}}},
+    // name        albedo                  rough wet  fwd   variation bump scale fracture
+    {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f, 0.5f}}},
+    {"dark_rock", {{0.13f, 0.118f, 0.102f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f, 0.3f}}},
     {"scree", {{0.18f, 0.17f, 0.155f}, 0.5f, 0.0f, 0.0f, {0.2f, 0.35f, 2.0f}}},
     {"meadow", {{0.11f, 0.10f, 0.05f}, 0.7f, 0.0f, 0.0f, {0.3f, 0.2f, 3.0f}}},
     {"dwarf_pine", {{0.028f, 0.042f, 0.022f}, 0.9f, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f}}},
@@ -99,7 +104,7 @@ Material blend(const Material& under, const MaterialOverride& over, float t) {
     const GroundDetail& a = under.detail;
     const GroundDetail& b = *over.detail;
     out.detail = {a.variation * (1 - t) + b.variation * t, a.bump * (1 - t) + b.bump * t,
-                  a.scale * (1 - t) + b.scale * t};
+                  a.scale * (1 - t) + b.scale * t, a.fracture * (1 - t) + b.fracture * t};
   }
   return out;
 }

@@ -29,6 +29,10 @@ struct GroundDetail {
   float variation = 0.0f;  // relative standard deviation of the albedo (0.2: +-20 %)
   float bump = 0.0f;       // rms slope of the sub-cell relief (tan of the facets' tilt)
   float scale = 4.0f;      // metres: wavelength of the relief's largest features
+  // Share of the relief's slope variance carried by jointed blocks (rock:
+  // facets with crisp edges, dark joints, ledges on steep faces) instead of
+  // smooth noise; 0 for soft ground (render/ground_detail.h).
+  float fracture = 0.0f;
 };
 
 struct Material {
@@ -93,6 +97,12 @@ struct MaterialRule {
   // else blobs about clump_size metres across cover clump_cover of it.
   float clump_size = 0.0f;
   float clump_cover = 1.0f;
+  // Patches (render/land_form.h: clump_mask with the rule's own weight as the
+  // cover): where the soft weight w is between 0 and 1 the rule covers a
+  // share w of the ground in patches about patch_size metres across with
+  // crisp edges, instead of a translucent w everywhere (snow patches, which
+  // end in a line, not a fade); far away the share w alone. 0: soft blend.
+  float patch_size = 0.0f;
   float weight(float altitude_m, float slope_deg, float position_m = 0.0f) const;
 };
 

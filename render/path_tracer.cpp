@@ -54,8 +54,18 @@ PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const
   shadow_slab_ = {scene.bottom(), scene.top()};
   air_reach_ = camera.eye.head<2>().norm() + scene.extent().norm() + scene.surround_reach();
   // The sky as a light, tabulated once for this camera and sun and
-  // importance-sampled at every vertex (render/sky_sampler.h).
-  if (settings.sample_sky) sky_sampler_.emplace([this](const Vector3f& d) { return sky_light(d); });
+  // importance-sampled at every vertex (render/sky_sampler.h); above the
+  // horizon only. Below it the air is bright too (57-68 % of the whole
+  // sphere's luminance in the snowfall and default scenes), but from the
+  // ground those directions meet the ground or the surface itself, so such
+  // samples were wasted; the BSDF's bounces alone cover them (MIS weight 1
+  // where the sampler's density is 0), and the sky's samples all land where
+  // a shaded slope can see them.
+  if (settings.sample_sky) {
+    sky_sampler_.emplace([this](const Vector3f& d) -> Vector3f {
+      return d.z() > 0.0f ? sky_light(d) : Vector3f::Zero();
+    });
+  }
 }
 
 PathTracer::~PathTracer() = default;

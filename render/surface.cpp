@@ -106,6 +106,8 @@ void stack_rules(const TerrainSurface& surface, double x, double y, const Relief
     float w = rule.weight(altitude, relief.slope_deg, position);
     if (rule.clump_size > 0.0f && w > 0.0f)
       w *= clump_mask(x, y, rule.clump_size, rule.clump_cover, 0xc1u + 7919u * i, footprint);
+    if (rule.patch_size > 0.0f && w > 0.0f && w < 1.0f)
+      w = clump_mask(x, y, rule.patch_size, w, 0x9a7u + 7919u * i, footprint);
     put_on_top(rule.material, w, channels ? channels->rules[i] : 0, channels, ground, p);
   }
 }
@@ -117,7 +119,12 @@ MaterialOverride with_thickness(const MaterialLayer& layer, const Material& bene
                                 double x, double y) {
   MaterialOverride material = layer.material;
   if (!layer.thickness || !material.albedo || !(w > 0.0f)) return material;
-  const float metres = std::max(sample_raster(layer.thickness->metres, x, y, 0.0f), 0.0f);
+  // Beyond the thickness raster (a layer's `outside` share, e.g. the storm's
+  // snow on the surround) the layer is as deep as it needs to be: opaque,
+  // not a film 0 m thick through which the bare ground showed.
+  const float raster = sample_raster(layer.thickness->metres, x, y, NAN);
+  if (std::isnan(raster)) return material;
+  const float metres = std::max(raster, 0.0f);
   const float lying = w < 1.0f ? std::max(metres / w, kFlakeDepth) : metres;
   material.albedo =
       layer_albedo(*material.albedo, beneath.albedo, layer.thickness->scattering * lying);

@@ -42,6 +42,20 @@ float apply_tone_curve(float linear, const DisplayTransform& display) {
   return clamp01(x);
 }
 
+double middle_grey_ev(ToneCurve curve) {
+  constexpr double kGrey = 0.18;
+  DisplayTransform display;
+  display.curve = curve;
+  // The curve is monotone (header comment): bisect for curve(x) = 0.18 in log2 x.
+  double lo = -8.0, hi = 8.0;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    const float shown = apply_tone_curve(static_cast<float>(kGrey * std::exp2(mid)), display);
+    (shown < kGrey ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 float srgb_encode(float v) {
   v = clamp01(v);
   // IEC 61966-2-1, eq. for the encoding (linear segment below 0.0031308).

@@ -33,6 +33,14 @@ struct DisplayTransform {
   bool auto_exposure = false;
 };
 
+// The exposure (EV) under which `curve` displays a scene middle grey (0.18)
+// at display-linear 0.18, i.e. sRGB code 118 of 255: a camera's standard
+// output sensitivity (ISO 12232:2006, SOS: the exposure that puts an 18 %
+// card at 118 in 8-bit sRGB). 0 for Clamp; about -0.47 EV for Filmic, whose
+// toe and mid-tone lift would otherwise show the card at 0.267 (141 of 255)
+// and every tone half a stop light. The meter adds it (render/image_io.h).
+double middle_grey_ev(ToneCurve curve);
+
 // Linear radiance -> display-linear value in [0, 1] (before the sRGB encoding).
 float apply_tone_curve(float linear, const DisplayTransform& display);
 

@@ -75,6 +75,23 @@ TEST(AutoExposure, CentreWeighted) {
   EXPECT_NEAR(meter_exposure(scene, kNoBalance).exposure_ev, -2.0, 1e-6);
 }
 
+TEST(AutoExposure, FarGroundsAirDoesNotMoveTheMeter) {
+  // Near ground (depth 2 km, albedo 0.2) in light 1; the far half of the
+  // frame (20 km) dark forest (0.04) whose radiance is mostly the air's own
+  // light: radiance over albedo reads 4x the light there. The meter reads
+  // the nearer half: light 1, 0 EV (reading all of it gave -2 EV).
+  Image scene(20, 20, {"R", "G", "B", "depth", "albedo.R", "albedo.G", "albedo.B", "mask.sky"});
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 20; ++x) {
+      const bool far = y < 10;
+      const float albedo = far ? 0.04f : 0.2f;
+      const float radiance = far ? 0.04f * 0.8f + 0.13f : 0.2f;
+      for (int c = 0; c < 3; ++c) scene.at(x, y, c) = radiance, scene.at(x, y, 4 + c) = albedo;
+      scene.at(x, y, 3) = far ? 20000.0f : 2000.0f;
+    }
+  EXPECT_NEAR(meter_exposure(scene, kNoBalance).exposure_ev, 0.0, 1e-6);
+}
+
 TEST(AutoExposure, WhiteBalanceIsMetered) {
   Image plain(4, 4, {"R", "G", "B"}, 0.5f);
   const std::array<float, 3> gains{2.0f, 2.0f, 2.0f};
@@ -87,7 +104,7 @@ TEST(AutoExposure, BlackFrameAndBadImages) {
 }
 
 TEST(AutoExposure, PngIsWrittenMetered) {
-  // The grey card through write_png: middle grey after the filmic curve,
+  // The grey card through write_png: middle grey after the tone curve,
   // and the compensation (exposure_ev) added on top of the meter.
   Image card = frame(8, 8);
   for (int y = 0; y < 8; ++y)
@@ -101,6 +118,12 @@ TEST(AutoExposure, PngIsWrittenMetered) {
   display.exposure_ev = 1.0;
   write_png(card, path, display);
   EXPECT_NEAR(read_image(path).at(3, 3, 1), 0.36f, 0.005f);
+  // Through the filmic curve too: the card at 0.18 (sRGB 118), as a camera's
+  // standard output shows it, not lifted to 0.267 by the curve's mid-tones.
+  display.curve = ToneCurve::Filmic;
+  display.exposure_ev = 0.0;
+  write_png(card, path, display);
+  EXPECT_NEAR(read_image(path).at(3, 3, 1), 0.18f, 0.003f);
   std::filesystem::remove(path);
 }
 

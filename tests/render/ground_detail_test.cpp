@@ -258,7 +258,10 @@ TEST(GroundDetail, SteepFacesAreNotStreakedDownTheirFallLine) {
   // stretched 1 / cos(70) = 2.9 times down the fall line (streaks), so points
   // 20 m apart down it would correlate far more than points 20 m apart across
   // it (0.79 against 0.59 measured; 0.60 against 0.59 triplanar). Triplanar, the two agree.
-  const Material rock = *material_preset("dark_rock");
+  // The joints are left out: their rows run across the face on purpose
+  // (ledges, JointsStandInRowsOnCliffs below).
+  Material rock = *material_preset("dark_rock");
+  rock.detail.fracture = 0.0f;
   const float slope = 70.0f * std::numbers::pi_v<float> / 180.0f;
   for (const float azimuth : {0.0f, 0.6f}) {  // facing east, and turned
     const Eigen::Vector3f n(std::sin(slope) * std::cos(azimuth),
@@ -277,6 +280,43 @@ TEST(GroundDetail, SteepFacesAreNotStreakedDownTheirFallLine) {
   const Eigen::Vector3f gentle = Eigen::Vector3f(0.3f, 0.1f, 1.0f).normalized();
   EXPECT_EQ(ground_detail(rock, 123.4, 567.8, 2000.0, gentle, 0.5).albedo,
             ground_detail(rock, 123.4, 567.8, -50.0, gentle, 0.5).albedo);
+}
+
+}  // namespace
+}  // namespace drift::render
+
+namespace drift::render {
+namespace {
+
+TEST(GroundDetail, JointedRockKeepsItsMeanAndStandsInRowsOnCliffs) {
+  // Rock's blocks (fracture 1: all of the relief in blocks): the dark joints
+  // keep the albedo's mean (factor 1 on average, < 0.7 in the joints, exactly
+  // 1 once the footprint covers blocks), and on a cliff (layered) the relief
+  // tilts mostly across the rows (ledges: 3x the variance), on the map's
+  // plane alike both ways.
+  GroundDetail d = material_preset("dark_rock")->detail;
+  d.fracture = 1.0f;
+  std::mt19937_64 rng(31);
+  std::uniform_real_distribution<double> u(-5e3, 5e3);
+  for (const bool layered : {false, true}) {
+    double sum = 0, darkest = 1, gx2 = 0, gy2 = 0;
+    const int n = 100000;
+    for (int i = 0; i < n; ++i) {
+      const DetailSlope s = detail_slope(d, u(rng), u(rng), 0.0, layered);
+      sum += s.joint_factor, darkest = std::min<double>(darkest, s.joint_factor);
+      gx2 += s.slope.x() * s.slope.x(), gy2 += s.slope.y() * s.slope.y();
+    }
+    SCOPED_TRACE(layered ? "cliff" : "map plane");
+    EXPECT_NEAR(sum / n, 1.0, 0.01);
+    EXPECT_LT(darkest, 0.7);
+    EXPECT_NEAR(std::sqrt((gx2 + gy2) / n), d.bump, 0.05 * d.bump);
+    if (layered) {
+      EXPECT_GT(gy2 / gx2, 2.5);
+    } else {
+      EXPECT_NEAR(gy2 / gx2, 1.0, 0.15);
+    }
+    EXPECT_EQ(detail_slope(d, 12.3, 45.6, 20.0, layered).joint_factor, 1.0f);
+  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "render/surface.h"
 #include "render/terrain_scene.h"
@@ -80,6 +81,43 @@ TEST(MaterialRules, SoftRangesAndLaterRulesWin) {
   const Material edge = apply_rules(2000.0f, 10.0f);
   EXPECT_NEAR(edge.albedo.x(), 0.5f * (base.albedo.x() + material_preset("grass")->albedo.x()),
               1e-6f);
+}
+
+TEST(MaterialRules, PatchesEndInCrispEdgesAndKeepTheShare) {
+  // Snow at weight 0.3 (a third of the way into its altitude band): blended,
+  // a translucent 0.3 everywhere; as patches of 15 m, up close snow or no
+  // snow (crisp edges: under 10 % of the ground in between) covering 0.3 of
+  // the ground, and from afar (a 60 m footprint) the blend's 0.3 exactly.
+  MaterialRule snow;
+  snow.material = full_override(*material_preset("snow"));
+  snow.material.detail = GroundDetail{};
+  snow.altitude = {2500.0f, 1e9f, 200.0f};
+  snow.patch_size = 15.0f;
+  TerrainSurface surface;
+  surface.ground = Material{{0.1f, 0.1f, 0.1f}, 0.2f, 0.0f};
+  surface.rules = {snow};
+  const float w = snow.weight(2450.0f, 10.0f);
+  ASSERT_GT(w, 0.1f);
+  ASSERT_LT(w, 0.9f);
+  auto share = [&](double x, double y, double footprint) {  // snow's share of the albedo
+    const Material m =
+        shade_terrain(surface, x, y, Eigen::Vector3f(0, 0, 1), footprint, {2450.0f, 10.0f})
+            .material;
+    return (m.albedo.x() - 0.1f) / (material_preset("snow")->albedo.x() - 0.1f);
+  };
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 5000.0);
+  double sum = 0;
+  int between = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const float s = share(u(rng), u(rng), 0.0);
+    sum += s;
+    between += s > 0.05f && s < 0.95f;
+  }
+  EXPECT_NEAR(sum / n, w, 0.03);
+  EXPECT_LT(between, n / 10);
+  EXPECT_NEAR(share(12.0, 34.0, 60.0), w, 1e-5);
 }
 
 TEST(MaterialRules, TerrainHitsSeeTrueSlopeAndAltitude) {

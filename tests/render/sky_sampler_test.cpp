@@ -172,5 +172,8 @@ TEST(SkySampler, MisOnAPlaneAgreesWithBruteForceWithLessNoise) {
       brute, mis, 100.0 * (mis - brute) / brute, brute1_var, mis1_var, brute1_var / mis1_var);
   // Standard errors of the means are ~0.1 %; allow 0.5 %.
   EXPECT_NEAR(mis, brute, 5e-3 * brute);
-  EXPECT_LT(mis1_var, 0.7 * brute1_var);
+  // The sky's samples all above the horizon (render/path_tracer.cpp): a
+  // sixth of brute force's variance (x5.9); a third (x3.0) when the sampler
+  // spent 57-68 % of its samples below the horizon, where the plane is.
+  EXPECT_LT(mis1_var, 0.25 * brute1_var);
 }
