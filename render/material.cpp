@@ -141,8 +141,13 @@ float SoftRange::weight(float x) const {
 }
 
 float MaterialRule::weight(float altitude_m, float slope_deg, float position_m) const {
-  return opacity * altitude.weight(altitude_m) * slope.weight(slope_deg) *
-         position.weight(position_m);
+  // The same product, left to right, stopped at the first zero (most
+  // rules are out of range at most points; the inputs are finite).
+  float w = opacity * altitude.weight(altitude_m);
+  if (w == 0.0f) return w;
+  w *= slope.weight(slope_deg);
+  if (w == 0.0f) return w;
+  return w * position.weight(position_m);
 }
 
 }  // namespace drift::render
