@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,9 @@ struct KeptInput {
   std::string target;
   fs::path file;
 };
+
+// What gtest (and so CTest's listing) shows of a parameter: its file's path.
+void PrintTo(const KeptInput& in, std::ostream* os) { *os << in.file.string(); }
 
 std::vector<char> bytes_of(const fs::path& p) {
   std::ifstream f(p, std::ios::binary);
