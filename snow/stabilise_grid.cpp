@@ -8,6 +8,7 @@
 #include <numbers>
 #include <vector>
 
+#include "snow/stabilise_settle.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
 #include "terrain/slope_relax.h"
@@ -19,6 +20,11 @@ namespace {
 constexpr int kTile = 16;
 // Tiles below which a phase runs on the calling thread (same result either way).
 constexpr std::size_t kParallelTiles = 32;
+// The shortcut (snow/stabilise_settle.h) runs once the passes are in their
+// slow tail: at least kTailPasses passes since the start or the last shortcut,
+// and fewer than kTailShare of the tiles still active.
+constexpr int kTailPasses = 200;
+constexpr double kTailShare = 0.1;
 // Neighbour k and neighbour 7 - k are opposite (the order of terrain/slope_relax,
 // so that sums are formed in the same order and give the same bits).
 constexpr std::array<int, 8> kDx{-1, 0, 1, -1, 1, -1, 0, 1};
@@ -58,28 +64,40 @@ class SnowPasses {
     surface_.resize(cells);
     for (std::size_t i = 0; i < cells; ++i) surface_[i] = static_cast<double>(g_[i]) + h_[i];
     give_.assign(cells, 0.0), take_.assign(cells, 0.0), delta_.assign(cells, 0.0);
-    active_.assign(cells, 1), touched_.assign(cells, 0);
+    active_.assign(cells, 0), touched_.assign(cells, 0);
     const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
-    tile_active_.assign(tiles, 1), tile_touched_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
+    tile_active_.assign(tiles, 0), tile_touched_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
+    for (std::size_t i = 0; i < cells; ++i) activate(i);
+    active_tiles_ = tiles_where_active();
   }
 
   // Bytes a grid of `cells` needs on top of the snow and the ground.
   static std::uint64_t bytes_per_cell() { return 4 * sizeof(double) + 2; }
 
-  // Passes until nothing moves or max_passes; on_pass(passes, active share).
-  template <class OnPass>
-  StabiliseReport run(int max_passes, const OnPass& on_pass) {
-    StabiliseReport report;
-    std::vector<int> active;
-    for (int t = 0; t < tiles_x_ * tiles_y_; ++t) active.push_back(t);
-    while (!active.empty() && report.iterations < max_passes) {
-      ++report.iterations;
-      pass(active);
-      active = next_active(active);
-      on_pass(report.iterations, static_cast<double>(active.size()) / tile_active_.size());
+  // Passes until nothing moves, max_passes, or pause(passes, active share)
+  // says to stop for now (it is also the progress report); true if converged.
+  template <class Pause>
+  bool run(int max_passes, const Pause& pause) {
+    while (!active_tiles_.empty() && passes_ < max_passes) {
+      ++passes_;
+      pass(active_tiles_);
+      active_tiles_ = next_active(active_tiles_);
+      const double share = static_cast<double>(active_tiles_.size()) / tile_active_.size();
+      if (pause(passes_, share)) break;
     }
-    report.converged = active.empty();
-    return report;
+    return active_tiles_.empty();
+  }
+  int passes() const { return passes_; }
+  // After the snow of `cells` was changed from outside: they and their
+  // neighbours look again.
+  void changed(const std::vector<std::size_t>& cells) {
+    for (std::size_t i : cells) {
+      surface_[i] = static_cast<double>(g_[i]) + h_[i];
+      activate(i);
+      for (int k = 0; k < 8; ++k)
+        if (inside(i, k)) activate(i + offset_[k]);
+    }
+    active_tiles_ = tiles_where_active();
   }
 
  private:
@@ -204,6 +222,17 @@ class SnowPasses {
     std::sort(out.begin(), out.end());
     return out;
   }
+  void activate(std::size_t i) {
+    active_[i] = 1;
+    const int x = static_cast<int>(i % w_), y = static_cast<int>(i / w_);
+    tile_active_[static_cast<std::size_t>(y / kTile) * tiles_x_ + x / kTile] = 1;
+  }
+  std::vector<int> tiles_where_active() const {
+    std::vector<int> out;
+    for (std::size_t t = 0; t < tile_active_.size(); ++t)
+      if (tile_active_[t]) out.push_back(static_cast<int>(t));
+    return out;
+  }
   void clear_active(int t) {
     for_cells(t, [&](std::size_t i, bool) { active_[i] = 0; });
     tile_active_[static_cast<std::size_t>(t)] = 0;
@@ -249,8 +278,35 @@ class SnowPasses {
   std::vector<double> surface_, give_, take_, delta_;
   std::vector<std::uint8_t> active_, touched_;
   std::vector<std::uint8_t> tile_active_, tile_touched_, tile_mark_;
+  std::vector<int> active_tiles_;
+  int passes_ = 0;
   std::vector<int> near_;  // this pass: active tiles and their neighbours
 };
+
+// Passes, and the shortcut each time they reach their slow tail, until they
+// converge (the shortcut only moves snow; convergence is the passes' verdict).
+template <class OnPass>
+StabiliseReport settle(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
+                       const SettleGeometry& geo, int max_passes, bool shortcut,
+                       const OnPass& on_pass) {
+  SnowPasses passes(ground, snow, geo.dx, geo.dy, geo.tan_repose, geo.tolerance);
+  int last = 0;
+  auto pause = [&](int p, double share) {
+    on_pass(p, share);
+    return shortcut && p - last >= kTailPasses && share < kTailShare;
+  };
+  bool converged = false;
+  while (!(converged = passes.run(max_passes, pause)) && passes.passes() < max_passes) {
+    const auto changed = settle_unsupported(ground, snow, geo);
+    shortcut = !changed.empty();
+    last = passes.passes();
+    passes.changed(changed);
+  }
+  StabiliseReport report;
+  report.iterations = passes.passes();
+  report.converged = converged;
+  return report;
+}
 
 }  // namespace
 
@@ -261,12 +317,16 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
     throw Error("the angle of repose of snow must lie in (0, 90) degrees");
   if (ground.width() != snow.width() || ground.height() != snow.height())
     throw Error("stabilise_grid: the ground and the snow grids differ in size");
-  require_memory(snow.size() * SnowPasses::bytes_per_cell(), "snow stabilisation's workspace",
-                 "use a smaller or coarser ground raster");
-  SnowPasses passes(ground, snow, dx, dy, tan_deg(options.repose_deg), options.tolerance);
-  const StabiliseReport report = passes.run(options.max_iterations, [&](int, double active_share) {
-    if (!progress(1.0 - active_share, "stabilising snow")) throw Cancelled();
-  });
+  // The passes' workspace, and the shortcut's: envelope, loose snow, resting
+  // cell and load (doubles and indices), marks, and a queue entry a cell at worst.
+  const std::uint64_t shortcut_bytes = 4 * sizeof(double) + 1 + 16;
+  require_memory(snow.size() * (SnowPasses::bytes_per_cell() + shortcut_bytes),
+                 "snow stabilisation's workspace", "use a smaller or coarser ground raster");
+  const SettleGeometry geo{dx, dy, tan_deg(options.repose_deg), options.tolerance};
+  const StabiliseReport report =
+      settle(ground, snow, geo, options.max_iterations, options.shortcut, [&](int, double share) {
+        if (!progress(1.0 - share, "stabilising snow")) throw Cancelled();
+      });
   progress(1.0, "stabilising snow");
   return report;
 }
