@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <vector>
 
 #include "pipeline/cli.h"
 #include "render/image_compare.h"
@@ -17,7 +18,8 @@ namespace drift::pipeline {
 namespace {
 
 struct CompareCommandOptions {
-  std::string a, b, diff, metric = "relmse", channels, region;
+  std::string a, b, diff, metric = "relmse", channels;
+  std::vector<int> region;  // X,Y,W,H; CLI11 refuses what an int cannot hold
   double threshold = 1e-2;
   double pixel_threshold = -1.0;
   double fail_percent = 100.0;
@@ -43,13 +45,9 @@ void run_compare(const CompareCommandOptions& o) {
   render::Image a = render::read_image(o.a);
   render::Image b = render::read_image(o.b);
   if (!o.region.empty()) {
-    int x = 0, y = 0, w = 0, h = 0;
-    char tail = 0;
-    if (std::sscanf(o.region.c_str(), "%d,%d,%d,%d%c", &x, &y, &w, &h, &tail) != 4) {
-      usage_error("--region '" + o.region + "' is not X,Y,W,H (pixels, e.g. 0,40,120,50)");
-    }
-    a = render::crop(a, x, y, w, h);
-    b = render::crop(b, x, y, w, h);
+    const auto& r = o.region;
+    a = render::crop(a, r[0], r[1], r[2], r[3]);
+    b = render::crop(b, r[0], r[1], r[2], r[3]);
   }
   const render::ComparisonResult r = render::compare_images(a, b, options);
   if (!o.diff.empty()) {
@@ -102,7 +100,9 @@ void add_compare_command(CLI::App& root) {
   sub->add_option("--channels", o->channels,
                   "comma-separated channels to compare (default R,G,B, else all)");
   sub->add_option("--region", o->region,
-                  "compare only the rectangle X,Y,W,H (pixels from the top left) of both images");
+                  "compare only the rectangle X,Y,W,H (pixels from the top left) of both images")
+      ->expected(4)
+      ->delimiter(',');
 }
 
 DRIFT_COMMAND(90, add_compare_command);

@@ -50,11 +50,23 @@ marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& tr
   return marks::materials_from_snow_depth(depth, c.snow_min, base, snow);
 }
 
+// The --frames directory, created if missing, before the simulation.
+void make_frames_directory(const std::string& frames) {
+  std::error_code ec;
+  if (fs::exists(frames, ec) && !fs::is_directory(frames, ec))
+    throw Error("--frames '" + frames +
+                "' is not a directory; name a directory (it is created if missing)");
+  fs::create_directories(frames, ec);
+  if (ec) throw Error("cannot create the --frames directory '" + frames + "': " + ec.message());
+}
+
 void run_marks(MarksCommand& c) {
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
   // Frames are each complete when written (they come one by one); the marked
   // ground and the disturbed raster replace their files together at the end.
-  OutputSet outputs({c.output, c.disturbed}, {c.ground, c.track, c.snow_depth});
+  std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth};
+  for (const fs::path& mesh : object_mesh_paths(c.track, "track file")) inputs.push_back(mesh);
+  OutputSet outputs({c.output, c.disturbed}, inputs);
   TrackFile track = read_track_file(c.track);
   marks::MarksOptions o = c.options;
   o.step = track.step;
@@ -74,7 +86,7 @@ void run_marks(MarksCommand& c) {
     }
   }
   marks::MaterialField materials = ground_materials(c, track, depth);
-  if (!c.frames.empty()) fs::create_directories(c.frames);
+  if (!c.frames.empty()) make_frames_directory(c.frames);
   marks::StepFn on_step;
   if (!c.frames.empty()) {
     on_step = [&](int step, const marks::MarksSimulation& sim) {

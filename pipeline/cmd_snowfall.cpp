@@ -73,7 +73,11 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   // Before reading anything large; the ranges live in SnowfallOptions::validate().
   validate_flags([&o] { o.validate(); }, c.parameters.flag_names());
 
-  OutputSet outputs({c.output, c.cover, c.surface, c.mesh_out}, {c.ground, c.objects});
+  std::vector<std::filesystem::path> inputs = {c.ground, c.objects};
+  if (!c.objects.empty()) {  // the meshes are inputs too: --mesh-out must not replace one
+    for (const auto& mesh : object_mesh_paths(c.objects, "objects file")) inputs.push_back(mesh);
+  }
+  OutputSet outputs({c.output, c.cover, c.surface, c.mesh_out}, inputs);
   const terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);
   const std::vector<terrain::PlacedMesh> objects =

@@ -109,12 +109,17 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
                    "--ground raster of " + std::to_string(w) + " x " + std::to_string(h) + " cells",
                    "lower --ground-margin");
   }
-  if (!c.frames.empty() && !fs::is_directory(c.frames))
-    throw Error("--frames directory '" + c.frames + "' does not exist; create it first");
+  if (!c.frames.empty() && !fs::is_directory(c.frames)) {
+    throw Error("--frames directory '" + c.frames + "' " +
+                (fs::exists(c.frames) ? "is not a directory; name a directory"
+                                      : "does not exist; create it first"));
+  }
 
   // Frames are each complete when written; the products replace their files
   // together at the end (docs/outputs.md).
-  OutputSet outputs({c.output, c.collision, c.vdb, c.surface, c.ground}, {c.scenario, c.terrain});
+  // The scenario's DEM is an input too, unless --terrain replaces it.
+  const fs::path dem = c.terrain.empty() ? soil_scenario_dem(c.scenario) : fs::path(c.terrain);
+  OutputSet outputs({c.output, c.collision, c.vdb, c.surface, c.ground}, {c.scenario, dem});
   soil::SoilSimulation sim = soil::make_simulation(sc);  // checks sizes and memory first
   const soil::SurfaceOptions surface{
       c.no_ridge_fix ? soil::RidgeFix::Off : soil::RidgeFix::StraightSlopes, 3, 0.0};

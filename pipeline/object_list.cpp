@@ -25,6 +25,11 @@ terrain::Mesh mesh_file(const fs::path& path, bool y_up) {
   return m;
 }
 
+// An entry's mesh: relative paths are relative to the file naming them.
+fs::path mesh_path(const fs::path& file, const std::string& mesh) {
+  return fs::path(mesh).is_absolute() ? fs::path(mesh) : file.parent_path() / mesh;
+}
+
 }  // namespace
 
 std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs::path& file,
@@ -37,8 +42,8 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs:
       if (!entry.is_table())
         throw Error(file.string() + ": every [[objects]] entry must be a table");
       Section obj(entry.as_table(), "objects", file);
-      const auto mesh_path = obj.string("mesh");
-      if (!mesh_path)
+      const auto mesh = obj.string("mesh");
+      if (!mesh)
         throw Error(file.string() + ": an [[objects]] entry needs 'mesh' (an OBJ or PLY file)");
       const bool y_up = obj.boolean("y_up", false);
       const auto position = obj.vector<3>("position", -1e8, 1e8);
@@ -48,9 +53,7 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs:
       placed.albedo = obj.color("color", placed.albedo);
       if (extra) extra(obj, out.size());
       obj.finish();
-      const fs::path mp = fs::path(*mesh_path).is_absolute() ? fs::path(*mesh_path)
-                                                             : file.parent_path() / *mesh_path;
-      placed.mesh = mesh_file(mp, y_up);
+      placed.mesh = mesh_file(mesh_path(file, *mesh), y_up);
       const double a = rotate * M_PI / 180.0;
       placed.position = position ? *position : Eigen::Vector3d::Zero();
       for (auto& p : placed.mesh.positions) {
@@ -75,6 +78,19 @@ std::vector<terrain::PlacedMesh> read_objects_file(const fs::path& path) {
     }
   }
   return read_objects(root, path);
+}
+
+std::vector<fs::path> object_mesh_paths(const fs::path& path, const char* what) {
+  std::vector<fs::path> meshes;
+  const toml::table root = parse_toml_file(path, what);
+  if (const toml::array* list = root["objects"].as_array()) {
+    for (const toml::node& entry : *list) {
+      const toml::table* t = entry.as_table();
+      const toml::node* mesh = t ? t->get("mesh") : nullptr;
+      if (mesh && mesh->is_string()) meshes.push_back(mesh_path(path, **mesh->as_string()));
+    }
+  }
+  return meshes;
 }
 
 void require_metric_crs(const terrain::HeightField& raster, const fs::path& path) {

@@ -32,6 +32,14 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root,
 // A TOML file holding only [[objects]] entries.
 std::vector<terrain::PlacedMesh> read_objects_file(const std::filesystem::path& path);
 
+// The mesh files that the [[objects]] entries of the TOML file `path` (`what`:
+// "objects file", "track file") name, resolved as read_objects resolves them; entries
+// without a mesh string are skipped (the reader reports them). They are inputs
+// of the run, which OutputSet refuses as outputs: `snow fall --mesh-out
+// rock.ply` must not replace the rock.ply it reads.
+std::vector<std::filesystem::path> object_mesh_paths(const std::filesystem::path& path,
+                                                     const char* what);
+
 // Throws drift::Error if `raster` (read from `path`) is in a geographic CRS
 // (degrees), telling the user to run drift import first.
 void require_metric_crs(const terrain::HeightField& raster, const std::filesystem::path& path);

@@ -112,9 +112,8 @@ void read_simulation(const toml::table& root, const std::filesystem::path& file,
 // metres below the crop's lowest point.
 void read_dem(Section& s, const std::filesystem::path& file,
               const std::filesystem::path& dem_override, soil::SoilScenario& sc) {
-  const std::string named = *s.string("dem");
   const std::filesystem::path dem =
-      dem_override.empty() ? file.parent_path() / named : dem_override;
+      dem_override.empty() ? file.parent_path() / *s.string("dem") : dem_override;
   const auto w = s.vector<4>("window", 0, 1e6);
   if (!w) s.invalid_table("with dem needs window = [x_off, y_off, width, height] (pixels)");
   const int up = s.integer("upsample", 1, 1, 64);
@@ -229,6 +228,13 @@ soil::SoilScenario read_soil_scenario(const std::filesystem::path& path,
   read_simulation(root, path, sc);
   read_bodies(root, path, sc);
   return sc;
+}
+
+std::filesystem::path soil_scenario_dem(const std::filesystem::path& path) {
+  const toml::table root = parse_toml_file(path, "soil scenario");
+  const toml::node* dem = root["terrain"]["dem"].node();
+  if (!dem || !dem->is_string()) return {};
+  return path.parent_path() / **dem->as_string();  // as read_dem
 }
 
 }  // namespace drift::pipeline

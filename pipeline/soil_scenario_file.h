@@ -14,4 +14,9 @@ namespace drift::pipeline {
 soil::SoilScenario read_soil_scenario(const std::filesystem::path& path,
                                       const std::filesystem::path& terrain = {});
 
+// The DEM the scenario's [terrain] names (resolved as read_soil_scenario does),
+// or none: an input of the run, which OutputSet refuses as an output, so that
+// `drift soil s.toml --surface dem.tif` cannot replace the dem.tif it reads.
+std::filesystem::path soil_scenario_dem(const std::filesystem::path& path);
+
 }  // namespace drift::pipeline

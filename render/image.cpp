@@ -26,7 +26,8 @@ int Image::channel_index(std::string_view name) const {
 }
 
 Image crop(const Image& image, int x, int y, int w, int h) {
-  if (x < 0 || y < 0 || w < 1 || h < 1 || x + w > image.width || y + h > image.height) {
+  // Compared as differences: x + w may overflow an int (a hostile --region).
+  if (x < 0 || y < 0 || w < 1 || h < 1 || x > image.width - w || y > image.height - h) {
     throw Error("the region " + std::to_string(w) + "x" + std::to_string(h) + " at (" +
                 std::to_string(x) + ", " + std::to_string(y) + ") is not inside the " +
                 std::to_string(image.width) + "x" + std::to_string(image.height) + " image");

@@ -18,6 +18,7 @@
 #include <map>
 #include <sstream>
 
+#include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
 #include "tests/test_files.h"
 
@@ -300,6 +301,56 @@ TEST(OutputsCli, InputsAreRefusedAsOutputsUnderAnyName) {
                          d);
   EXPECT_EQ(r.status, 1) << r.log;
   EXPECT_TRUE(fs::exists(in.dem) && !fs::exists(d / "a.png"));
+}
+
+// Files named inside an input are inputs too: the meshes of an objects or track
+// file and the DEM of a soil scenario. Each was replaced by an output named
+// like it (snow fall --mesh-out, marks -o, soil --surface) before they were
+// counted.
+TEST(OutputsCli, FilesNamedInInputsAreRefusedAsOutputs) {
+  const Inputs in = make_inputs();
+  const fs::path d = test_dir();
+  fs::copy_file(DRIFT_SOURCE_DIR "/data/objects/ball.obj", d / "ball.obj");
+  drift::terrain::Mesh tetra;
+  tetra.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  tetra.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  drift::terrain::write_ply(tetra, d / "rock.ply");
+  fs::copy_file(in.dem, d / "dem.tif");
+  put(d / "objects.toml", "[[objects]]\nmesh = \"rock.ply\"\nposition = [150, -150, 200]\n");
+  std::string track = slurp(in.track);
+  track.replace(track.find(DRIFT_SOURCE_DIR "/data/objects/ball.obj"),
+                std::string(DRIFT_SOURCE_DIR "/data/objects/ball.obj").size(), "ball.obj");
+  put(d / "track.toml", track);
+  put(d / "soil.toml",  // a ball of soil over a 4 x 4 window of the 10 m DEM
+      "[grid]\nsize = [0, 0, 12]\n[terrain]\ndem = \"dem.tif\"\nwindow = [0, 0, 4, 4]\n"
+      "[simulation]\nsteps = 1\n[[soil_body]]\n[[soil_body.primitive]]\nshape = \"sphere\"\n"
+      "center = [20, 20, 150]\nradius = 15\n");
+  const std::string before_ply = slurp(d / "rock.ply"), before_obj = slurp(d / "ball.obj"),
+                    before_dem = slurp(d / "dem.tif");
+  const std::string runs[] = {"snow fall " + in.dem.string() + " --maps 1 --spread 0 --objects " +
+                                  (d / "objects.toml").string() + " --mesh-out " +
+                                  (d / "rock.ply").string() + " -o " + (d / "depth.tif").string(),
+                              "marks " + in.marks_ground.string() + " --track " +
+                                  (d / "track.toml").string() + " -o " + (d / "ball.obj").string(),
+                              "soil " + (d / "soil.toml").string() + " -o " +
+                                  (d / "soil.ply").string() + " --surface " +
+                                  (d / "dem.tif").string()};
+  for (const std::string& args : runs) {
+    const Result r = drift(args, d);
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.log;
+    EXPECT_NE(r.log.find("input"), std::string::npos) << args << "\n" << r.log;
+  }
+  EXPECT_EQ(slurp(d / "rock.ply"), before_ply);
+  EXPECT_EQ(slurp(d / "ball.obj"), before_obj);
+  EXPECT_EQ(slurp(d / "dem.tif"), before_dem);
+  EXPECT_FALSE(fs::exists(d / "depth.tif") || fs::exists(d / "soil.ply"));
+  EXPECT_TRUE(hidden_files(d).empty());
+  // The same soil run with another --surface works: it was refused for the DEM.
+  EXPECT_EQ(drift("soil " + (d / "soil.toml").string() + " -o " + (d / "soil.ply").string() +
+                      " --surface " + (d / "top.tif").string(),
+                  d)
+                .status,
+            0);
 }
 
 // Commands with several outputs: a path named twice or a bad second output is

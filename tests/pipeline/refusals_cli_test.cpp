@@ -12,6 +12,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "render/image.h"
+#include "render/image_io.h"
 #include "terrain/raster_io.h"
 #include "tests/test_files.h"
 
@@ -243,7 +245,12 @@ TEST(RefusalsCli, SoilRefusesValuesOutOfRangeAndGridsLargerThanMemory) {
   EXPECT_REFUSED(drift(ground + " --ground-margin 50000", d, "DRIFT_MEMORY_LIMIT=256M"), 1,
                  "--ground raster of 100016 x 100016 cells");
   EXPECT_REFUSED(drift(ground + " --ground-margin -5", d), 2, "--ground-margin");
+  // --frames must name a directory: a file is not one (it was "does not exist").
+  put(d / "afile", "keep");
+  EXPECT_REFUSED(drift(run + " --frames " + (d / "afile").string(), d), 1, "is not a directory");
+  EXPECT_REFUSED(drift(run + " --frames " + (d / "none").string(), d), 1, "does not exist");
   EXPECT_EQ(slurp(out), "old");
+  EXPECT_EQ(slurp(d / "afile"), "keep");
   EXPECT_FALSE(fs::exists(d / "g.tif"));
 }
 
@@ -284,6 +291,13 @@ TEST(RefusalsCli, MarksRefusesValuesOutOfRangeEndlessTracksAndGroundsLargerThanM
                            " -o " + out.string(),
                        d, "DRIFT_MEMORY_LIMIT=64M"),
                  1, "marks state for a 2048 x 2048 ground");
+  // --frames naming a file or a device: refused before any work, naming the flag.
+  put(d / "afile", "keep");
+  EXPECT_REFUSED(drift(run + " --frames " + (d / "afile").string(), d), 1,
+                 "--frames '" + (d / "afile").string() + "' is not a directory");
+  EXPECT_REFUSED(drift(run + " --frames /dev/null", d), 1,
+                 "--frames '/dev/null' is not a directory");
+  EXPECT_EQ(slurp(d / "afile"), "keep");
   EXPECT_EQ(slurp(out), "old");
 }
 
@@ -318,6 +332,29 @@ TEST(RefusalsCli, TilesOfDifferentScenesDoNotMerge) {
       drift("merge " + a0 + " " + (d / "a1.exr").string() + " -o " + (d / "m.exr").string(), d)
           .status,
       0);
+}
+
+// compare --region X,Y,W,H: numbers an int cannot hold are usage errors (they
+// were read modulo 2^32, so 4294967296 compared column 0), and a rectangle
+// whose far edge overflows an int is outside the image (it wrapped past the
+// check and read beyond the pixels).
+TEST(RefusalsCli, CompareRegionsBeyondAnIntOrTheImageAreRefused) {
+  const fs::path d = test_dir();
+  const std::string png = (d / "a.png").string(), diff = (d / "diff.png").string();
+  drift::render::write_image(drift::render::Image(8, 4, {"R", "G", "B"}, 0.5f), png);
+  put(diff, "old");
+  const std::string base = "compare " + png + " " + png + " --diff " + diff + " --region ";
+  EXPECT_EQ(drift(base + "1,1,4,2", d).status, 0);
+  for (const char* region : {"4294967296,0,1,1", "0,0,99999999999999999999,1", "0,0,nan,1", "0,0,1",
+                             "0,0,1,1,1", "1.5,0,1,1"}) {
+    SCOPED_TRACE(region);
+    EXPECT_REFUSED(drift(base + region, d), 2, "--region");
+  }
+  EXPECT_REFUSED(drift(base + "2147483000,0,1000,1", d), 1, "not inside the 8x4 image");
+  EXPECT_REFUSED(drift(base + "0,1,8,2147483647", d), 1, "not inside the 8x4 image");
+  put(diff, "old");
+  EXPECT_REFUSED(drift(base + "7,0,2,1", d), 1, "not inside the 8x4 image");
+  EXPECT_EQ(slurp(diff), "old");
 }
 
 TEST(RefusalsCli, SceneOutputFilesResolveAgainstTheSceneFile) {

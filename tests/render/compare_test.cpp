@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "render/image.h"
@@ -153,6 +154,11 @@ TEST(Compare, CropKeepsTheRectangleAndRefusesOneOutside) {
   EXPECT_THROW(crop(img, 3, 0, 2, 1), Error);
   EXPECT_THROW(crop(img, 0, 0, 0, 1), Error);
   EXPECT_THROW(crop(img, -1, 0, 1, 1), Error);
+  // x + w and y + h beyond an int (a hostile --region) must not wrap past the check.
+  const int huge = std::numeric_limits<int>::max();
+  EXPECT_THROW(crop(img, huge - 1, 0, 2, 1), Error);
+  EXPECT_THROW(crop(img, 1, 0, huge, 1), Error);
+  EXPECT_THROW(crop(img, 0, huge, 1, huge), Error);
 }
 
 }  // namespace
