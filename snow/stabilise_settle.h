@@ -12,18 +12,25 @@
 // The shortcut, in three steps (with k = tan(repose), d the distance between
 // the centres of 8-neighbours, tol the stabilisation tolerance):
 //  1. the repose envelope E: the highest surface with E <= H (H = ground +
-//     snow), E >= ground, and E(i) <= E(n) + k d + tol for every neighbour n of
-//     every cell i holding snow (a film thinner than tol stays as it is). It is
-//     the largest fixed point of E(i) = max(ground, min(H, min_n E(n) + k d +
-//     tol)), found by a label-correcting Dijkstra from the cells that break it;
-//  2. the snow above it, H - E, runs down the steepest excess of the cut
-//     surface while the slope is at repose or steeper (excess >= -tol), and
-//     comes to rest where it flattens;
+//     snow), E >= ground, and E(i) <= E(n) + k d + tol along chains of cells
+//     holding snow that start at a bare neighbour n (a film thinner than tol
+//     counts as bare and stays as it is). Chains start only at bare cells
+//     because their surface will not rise; a deposit still filling would be
+//     cut against its own low point, which is still rising. Found by a
+//     label-correcting Dijkstra from the snowy cells next to bare ones;
+//  2. the snow above it, H - E, runs down the steepest excess: over the cut
+//     surface while it is at repose or steeper (excess >= -tol: what lay above
+//     it is gone), then while it is steeper than repose by more than 10 tol and
+//     the cell holds less than 100 tol of snow; it rests where it stops: at the
+//     upper edge of a deposit, where the passes would stop it;
 //  3. the snow resting at a cell p is heaped there as the cone of slope k over
 //     the surface (Prigozhin 1994: a heap fed at a point grows as the
 //     repose-limited envelope over the surface below it): H' = max(H, T -
 //     k d(x, p)), d the 8-neighbour (octagonal) distance, over the connected
-//     part around p; T by bisection so that the heap holds exactly the snow.
+//     cells around p where the cone stands above H and its layer thickens
+//     away from p by at most 10 tol a step; T by bisection so that the heap
+//     holds exactly the snow. Where a deposit's flank stands at repose below
+//     p, the cone raises it in parallel, as the passes do in many steps.
 // Mass moves from cell to cell as the same doubles (to rounding); everything is
 // sequential in a fixed order, so the result is the same for any thread count.
 // The passes then resume and are what decides convergence: the shortcut only
