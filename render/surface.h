@@ -25,7 +25,9 @@ namespace drift::render {
 // kFlakeDepth where it shows as flakes, and reflects layer_albedo(its albedo,
 // the albedo beneath, scattering x that depth) (render/material.h).
 struct LayerThickness {
-  terrain::HeightField metres;  // outside, nodata and below zero: none
+  // Beyond the raster and at nodata the layer is opaque (as deep as it needs
+  // to be: the storm's snow around a cropped snowfall); below zero: none.
+  terrain::HeightField metres;
   // Kubelka-Munk scattering coefficient S, per metre (snow's, with its
   // source: pipeline/scene_snow.cpp).
   float scattering = 400.0f;
