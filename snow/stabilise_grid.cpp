@@ -136,19 +136,27 @@ class SnowPasses {
     const double room = std::max(h_[i] - 0.0, 0.0);
     return room > tol_ ? std::min(room, 0.5 * largest) / sum : 0.0;
   }
-  // Phase 2: the share of its offers a taker takes (half the largest excess it
-  // is offered from).
-  double take_share(std::size_t i, bool edge) const {
-    double in = 0.0, largest = 0.0;
+  // Calls f(n, e) for each active neighbour n of cell i whose excess e over
+  // repose towards i is above the tolerance: the offers i may take from, in
+  // the fixed neighbour order.
+  template <class F>
+  void for_each_offer_to(std::size_t i, bool edge, F&& f) const {
     for (int k = 0; k < 8; ++k) {
       if (edge && !inside(i, k)) continue;
       const std::size_t n = i + offset_[k];
       if (!active_[n]) continue;
       const double e = excess(n, i, 7 - k);
-      if (e <= tol_) continue;
+      if (e > tol_) f(n, e);
+    }
+  }
+  // Phase 2: the share of its offers a taker takes (half the largest excess it
+  // is offered from).
+  double take_share(std::size_t i, bool edge) const {
+    double in = 0.0, largest = 0.0;
+    for_each_offer_to(i, edge, [&](std::size_t n, double e) {
       in += give_[n] * e;
       largest = std::max(largest, e);
-    }
+    });
     if (!(in > 0.0)) return 0.0;
     return std::min(1.0, 0.5 * largest / in);
   }
@@ -166,15 +174,10 @@ class SnowPasses {
         if (f > 0.0) out += f, moved = true;
       }
     if (take_[i] > 0.0)
-      for (int k = 0; k < 8; ++k) {
-        if (edge && !inside(i, k)) continue;
-        const std::size_t n = i + offset_[k];
-        if (!active_[n]) continue;
-        const double e = excess(n, i, 7 - k);
-        if (e <= tol_) continue;
+      for_each_offer_to(i, edge, [&](std::size_t n, double e) {
         const double f = give_[n] * e * take_[i];
         if (f > 0.0) in += f, moved = true;
-      }
+      });
     delta_[i] = in - out;
     touched_[i] = moved;
   }
