@@ -314,8 +314,8 @@ TEST(OutputsCli, InputsAreRefusedAsOutputsUnderAnyName) {
   fs::copy_file(in.tile1, d / "around.exr");
   put(d / "surround.toml",
       "[terrain]\nraster = \"" + in.dem.string() + "\"\nsurround = \"around.exr\"\n");
-  const Result s = drift("render " + (d / "surround.toml").string() +
-                             " --size 16x8 --spp 1 -o " + (d / "around.exr").string(),
+  const Result s = drift("render " + (d / "surround.toml").string() + " --size 16x8 --spp 1 -o " +
+                             (d / "around.exr").string(),
                          d);
   EXPECT_EQ(s.status, 1) << s.log;
   EXPECT_NE(s.log.find("it is the input"), std::string::npos) << s.log;
