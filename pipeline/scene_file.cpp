@@ -534,6 +534,7 @@ std::vector<fs::path> scene_inputs(const SceneFile& scene) {
   std::vector<fs::path> inputs = {scene.terrain_raster, scene.albedo_map};
   for (const auto& [key, file] : scene.product_files) inputs.push_back(file);
   inputs.insert(inputs.end(), scene.layer_masks.begin(), scene.layer_masks.end());
+  inputs.insert(inputs.end(), scene.surround_rasters.begin(), scene.surround_rasters.end());
   std::erase_if(inputs, [](const fs::path& p) { return p.empty(); });
   return inputs;
 }

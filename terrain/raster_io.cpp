@@ -5,6 +5,7 @@
 #include <gdal_priv.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <system_error>
@@ -88,19 +89,35 @@ void require_usable_georeference(const GeoReference& geo, const fs::path& path) 
   }
 }
 
-// Infinite heights are refused rather than guessed at; NaN is nodata (filled by
-// drift import, refused or handled by each stage).
+// Heights beyond this are no ground in any unit (10,000 km; the deepest trench
+// in millimetres still fits): an undeclared nodata such as -3.4e38, or a
+// corrupt cell. Kept, such a cell overflowed the renderer's arithmetic (a black
+// frame with exit 0) and every stage's slopes.
+constexpr float kMaxAbsHeight = 1e7f;
+
+std::string cell_place(const HeightField& grid, std::size_t i) {
+  const std::size_t width = static_cast<std::size_t>(grid.width());
+  return "column " + std::to_string(i % width) + ", row " + std::to_string(i / width);
+}
+
+// Infinite and absurd heights are refused rather than guessed at; NaN is
+// nodata (filled by drift import, refused or handled by each stage).
 void require_finite_cells(const HeightField& grid, const fs::path& path) {
   const float nd = grid.geo().nodata ? static_cast<float>(*grid.geo().nodata) : 0.0f;
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const float v = grid.values()[i];
-    if (std::isinf(v) && !(grid.geo().nodata && v == nd)) {
-      const std::size_t col = i % static_cast<std::size_t>(grid.width());
-      const std::size_t row = i / static_cast<std::size_t>(grid.width());
+    if (!(std::fabs(v) > kMaxAbsHeight) || (grid.geo().nodata && v == nd)) continue;
+    if (std::isinf(v)) {
       throw Error("raster '" + path.string() + "' holds an infinite height (" +
-                  (v > 0 ? "+inf" : "-inf") + ") at column " + std::to_string(col) + ", row " +
-                  std::to_string(row) + "; declare it nodata or fix the cell");
+                  (v > 0 ? "+inf" : "-inf") + ") at " + cell_place(grid, i) +
+                  "; declare it nodata or fix the cell");
     }
+    char value[32];
+    std::snprintf(value, sizeof value, "%g", static_cast<double>(v));
+    throw Error("raster '" + path.string() + "' holds a height of " + value + " at " +
+                cell_place(grid, i) + ", beyond any ground (|height| <= 1e7 m); if it marks " +
+                "missing data, declare it nodata (gdal_edit.py -a_nodata " + value +
+                "), else fix the cell");
   }
 }
 

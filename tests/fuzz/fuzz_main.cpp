@@ -9,6 +9,7 @@
 // scripts/fuzz.sh): anything larger that is still allocated is unchecked.
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   setenv("DRIFT_MEMORY_LIMIT", "2G", 1);
+  drift::fuzz::bound_work_per_input();
   return 0;
 }
 

@@ -26,6 +26,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+bool g_bounded = false;  // bound_work_per_input()
+
 // The files a fuzzed file may name by a relative path (the seeds do): small
 // meshes and a metric DEM, so that the readers go on past the reference.
 void write_fixtures(const fs::path& dir) {
@@ -98,6 +100,15 @@ void track(const std::uint8_t* data, std::size_t size) {
       t0 = std::min(t0, o.trajectory.start()), t1 = std::max(t1, o.trajectory.end());
     if ((t1 - t0) / t.step > 8) return;  // a few steps: many inputs a second
     const Eigen::Vector3d at = t.objects.front().trajectory.keys.front().position;
+    // The ground lies under the first keyframe; a keyframe kilometres below it
+    // cuts a hole as deep, which the erosion passes then take seconds to fill
+    // (under ASan; round 3 ran 117 inputs in 4 min). Fuzzing, keyframes within
+    // 2 m of the first (every path still meets the 0.64 m ground and digs
+    // through it); the replay runs every kept input whole.
+    if (g_bounded)
+      for (const marks::MarkObject& o : t.objects)
+        for (const auto& key : o.trajectory.keys)
+          if (!((key.position - at).norm() <= 2.0)) return;
     terrain::GeoReference geo = terrain::local_georeference(0.02);
     geo.geotransform[0] = at.x() - 0.32, geo.geotransform[3] = at.y() + 0.32;
     const terrain::HeightField ground(32, 32, static_cast<float>(at.z() - 0.02), geo);
@@ -160,6 +171,8 @@ void image(const std::uint8_t* data, std::size_t size) {
 }
 
 }  // namespace
+
+void bound_work_per_input() { g_bounded = true; }
 
 const std::vector<Target>& targets() {
   static const std::vector<Target> all = {

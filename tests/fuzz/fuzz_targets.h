@@ -22,6 +22,11 @@ struct Target {
 // image.
 const std::vector<Target>& targets();
 
+// For the libFuzzer binaries: a target skips the costly part (a simulation)
+// for inputs whose cost grows with their values without reaching new code,
+// so that a fuzzer explores; the suite's replay runs every input whole.
+void bound_work_per_input();
+
 // Runs target `name` on one input; returns false if there is no such target.
 bool run_target(const std::string& name, const std::uint8_t* data, std::size_t size);
 

@@ -292,15 +292,34 @@ TEST(OutputsCli, InputsAreRefusedAsOutputsUnderAnyName) {
   for (const fs::path& out : {in.dir / "." / "t1.exr", d / "hard.exr"}) {
     const Result r = drift(merge + out.string(), d);
     EXPECT_EQ(r.status, 1) << out << ": " << r.log;
-    EXPECT_NE(r.log.find("input"), std::string::npos) << r.log;
+    EXPECT_NE(r.log.find("it is the input"), std::string::npos) << r.log;
   }
   EXPECT_EQ(slurp(in.tile1), before);
-  // The scene's own rasters are inputs of a render too.
-  const Result r = drift("render " + in.scene.string() + " --size 16x8 --spp 1 -o " +
-                             (d / "a.png").string() + " -o " + in.dem.string(),
+  // The scene's own rasters are inputs of a render too: an albedo map named
+  // like an image the render may write (a DEM cannot be: -o takes .png or .exr
+  // only, and would be refused for its extension), spelled another way.
+  fs::copy_file(in.png, d / "albedo.png");
+  put(d / "scene.toml",
+      "[terrain]\nraster = \"" + in.dem.string() + "\"\nalbedo_map = \"albedo.png\"\n");
+  const std::string albedo_before = slurp(d / "albedo.png");
+  const Result r = drift("render " + (d / "scene.toml").string() + " --size 16x8 --spp 1 -o " +
+                             (d / "a.png").string() + " -o " + (d / "." / "albedo.png").string(),
                          d);
   EXPECT_EQ(r.status, 1) << r.log;
-  EXPECT_TRUE(fs::exists(in.dem) && !fs::exists(d / "a.png"));
+  EXPECT_NE(r.log.find("it is the input"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("albedo.png"), std::string::npos) << r.log;
+  EXPECT_TRUE(slurp(d / "albedo.png") == albedo_before) << "the albedo map was replaced";
+  EXPECT_FALSE(fs::exists(d / "a.png"));
+  // So is a surround raster ("any GDAL raster in metres", EXR included).
+  fs::copy_file(in.tile1, d / "around.exr");
+  put(d / "surround.toml",
+      "[terrain]\nraster = \"" + in.dem.string() + "\"\nsurround = \"around.exr\"\n");
+  const Result s = drift("render " + (d / "surround.toml").string() + " --size 16x8 --spp 1 -o " +
+                             (d / "around.exr").string(),
+                         d);
+  EXPECT_EQ(s.status, 1) << s.log;
+  EXPECT_NE(s.log.find("it is the input"), std::string::npos) << s.log;
+  EXPECT_TRUE(slurp(d / "around.exr") == before) << "the surround raster was replaced";
 }
 
 // Files named inside an input are inputs too: the meshes of an objects or track

@@ -158,6 +158,28 @@ TEST(RefusalsCli, RastersWithInfiniteCellsOrCellSizesAreRefused) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A finite height no ground has, such as an undeclared nodata of -3.4e38 or a
+// snow depth of 1e30 m, is refused like an infinite one: the render of such a
+// raster came out black with exit 0 (the ray tracer's arithmetic overflows).
+TEST(RefusalsCli, RastersWithHeightsBeyondAnyGroundAreRefused) {
+  const fs::path d = test_dir(), out = d / "out.png";
+  const std::string huge = dem(d, -3.4e38f).string();
+  EXPECT_REFUSED(drift("info " + huge, d), 1, "column 3, row 2");
+  drift::terrain::HeightField depth(16, 16, 0.2f, drift::terrain::local_georeference(10.0));
+  depth(5, 4) = 1e30f;
+  drift::terrain::write_geotiff(depth, d / "depth.tif");
+  fs::copy_file(dem(d, 100.0f), d / "ground.tif");
+  put(d / "scene.toml", "[terrain]\nraster = \"ground.tif\"\n");
+  EXPECT_REFUSED(
+      drift("render " + (d / "scene.toml").string() + " --size 16x8 --spp 1 --snow-depth " +
+                (d / "depth.tif").string() + " -o " + out.string(),
+            d),
+      1, "depth.tif' holds a height of 1e+30 at column 5, row 4");
+  EXPECT_FALSE(fs::exists(out));
+  // Within the bound (10,000 km: heights in millimetres still fit), it is read.
+  EXPECT_EQ(drift("info " + dem(d, 9.9e6f).string(), d).status, 0);
+}
+
 TEST(RefusalsCli, SceneValuesWhoseReciprocalsOverflowAndLatitudesOffTheGlobe) {
   const fs::path d = test_dir();
   dem(d);
