@@ -7,6 +7,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "terrain/bilinear.h"
 #include "terrain/error.h"
@@ -253,8 +254,7 @@ Atmosphere::Atmosphere(const AtmosphereParameters& parameters) : parameters_(par
   tbb::parallel_for(0, kMsAltitudes, [&](int a) {
     const double fa = static_cast<double>(a) / (kMsAltitudes - 1);
     const double h = kTableTop * fa * fa;
-    for (int m = 0; m < kMsMus; ++m)
-      ms_table_[a * kMsMus + m] = multiple_scattering_entry(h, -1.0 + 2.0 * m / (kMsMus - 1));
+    multiple_scattering_row(h, &ms_table_[static_cast<std::size_t>(a) * kMsMus]);
   });
 }
 
@@ -274,63 +274,94 @@ void Atmosphere::init_sun_colour() {
   }
 }
 
-Spectrum Atmosphere::multiple_scattering_entry(double h, double mu_s) const {
+namespace {
+
+// Hillaire 2020's sphere of directions and steps along each (below).
+constexpr int kMsDirections = 64;
+constexpr int kMsSteps = 20;
+
+// One step of a direction's path: where it is and, per band, the path's
+// transmittance to it times the scattering there (ts) and the step's
+// integrated transmittance (seg). None of it depends on the sun.
+struct MsStep {
+  Eigen::Vector3d x;
+  double rx = 0.0, hx = 0.0;
+  std::array<double, kBands> ts{}, seg{};
+};
+struct MsPath {
+  std::array<MsStep, kMsSteps> steps;
+  std::array<double, kBands> trans_end{};  // to the ground (or the top)
+  Eigen::Vector3d w{0, 0, 1};
+  double ground = -1.0;  // distance to the ground, < 0 if the path misses it
+};
+
+}  // namespace
+
+void Atmosphere::multiple_scattering_row(double h, Spectrum* row) const {
   // Multiple scattering (Hillaire 2020, eqs. 5-10): at altitude h and sun
   // zenith cosine mu_s, integrate over the sphere of directions the
   // second-order light (isotropic phase) and the transfer f_ms;
-  // Psi = L2 / (1 - f_ms).
-  constexpr int kDirections = 64;
+  // Psi = L2 / (1 - f_ms). Along each direction from radius r to the ground
+  // or the top: the sun's light scattered once towards the start (l2) and
+  // the share scattered at all (f). The paths and f do not depend on the
+  // sun, so they are traced once for the row's kMsMus sun angles (the same
+  // sums in the same order as tracing them for each: same bits, a 20th of
+  // the exponentials).
   const double r = kBottomRadius + h;
-  const Eigen::Vector3d sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
-  std::array<double, kBands> l2{}, f{};
-  for (int d = 0; d < kDirections; ++d) {
+  const Eigen::Vector3d origin(0.0, 0.0, r);
+  std::vector<MsPath> paths(kMsDirections);
+  std::array<double, kBands> f{};
+  for (int d = 0; d < kMsDirections; ++d) {
     // Fibonacci sphere: even directions.
-    const double z = 1.0 - 2.0 * (d + 0.5) / kDirections;
+    const double z = 1.0 - 2.0 * (d + 0.5) / kMsDirections;
     const double phi = d * kPi * (3.0 - std::sqrt(5.0));
     const double s = std::sqrt(1.0 - z * z);
-    second_order_light(r, Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z), sun, l2, f);
-  }
-  Spectrum psi{};
-  for (int b = 0; b < kBands; ++b) {
-    const double l2_avg = l2[b] / kDirections, f_avg = f[b] / kDirections;
-    psi[b] = static_cast<float>(l2_avg / (1.0 - std::min(f_avg, 0.99)));
-  }
-  return psi;
-}
-
-void Atmosphere::second_order_light(double r, const Eigen::Vector3d& w, const Eigen::Vector3d& sun,
-                                    std::array<double, kBands>& l2,
-                                    std::array<double, kBands>& f) const {
-  // Along direction w from radius r to the ground or the top: the sun's light
-  // scattered once towards the start (l2) and the share scattered at all (f).
-  constexpr int kSteps = 20;
-  const double ground = distance_to_ground(r, w.z());
-  const double length = ground >= 0.0 ? ground : distance_to_top(r, w.z());
-  const double dt = length / kSteps;
-  std::array<double, kBands> trans;
-  trans.fill(1.0);
-  const Eigen::Vector3d origin(0.0, 0.0, r);
-  for (int k = 0; k < kSteps; ++k) {
-    const Eigen::Vector3d x = origin + w * ((k + 0.5) * dt);
-    const double rx = x.norm(), hx = rx - kBottomRadius;
-    const Spectrum ext = extinction(hx);
-    const Spectrum sr = rayleigh_scattering(hx), sm = mie_scattering(hx);
-    const Spectrum sun_t = transmittance_to_space(hx, x.dot(sun) / rx);
-    for (int b = 0; b < kBands; ++b) {
-      const double sigma_s = sr[b] + sm[b];
-      const double step_t = std::exp(-ext[b] * dt);
-      const double seg = (1.0 - step_t) / std::max<double>(ext[b], 1e-12);
-      l2[b] += trans[b] * sigma_s * sun_t[b] / (4.0 * kPi) * seg;
-      f[b] += trans[b] * sigma_s * seg;
-      trans[b] *= step_t;
+    MsPath& path = paths[d];
+    path.w = Eigen::Vector3d(s * std::cos(phi), s * std::sin(phi), z);
+    path.ground = distance_to_ground(r, path.w.z());
+    const double length = path.ground >= 0.0 ? path.ground : distance_to_top(r, path.w.z());
+    const double dt = length / kMsSteps;
+    std::array<double, kBands> trans;
+    trans.fill(1.0);
+    for (int k = 0; k < kMsSteps; ++k) {
+      MsStep& step = path.steps[k];
+      step.x = origin + path.w * ((k + 0.5) * dt);
+      step.rx = step.x.norm(), step.hx = step.rx - kBottomRadius;
+      const Spectrum ext = extinction(step.hx);
+      const Spectrum sr = rayleigh_scattering(step.hx), sm = mie_scattering(step.hx);
+      for (int b = 0; b < kBands; ++b) {
+        const double sigma_s = sr[b] + sm[b];
+        const double step_t = std::exp(-ext[b] * dt);
+        step.seg[b] = (1.0 - step_t) / std::max<double>(ext[b], 1e-12);
+        step.ts[b] = trans[b] * sigma_s;
+        f[b] += step.ts[b] * step.seg[b];
+        trans[b] *= step_t;
+      }
     }
+    path.trans_end = trans;
   }
-  if (ground >= 0.0) {  // Lambertian ground lit by the sun
-    const Eigen::Vector3d g = origin + w * ground;
-    const double mu_g = g.dot(sun) / g.norm();
-    const Spectrum sun_t = transmittance_to_space(0.0, mu_g);
-    for (int b = 0; b < kBands; ++b)
-      l2[b] += trans[b] * sun_t[b] * std::max(mu_g, 0.0) * parameters_.ground_albedo / kPi;
+  for (int m = 0; m < kMsMus; ++m) {
+    const double mu_s = -1.0 + 2.0 * m / (kMsMus - 1);
+    const Eigen::Vector3d sun(std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)), 0.0, mu_s);
+    std::array<double, kBands> l2{};
+    for (const MsPath& path : paths) {
+      for (const MsStep& step : path.steps) {
+        const Spectrum sun_t = transmittance_to_space(step.hx, step.x.dot(sun) / step.rx);
+        for (int b = 0; b < kBands; ++b) l2[b] += step.ts[b] * sun_t[b] / (4.0 * kPi) * step.seg[b];
+      }
+      if (path.ground >= 0.0) {  // Lambertian ground lit by the sun
+        const Eigen::Vector3d g = origin + path.w * path.ground;
+        const double mu_g = g.dot(sun) / g.norm();
+        const Spectrum sun_t = transmittance_to_space(0.0, mu_g);
+        for (int b = 0; b < kBands; ++b)
+          l2[b] +=
+              path.trans_end[b] * sun_t[b] * std::max(mu_g, 0.0) * parameters_.ground_albedo / kPi;
+      }
+    }
+    for (int b = 0; b < kBands; ++b) {
+      const double l2_avg = l2[b] / kMsDirections, f_avg = f[b] / kMsDirections;
+      row[m][b] = static_cast<float>(l2_avg / (1.0 - std::min(f_avg, 0.99)));
+    }
   }
 }
 

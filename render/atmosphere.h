@@ -89,12 +89,10 @@ class Atmosphere {
   static constexpr double kTopRadius = 6420e3;
 
  private:
-  // The constructor's steps: the sun's colour per band, and one entry of the
-  // multiple-scattering table with its second-order light along one direction.
+  // The constructor's steps: the sun's colour per band, and one altitude's
+  // row of the multiple-scattering table (kMsMus entries from `row` on).
   void init_sun_colour();
-  Spectrum multiple_scattering_entry(double altitude, double mu_sun) const;
-  void second_order_light(double r, const Eigen::Vector3d& w, const Eigen::Vector3d& sun,
-                          std::array<double, kBands>& l2, std::array<double, kBands>& f) const;
+  void multiple_scattering_row(double altitude, Spectrum* row) const;
   void optical_depths(double h, double mu, const double* rayleigh, const double* ozone, int n,
                       double* depth) const;
 

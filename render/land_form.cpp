@@ -95,12 +95,12 @@ float clump_mask(double x, double y, float size, float cover, std::uint64_t seed
   return keep * inside + (1.0f - keep) * cover;
 }
 
-float raggedness(double x, double y) {
+float raggedness(double x, double y, double footprint) {
   // 6 octaves, Hurst 0.5: a standard deviation of 1/2, so a bound moved by
   // jitter x this stays within about +-jitter.
   constexpr Octaves octaves{800.0, 25.0, 0x7a66ed00u};
   constexpr float amplitude = 0.5f / (kNoiseStd * 1.4036f);  // sqrt(1.97)
-  return filtered_noise(x, y, octaves, amplitude, 0.5f, 0.0).value;
+  return filtered_noise(x, y, octaves, amplitude, 0.5f, footprint).value;
 }
 
 }  // namespace drift::render

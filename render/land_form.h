@@ -29,7 +29,10 @@ terrain::HeightField topographic_position(const terrain::HeightField& dem, doubl
 // `altitude_jitter` times this, so that a tree line or a snow line follows
 // the terrain raggedly. One field for all rules, so zones shift together
 // (a warm, sheltered slope lifts the forest line and the meadows alike).
-float raggedness(double x, double y);
+// A `footprint` (metres) fades the octaves it covers, as the ground detail's
+// (render/procedural_noise.h): a far or bounced ray's rules read the jitter
+// it can resolve, for a quarter to a half of the noise's cost.
+float raggedness(double x, double y, double footprint = 0.0);
 
 // Clumps: where a sparse plant cover grows as separate bushes or groups of
 // them (autumn rowan and birch scrub), a rule covers `cover` of the ground in

@@ -20,15 +20,24 @@ struct Preset {
 // - rock: weathered granite and scree, visible reflectance 0.2-0.35 in the
 //   USGS spectral library (Kokaly et al. 2017); basalt is far darker (~0.08).
 // - dark_rock: the andesite, welded tuff and hornfels of the Hotaka and
-//   Yarigatake massifs (Harayama et al. 2000, GSJ 1:50,000 geological sheet "Kamikochi"),
-//   dark grey-brown with lichen and oxide films: visible reflectance
-//   0.08-0.18 for andesites and lichen-covered rock in the USGS library
-//   (Kokaly et al. 2017), rising gently from blue to red (weathering iron
-//   oxides), so a little warmer than neutral at the same luminance; strongly
-//   varied (fresh faces, oxide stains, lichen), fractured relief.
-// - scree: talus of the same rock below the cliffs, fresher broken faces and
-//   no soil: a little lighter (0.15-0.22), granular relief of blocks of
-//   decimetres to a metre.
+//   Yarigatake massifs (Harayama et al. 2000, GSJ 1:50,000 geological sheet
+//   "Kamikochi"), dark grey-brown with lichen and oxide films. Measured
+//   visible reflectance of these rock types is low: andesite, dacite tuff and
+//   hornfels solids 0.08-0.15 at 0.45-0.65 um in the ASTER/ECOSTRESS library
+//   (Baldridge et al. 2009, Remote Sens. Environ. 113, 711-715) and the USGS
+//   library (Kokaly et al. 2017, splib07); weathering rinds and crustose
+//   lichen darken a face further and flatten its spectrum (Watson 1971,
+//   Remote Sens. Environ. 2, 95-100; Clark 1999, "Spectroscopy of rocks and
+//   minerals", Manual of Remote Sensing vol. 3, ch. 1, sec. 2-3: opaque
+//   mafic grains and coatings lower the visible continuum). Luminance 0.09,
+//   the lower middle of that range, rising gently from blue to red (iron
+//   oxides), so a little warmer than neutral; strongly varied (fresh faces,
+//   oxide stains, lichen), fractured relief. (0.12 before read light grey
+//   in the default view once the haze of 8-10 km of air was added.)
+// - scree: talus of the same rock below the cliffs, fresher broken faces
+//   without lichen or rind: a little lighter (0.11-0.16, Baldridge et al.
+//   2009 for fresh andesite surfaces), luminance 0.125; granular relief of
+//   blocks of decimetres to a metre.
 // - meadow: alpine meadow in autumn (sedges and grasses turning straw and
 //   russet among Vaccinium): senescent leaves reflect more in the red than
 //   green ones (Asner 1998, Remote Sens. Environ. 64, 234-253): ~0.08-0.12.
@@ -59,8 +68,8 @@ constexpr float kRough = 0.35f;
 const std::array<Preset, 10> kPresets = {{
     // name        albedo                  rough wet  fwd   variation bump scale fracture
     {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f, 0.5f}}},
-    {"dark_rock", {{0.13f, 0.118f, 0.102f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f, 0.3f}}},
-    {"scree", {{0.18f, 0.17f, 0.155f}, 0.5f, 0.0f, 0.0f, {0.2f, 0.35f, 2.0f}}},
+    {"dark_rock", {{0.10f, 0.088f, 0.074f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f, 0.3f}}},
+    {"scree", {{0.135f, 0.124f, 0.11f}, 0.5f, 0.0f, 0.0f, {0.2f, 0.35f, 2.0f}}},
     {"meadow", {{0.11f, 0.10f, 0.05f}, 0.7f, 0.0f, 0.0f, {0.3f, 0.2f, 3.0f}}},
     {"dwarf_pine", {{0.028f, 0.042f, 0.022f}, 0.9f, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f}}},
     {"forest", {{0.036f, 0.044f, 0.024f}, 1.0f, 0.0f, 0.0f, {0.35f, 0.6f, 4.5f}}},

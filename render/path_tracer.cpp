@@ -21,6 +21,16 @@ float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCo
 // per metre: light averages over them, so the finest octaves are not needed.
 constexpr float kCloudLightingSpread = 0.05f;
 
+// Path vertices (from the camera's hit on) that take a sample of the sky as a
+// light, weighted by MIS against their bounce's escape. Deeper vertices see
+// the sky through their bounce alone: after one diffuse bounce the path
+// carries a tenth or less of the light (albedo ~0.1-0.3), the clear sky is
+// smooth enough for cosine sampling, and the sky's shadow rays were the
+// costliest rays of the frame (grazing rays across the DEM and its
+// surround, ~20 % of the CPU time of the default frame against ~7 % for the
+// sun's). docs/rendering.md ("Speed") gives the time and relMSE it costs.
+constexpr int kSkySampledVertices = 1;
+
 }  // namespace
 
 PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const CameraRays& camera,
@@ -199,8 +209,10 @@ PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& 
     const GroundBsdf bsdf(hit.normal, wo, hit.material);
     const float u1 = rng.next(), u2 = rng.next();
     if (sun_up_) sample_sun(path, hit, p, bsdf, u1, u2, out, rays);
+    // The sky's own samples at the first vertex only (both numbers drawn
+    // at every vertex, so the stream, and vertex 0, keep their bits).
     const float s1 = rng.next(), s2 = rng.next();
-    sample_sky(path, hit, p, bsdf, s1, s2, out, rays);
+    if (depth < kSkySampledVertices) sample_sky(path, hit, p, bsdf, s1, s2, out, rays);
     if (!bounce(path, hit, p, bsdf, depth, rng)) break;
   }
   return out;
@@ -221,7 +233,9 @@ void PathTracer::escape_to_sky(const Path& path, int depth, PixelSample& out,
     const RayCone cone{path.cone.width, depth == 0 ? path.cone.spread : kCloudLightingSpread};
     light = cloudy_sky(path.origin, path.dir, light, depth == 0, cone, rays);
   }
-  const float w = depth > 0 && sky_sampler_
+  // MIS only where the vertex it left sampled the sky too (depth - 1 <
+  // kSkySampledVertices); deeper escapes are the sky's one estimate.
+  const float w = depth > 0 && depth <= kSkySampledVertices && sky_sampler_
                       ? power_heuristic(path.bounce_pdf, sky_sampler_->pdf(path.dir))
                       : 1.0f;
   out.radiance += path.throughput.cwiseProduct(light) * w;

@@ -20,12 +20,27 @@ Distribution1D::Distribution1D(std::vector<float> f) : f_(std::move(f)), cdf_(f_
   integral_ = cdf_[n];
   for (int i = 1; i <= n; ++i)
     cdf_[i] = integral_ > 0.0f ? cdf_[i] / integral_ : static_cast<float>(i) / n;
+  guide_.resize(n + 1);
+  for (int g = 0; g <= n; ++g) {
+    const float level = static_cast<float>(g) / static_cast<float>(n);
+    guide_[g] = static_cast<int>(std::upper_bound(cdf_.begin(), cdf_.end(), level) - cdf_.begin());
+  }
 }
 
 float Distribution1D::sample(float u, float& pdf, int& cell) const {
   // The last cdf entry <= u (ties: the first cell with a nonzero width).
-  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-  cell = std::clamp(static_cast<int>(it - cdf_.begin()) - 1, 0, size() - 1);
+  // The answer lies between the guides of the cells either side of u's
+  // (one cell of slack each way for the rounding of u x size); u outside
+  // [0, 1) searches the whole table.
+  const int n = size();
+  auto lo = cdf_.begin(), hi = cdf_.end();
+  if (u >= 0.0f && u < 1.0f) {
+    const int g = static_cast<int>(u * static_cast<float>(n));
+    lo = cdf_.begin() + guide_[std::max(g - 1, 0)];
+    hi = cdf_.begin() + std::min(guide_[std::min(g + 2, n)] + 1, n + 1);
+  }
+  const auto it = std::upper_bound(lo, hi, u);
+  cell = std::clamp(static_cast<int>(it - cdf_.begin()) - 1, 0, n - 1);
   float du = u - cdf_[cell];
   const float width = cdf_[cell + 1] - cdf_[cell];
   if (width > 0.0f) du /= width;

@@ -29,6 +29,11 @@ class Distribution1D {
 
  private:
   std::vector<float> f_, cdf_;
+  // Guide table (Chen & Wu's cutpoint method; Devroye 1986, "Non-Uniform
+  // Random Variate Generation", sec. III.2.4): guide_[g] is the first cdf
+  // index above g / size, so sample() searches a few entries, not all, with
+  // the same result as a search of the whole table.
+  std::vector<int> guide_;
   float integral_ = 0.0f;
 };
 

@@ -99,7 +99,7 @@ void stack_rules(const TerrainSurface& surface, double x, double y, const Relief
   float ragged = NAN;  // raggedness(x, y), evaluated once if a rule asks
   for (std::size_t i = 0; i < surface.rules.size(); ++i) {
     const MaterialRule& rule = surface.rules[i];
-    if (rule.altitude_jitter > 0.0f && std::isnan(ragged)) ragged = raggedness(x, y);
+    if (rule.altitude_jitter > 0.0f && std::isnan(ragged)) ragged = raggedness(x, y, footprint);
     const float altitude = rule.altitude_jitter > 0.0f
                                ? relief.altitude + rule.altitude_jitter * ragged
                                : relief.altitude;

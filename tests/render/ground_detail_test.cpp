@@ -192,6 +192,29 @@ TEST(LandForm, RaggednessIsSmoothBoundedNoise) {
   EXPECT_EQ(raggedness(1.0, 2.0), raggedness(1.0, 2.0));
 }
 
+TEST(LandForm, RaggednessSeenByAFootprintKeepsTheOctavesItResolves) {
+  // A 100 m footprint keeps the 800, 400 and 200 m octaves (of 800 down to
+  // 25 m) and drops the rest: what is left is the noise's coarse part, a
+  // little weaker, centred on the same mean and close to the point value;
+  // a footprint wider than the largest octave sees the mean, 0.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 20000.0);
+  double s = 0, s2 = 0, d2 = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const double x = u(rng), y = u(rng);
+    const double r = raggedness(x, y, 100.0), point = raggedness(x, y);
+    s += r, s2 += r * r, d2 += (r - point) * (r - point);
+    EXPECT_EQ(raggedness(x, y, 2000.0), 0.0f);
+  }
+  EXPECT_NEAR(s / n, 0.0, 0.05);
+  EXPECT_GT(std::sqrt(s2 / n), 0.35);
+  EXPECT_LT(std::sqrt(s2 / n), 0.5);
+  EXPECT_GT(std::sqrt(d2 / n), 0.05);  // the fine octaves are gone
+  EXPECT_LT(std::sqrt(d2 / n), 0.25);
+  EXPECT_EQ(raggedness(7.0, 9.0, 0.0), raggedness(7.0, 9.0));
+}
+
 TEST(LandForm, ClumpsCoverTheirShareAsSeparateBushesAndFadeToItFarAway) {
   // Scrub in clumps of 20 m over 35 % of the ground: close up the mask is
   // mostly all or nothing (bushes and gaps, not a tint) and covers 35 %; at

@@ -6,9 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <random>
+#include <vector>
 
 #include "render/random.h"
 #include "render/renderer.h"
@@ -51,6 +54,32 @@ double sphere_integral(G g) {
 }
 
 }  // namespace
+
+TEST(Distribution1D, GuidedSearchFindsTheCellOfAFullSearch) {
+  // 128 cells with runs of zeros: the guide table's search returns the cell
+  // whose cdf interval holds u (the first of a run of equal entries), as a
+  // search of the whole table does, including u at the cells' edges.
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> v(0.0f, 1.0f);
+  std::vector<float> f(128);
+  for (float& x : f) x = v(rng) < 0.3f ? 0.0f : v(rng) * v(rng) * 10.0f;
+  const Distribution1D d(f);
+  std::vector<float> cdf(f.size() + 1, 0.0f);  // as the constructor sums it
+  for (std::size_t i = 0; i < f.size(); ++i) cdf[i + 1] = cdf[i] + f[i] / 128.0f;
+  for (float& c : cdf) c /= cdf.back();
+  std::vector<float> us;
+  for (int k = 0; k < 20000; ++k) us.push_back(v(rng));
+  for (float c : cdf) us.push_back(std::min(c, 0.99999994f));
+  for (float u : us) {
+    float pdf = 0.0f;
+    int cell = -1;
+    d.sample(u, pdf, cell);
+    const int full = std::clamp(
+        static_cast<int>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()) - 1, 0, 127);
+    ASSERT_EQ(cell, full) << u;
+    ASSERT_GT(f[cell], 0.0f) << u;
+  }
+}
 
 TEST(Distribution1D, SamplesFollowTheFunction) {
   const Distribution1D d({1.0f, 0.0f, 3.0f, 0.0f});
