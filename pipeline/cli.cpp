@@ -28,6 +28,21 @@ void require_finite_numbers(const CLI::App& sub) {
   }
 }
 
+// An empty value (`--cover ""`, say from an unset shell variable in a batch
+// job) was taken as the option not given: the output it asked for was not
+// written, the input it named not read, with exit 0. Free text may be empty.
+void require_nonempty_values(const CLI::App& sub) {
+  for (const CLI::Option* option : sub.get_options()) {
+    const std::string name = option->get_name();
+    if (name == "--title" || name == "--labels") continue;  // drift sheet's free text
+    for (const std::string& given : option->results()) {
+      if (!given.empty()) continue;
+      usage_error(option->nonpositional() ? name + " is empty; give a value or leave the option out"
+                                          : "the " + name + " argument is empty; give a value");
+    }
+  }
+}
+
 }  // namespace
 
 CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
@@ -39,6 +54,7 @@ CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::s
       ->check(CLI::Range(0, 4096));
   sub->callback([sub, threads, run = std::move(run)] {
     require_finite_numbers(*sub);
+    require_nonempty_values(*sub);
     std::unique_ptr<tbb::global_control> limit;
     if (*threads > 0) {
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,

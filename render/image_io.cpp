@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 
 #include "render/auto_exposure.h"
 #include "terrain/atomic_file.h"
@@ -93,6 +94,44 @@ Image display_image(const OIIO::ImageSpec& spec, const std::vector<float>& raw) 
   return image;
 }
 
+// OpenEXR allocates each header attribute at the size the file declares before
+// reading it: a 973-byte EXR declaring a 1.9 GB attribute had 1.9 GB allocated
+// (found by fuzz_image). Walks the header(s) and refuses a size beyond the
+// file's end first (OpenEXR file layout: magic, version, then per header
+// `name\0 type\0 int32 size, value` until an empty name; multi-part files
+// repeat headers until an empty one).
+void check_exr_attribute_sizes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char magic[8] = {};
+  if (!in.read(reinterpret_cast<char*>(magic), 8) || magic[0] != 0x76 || magic[1] != 0x2f ||
+      magic[2] != 0x31 || magic[3] != 0x01)
+    return;  // not an EXR: its reader checks it
+  const bool multipart = magic[5] & 0x10;
+  const std::uint64_t file_size = std::filesystem::file_size(path);
+  const auto read_name = [&in](std::string& name) {
+    name.clear();
+    for (char c; in.get(c) && c != '\0' && name.size() < 256;) name.push_back(c);
+    return static_cast<bool>(in);
+  };
+  std::string name, type;
+  for (int attributes = 0; attributes < 100000; ++attributes) {
+    if (!read_name(name)) return;  // truncated: OpenEXR says so
+    if (name.empty()) {
+      if (!multipart || in.peek() == '\0' || in.peek() == EOF) return;
+      continue;  // the next part's header
+    }
+    std::int32_t size = 0;
+    if (!read_name(type) || !in.read(reinterpret_cast<char*>(&size), 4)) return;
+    const std::uint64_t at = static_cast<std::uint64_t>(in.tellg());
+    if (size < 0 || static_cast<std::uint64_t>(size) > file_size - std::min(at, file_size)) {
+      throw Error("cannot read image " + path.string() + ": its header attribute '" + name +
+                  "' declares " + std::to_string(size) + " bytes but the file holds " +
+                  std::to_string(file_size) + " (the file is corrupt)");
+    }
+    in.seekg(size, std::ios::cur);
+  }
+}
+
 }  // namespace
 
 Image read_image(const std::filesystem::path& path) {
@@ -100,6 +139,7 @@ Image read_image(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw Error("image " + path.string() + " does not exist or is not a file; check the path");
   }
+  check_exr_attribute_sizes(path);
   auto in = OIIO::ImageInput::open(path.string());
   if (!in) {
     throw Error("cannot read image " + path.string() + ": " + oiio_message(OIIO::geterror()) +

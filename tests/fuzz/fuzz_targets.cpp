@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -42,13 +43,26 @@ void write_fixtures(const fs::path& dir) {
 
 // The readers take paths: each input goes to a file of this process, named with
 // the extension the reader chooses its format by.
-fs::path as_file(const std::uint8_t* data, std::size_t size, const std::string& name) {
+// The directory goes when the process exits (a fuzzer at its time limit, the
+// replay); one of each run had stayed behind in /tmp. Registered after `dir`
+// is made, the removal runs before `dir` is destroyed.
+const fs::path& fixture_dir() {
   static const fs::path dir = [] {
     const fs::path d = fs::temp_directory_path() / ("drift-fuzz-" + std::to_string(getpid()));
     fs::create_directories(d);
     write_fixtures(d);
     return d;
   }();
+  static const int removal = std::atexit([] {
+    std::error_code ignored;
+    fs::remove_all(fixture_dir(), ignored);
+  });
+  (void)removal;
+  return dir;
+}
+
+fs::path as_file(const std::uint8_t* data, std::size_t size, const std::string& name) {
+  const fs::path& dir = fixture_dir();
   const fs::path file = dir / name;
   std::ofstream(file, std::ios::binary | std::ios::trunc)
       .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
@@ -78,9 +92,15 @@ void raster(const std::uint8_t* data, std::size_t size) {
   });
 }
 
+// The scene TOML, then what it names loaded as drift render loads it (the
+// fixture dem.tif stands for every raster: terrain, surround, albedo map,
+// layer masks, [snow] cover and depth), without building the ray tracer.
 void scene(const std::uint8_t* data, std::size_t size) {
   const fs::path file = as_file(data, size, "scene.toml");
-  refusals_allowed([&] { pipeline::read_scene_file(file); });
+  refusals_allowed([&] {
+    pipeline::SceneFile scene = pipeline::read_scene_file(file);
+    pipeline::load_scene_terrain(scene);
+  });
 }
 
 void objects(const std::uint8_t* data, std::size_t size) {

@@ -146,6 +146,34 @@ TEST(RefusalsCli, ImportRefusesEmptyCropsLatitudesOffTheGlobeAndHugeGrids) {
   EXPECT_EQ(slurp(out), "old");
 }
 
+// An empty value, as an unset shell variable gives, is a usage error naming
+// the option: `snow fall --cover ""` wrote no cover and `render --terrain ""`
+// rendered the scene's own raster, both with exit 0.
+TEST(RefusalsCli, EmptyValuesAreUsageErrors) {
+  const fs::path d = test_dir(), in = dem(d), out = d / "out.tif";
+  put(out, "old");
+  const std::string i = in.string(), o = " -o " + out.string();
+  put(d / "scene.toml", "[terrain]\nraster = \"dem.tif\"\n");
+  const std::string render = "render " + (d / "scene.toml").string() + " --size 16x8 --spp 1 ";
+  const std::pair<std::string, std::string> runs[] = {
+      {"snow fall " + i + " --maps 1 --cover \"\"" + o, "--cover is empty"},
+      {"snow fall " + i + " --maps 1 --objects \"\"" + o, "--objects is empty"},
+      {render + "--terrain \"\" -o " + (d / "a.png").string(), "--terrain is empty"},
+      {render + "--snow-depth \"\" -o " + (d / "a.png").string(), "--snow-depth is empty"},
+      {"snow cover " + i + " --descriptor \"\"" + o, "--descriptor is empty"},
+      {"info \"\"", "raster argument is empty"},
+  };
+  for (const auto& [args, needle] : runs) EXPECT_REFUSED(drift(args, d), 2, needle);
+  EXPECT_EQ(slurp(out), "old");
+  EXPECT_FALSE(fs::exists(d / "a.png"));
+  // Free text may be empty: a sheet without a title.
+  EXPECT_EQ(drift(render + "-o " + (d / "a.png").string(), d).status, 0);
+  EXPECT_EQ(
+      drift("sheet " + (d / "a.png").string() + " --title \"\" -o " + (d / "sheet.png").string(), d)
+          .status,
+      0);
+}
+
 TEST(RefusalsCli, RastersWithInfiniteCellsOrCellSizesAreRefused) {
   const fs::path d = test_dir(), out = d / "out.tif";
   const std::string o = " -o " + out.string();

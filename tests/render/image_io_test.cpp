@@ -152,5 +152,31 @@ TEST(ImageIo, BadFilesAreErrorsNamingTheFile) {
   expect_read_error(temp_dir() / "truncated.exr");
 }
 
+// An EXR header attribute declaring more bytes than the file holds is refused
+// before OpenEXR allocates it (a 973-byte file had 1.9 GB allocated; found by
+// fuzz_image, kept in tests/fuzz/regressions/image/).
+TEST(ImageIo, ExrAttributeLargerThanTheFileIsRefusedBeforeAllocating) {
+  const fs::path file = temp_dir() / "huge_attribute.exr";
+  std::ofstream out(file, std::ios::binary);
+  const unsigned char version[8] = {0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0};
+  out.write(reinterpret_cast<const char*>(version), 8);
+  const char name_and_type[] = "capDate\0string";  // two null-terminated strings
+  out.write(name_and_type, sizeof name_and_type);
+  const std::int32_t size = 0x7ffffff0;
+  out.write(reinterpret_cast<const char*>(&size), 4);
+  out << "2026:11:24 20:26:15";
+  out.close();
+  try {
+    read_image(file);
+    ADD_FAILURE() << "read";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("'capDate' declares 2147483632 bytes but the file holds 46"),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find(file.string()), std::string::npos) << m;
+  }
+}
+
 }  // namespace
 }  // namespace drift::render
