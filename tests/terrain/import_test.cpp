@@ -205,6 +205,21 @@ TEST(Import, ReprojectedGridIsCheckedAtItsWarpedExtent) {
   fs::remove(file);
 }
 
+// GDAL reads a pixel-interleaved row across every band at once: 1.3 GiB for
+// this 457-byte TIFF of 63,233 bands (fuzz_raster), checked before reading.
+TEST(Import, RowAcrossEveryBandIsCheckedBeforeReading) {
+  setenv("DRIFT_MEMORY_LIMIT", "64M", 1);
+  const fs::path file =
+      fs::path(DRIFT_SOURCE_DIR) / "tests/fuzz/regressions/raster/row_across_63233_bands.tif";
+  try {
+    import_dem(file, {});
+    ADD_FAILURE() << "imported";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("across its 63233 bands"), std::string::npos) << e.what();
+  }
+  unsetenv("DRIFT_MEMORY_LIMIT");
+}
+
 TEST(ImportCommand, MissingFileExitsOneAndWritesNothing) {
   const fs::path out = fs::temp_directory_path() / "drift_import_missing.tif";
   fs::remove(out);
