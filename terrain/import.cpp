@@ -2,6 +2,7 @@
 
 #include <gdal_priv.h>
 #include <gdal_utils.h>
+#include <gdalwarper.h>
 #include <ogr_spatialref.h>
 
 #include <cmath>
@@ -129,6 +130,7 @@ struct WarpPlan {
   std::vector<std::string> args;
   double cell = 0.0;  // output cell size (metres, or degrees with keep_crs)
   bool has_crs = false, reproject = false, geographic = false;
+  int epsg = 0;  // the UTM zone reprojected to
 };
 
 // The target CRS and cell size: a geographic DEM goes to the UTM zone of its
@@ -147,6 +149,7 @@ void plan_grid(const fs::path& path, const RasterHeader& header, const ImportOpt
                   fmt(lonlat[1]) + ") lies off the globe; check its georeference (gdalinfo)");
     }
     const int epsg = utm_epsg(lonlat[0], lonlat[1]);
+    plan.epsg = epsg;
     // Square cells near the source's finest metric spacing.
     const auto metric = cell_size_metres(header.geo, header.width, header.height);
     const double cx = metric[0], cy = metric[1];
@@ -192,6 +195,34 @@ double metres_per_unit(const RasterHeader& h) {
   return dx > 0 ? cell_size_metres(h.geo, h.width, h.height)[0] / dx : 1.0;
 }
 
+// The box in metres GDALWarp will cover when it reprojects the whole source
+// (GDALSuggestedWarpOutput2, as GDALWarp itself computes it); false if GDAL
+// cannot say. A tall strip of degrees near a zone's edge lies slanted in UTM:
+// a 4 x 65535 cell strip became 150 million cells, where its own width and
+// height at the cell size counted 320,000 (found by fuzz_raster).
+bool reprojected_extent(const fs::path& path, int epsg, double& width_m, double& height_m) {
+  OGRSpatialReference target;
+  char* wkt = nullptr;
+  if (target.importFromEPSG(epsg) != OGRERR_NONE || target.exportToWkt(&wkt) != OGRERR_NONE)
+    return false;
+  const std::string option = std::string("DST_SRS=") + wkt;
+  CPLFree(wkt);
+  std::unique_ptr<void, decltype(&GDALClose)> ds(GDALOpen(path.c_str(), GA_ReadOnly), GDALClose);
+  if (!ds) return false;
+  const char* options[] = {option.c_str(), nullptr};
+  void* transform =
+      GDALCreateGenImgProjTransformer2(ds.get(), nullptr, const_cast<char**>(options));
+  if (!transform) return false;
+  double gt[6], extent[4];
+  int pixels = 0, lines = 0;
+  const CPLErr err = GDALSuggestedWarpOutput2(ds.get(), GDALGenImgProjTransform, transform, gt,
+                                              &pixels, &lines, extent, 0);
+  GDALDestroyGenImgProjTransformer(transform);
+  if (err != CE_None) return false;
+  width_m = extent[2] - extent[0], height_m = extent[3] - extent[1];
+  return std::isfinite(width_m) && std::isfinite(height_m);
+}
+
 // The warped grid covers the crop box (or the source) at the plan's cell: checks
 // it fits in memory three times over (GDAL's grid, ours, the nodata filling's
 // copy) before GDAL allocates it.
@@ -199,6 +230,11 @@ void require_warp_memory(const RasterHeader& h, const ImportOptions& o, const Wa
                          const fs::path& path) {
   const auto metric = cell_size_metres(h.geo, h.width, h.height);
   double width_m = h.width * metric[0], height_m = h.height * metric[1];
+  double warped_w = 0.0, warped_h = 0.0;
+  if (plan.reproject && !o.crop && !o.crop_lonlat &&
+      reprojected_extent(path, plan.epsg, warped_w, warped_h)) {
+    width_m = std::max(width_m, warped_w), height_m = std::max(height_m, warped_h);
+  }
   if (o.crop) {
     const auto& b = *o.crop;
     const double dx = std::fabs(h.geo.cell_size_x()), dy = std::fabs(h.geo.cell_size_y());

@@ -176,6 +176,22 @@ TEST(ImageIo, ExrAttributeLargerThanTheFileIsRefusedBeforeAllocating) {
         << m;
     EXPECT_NE(m.find(file.string()), std::string::npos) << m;
   }
+  // OpenEXR reads at most 32 characters of a name: a 33rd starts the type
+  // name, and the size follows that (a longer name was walked past whole).
+  const fs::path cut = temp_dir() / "long_name.exr";
+  std::ofstream cut_out(cut, std::ios::binary);
+  cut_out.write(reinterpret_cast<const char*>(version), 8);
+  cut_out << std::string(32, 'a') << 'b' << '\0';
+  cut_out.write(reinterpret_cast<const char*>(&size), 4);
+  cut_out << "0123456789";
+  cut_out.close();
+  EXPECT_THROW(
+      try { read_image(cut); } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("declares 2147483632 bytes"), std::string::npos)
+            << e.what();
+        throw;
+      },
+      Error);
 }
 
 }  // namespace

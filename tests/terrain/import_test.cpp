@@ -178,6 +178,33 @@ TEST(Import, FillNodataIsLinearInAGapsWidth) {
   EXPECT_EQ(g(0, 999999), 7.0f);
 }
 
+// A strip of degrees near a UTM zone's edge lies slanted after reprojection:
+// its warped grid is the slanted strip's box (150 million cells here), not its
+// own 4 x 80,000; found by fuzz_raster when GDAL allocated 603 MB unchecked.
+TEST(Import, ReprojectedGridIsCheckedAtItsWarpedExtent) {
+  OGRSpatialReference wgs84;
+  wgs84.importFromEPSG(4326);
+  char* wkt = nullptr;
+  wgs84.exportToWkt(&wkt);
+  GeoReference geo;
+  geo.crs_wkt = wkt;
+  CPLFree(wkt);
+  geo.geotransform = {137.6, 1e-4, 0.0, 36.4, 0.0, -1e-4};
+  HeightField strip(4, 65535, 1000.0f, geo);
+  const fs::path file = fs::temp_directory_path() / "drift_import_slanted_strip.tif";
+  write_geotiff(strip, file);
+  setenv("DRIFT_MEMORY_LIMIT", "256M", 1);
+  try {
+    import_dem(file, {});
+    ADD_FAILURE() << "imported";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("importing '" + file.string()), std::string::npos)
+        << e.what();
+  }
+  unsetenv("DRIFT_MEMORY_LIMIT");
+  fs::remove(file);
+}
+
 TEST(ImportCommand, MissingFileExitsOneAndWritesNothing) {
   const fs::path out = fs::temp_directory_path() / "drift_import_missing.tif";
   fs::remove(out);
