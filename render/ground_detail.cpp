@@ -109,8 +109,9 @@ struct Block {
   double edge[4] = {0, 0, 0, 0};
   float open[4] = {0, 0, 0, 0};
 };
-// On a cliff the rows follow bedding or sheeting that is seldom a straight
-// line: the row coordinate is bent by two octaves of noise along the rows
+// Rows follow bedding or sheeting that is seldom a straight line (on gentle
+// ground too, where straight rows read as paving): the row coordinate is
+// bent by two octaves of noise along the rows
 // (wavelengths 4 and 1.3 block lengths, rms about a quarter of a row), so a
 // ledge rises and falls across a face and rows pinch out (Selby 1980:
 // sheeting joints follow the surface's curvature). The noise is zero-mean,
@@ -127,11 +128,11 @@ double bent_row(double ru, double rv, double length, double rows, std::uint64_t 
 // goes instead of running the width of a face.
 constexpr double kOpenStretch = 1.7;
 
-Block locate_block(double u, double v, double length, double rows, double angle, std::uint64_t set,
-                   bool layered) {
+Block locate_block(double u, double v, double length, double rows, double angle,
+                   std::uint64_t set) {
   const double c = std::cos(angle), s = std::sin(angle);
   const double ru = c * u + s * v;
-  const double rv = layered ? bent_row(ru, -s * u + c * v, length, rows, set) : -s * u + c * v;
+  const double rv = bent_row(ru, -s * u + c * v, length, rows, set);
   Block b;
   b.row = joint_span(rv, rows, 0, set);
   const double shifted = ru + unit_hash(b.row.index, 0, set + 1) * length;
@@ -140,9 +141,8 @@ Block locate_block(double u, double v, double length, double rows, double angle,
   b.sv = static_cast<float>((rv - b.row.lo) / (b.row.hi - b.row.lo));
   const double edge[4] = {shifted - b.col.lo, b.col.hi - shifted, rv - b.row.lo, b.row.hi - rv};
   // Each joint's openness from its own index (a row joint's from its
-  // stretch too), so both sides of it agree.
-  const auto stretch =
-      layered ? static_cast<std::int64_t>(std::floor(ru / (kOpenStretch * length))) : 0;
+  // stretch along the row too), so both sides of it agree.
+  const auto stretch = static_cast<std::int64_t>(std::floor(ru / (kOpenStretch * length)));
   const float h[4] = {unit_hash(b.col.index, b.row.index, set + 3),
                       unit_hash(b.col.index + 1, b.row.index, set + 3),
                       unit_hash(b.row.index, stretch, set + 4),
@@ -191,7 +191,7 @@ JointedBlocks jointed_blocks(double u, double v, float length, float rms, bool l
   out.lost_variance = (1.0f - keep * keep) * rms * rms;
   if (keep <= 0.0f) return out;
   const float angle = layered ? 0.21f : 0.61f;
-  const Block b = locate_block(u, v, length, rows, angle, 1, layered);
+  const Block b = locate_block(u, v, length, rows, angle, 1);
   // Share of the variance across the rows: ledges on a cliff.
   const float across = layered ? 0.75f : 0.5f;
   auto hash = [&](std::uint64_t k) { return unit_hash(b.col.index, b.row.index, k); };
@@ -219,8 +219,7 @@ float joint_tone(double u, double v, float scale, bool layered, double footprint
   const double rows = (layered ? 0.5 : 0.8) * length;
   const float keep = kept(rows, footprint);
   if (keep <= 0.0f) return 1.0f;
-  const Block b =
-      locate_block(u + 5171.3, v + 2237.9, length, rows, layered ? -0.27 : 1.13, 11, layered);
+  const Block b = locate_block(u + 5171.3, v + 2237.9, length, rows, layered ? -0.27 : 1.13, 11);
   const float tone =
       kMassTone * std::sqrt(3.0f) * (2.0f * unit_hash(b.col.index, b.row.index, 12) - 1.0f);
   return (1.0f + keep * tone) * joint_darkening(b, length, rows, footprint, keep);
