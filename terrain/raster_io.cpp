@@ -176,6 +176,15 @@ HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadO
                      std::to_string(win.height) + " cells as float32)",
                  "crop it (drift import --crop) or resample it to a coarser cell size first");
 
+  // GDAL reads a pixel-interleaved file a block across all its bands at once
+  // (import's check, terrain/import.cpp): at least a row of them.
+  const GDALDataType type = band->GetRasterDataType();
+  require_memory(static_cast<std::uint64_t>(win.width) * ds->GetRasterCount() *
+                     static_cast<std::uint64_t>(std::max(GDALGetDataTypeSizeBytes(type), 1)),
+                 "raster '" + path.string() + "' (a row of " + std::to_string(win.width) +
+                     " cells across its " + std::to_string(ds->GetRasterCount()) + " bands)",
+                 "keep band 1 only first: gdal_translate -b 1 IN OUT.tif");
+
   GeoReference geo = georeference_of(*ds, *band);
   require_usable_georeference(geo, path);
   // Shift the geotransform to the window's origin.

@@ -146,6 +146,15 @@ TEST(RefusalsCli, ImportRefusesEmptyCropsLatitudesOffTheGlobeAndHugeGrids) {
   EXPECT_EQ(slurp(out), "old");
 }
 
+// A pixel-interleaved TIFF of 63,233 bands: GDAL reads a row across all of
+// them (1.3 GiB) to give one row of band 1; every reader checks that first.
+TEST(RefusalsCli, RowAcrossEveryBandIsCheckedBeforeReading) {
+  const fs::path d = test_dir();
+  const std::string bands =
+      DRIFT_SOURCE_DIR "/tests/fuzz/regressions/raster/row_across_63233_bands.tif";
+  EXPECT_REFUSED(drift("info " + bands, d, "DRIFT_MEMORY_LIMIT=64M"), 1, "across its 63233 bands");
+}
+
 // An empty value, as an unset shell variable gives, is a usage error naming
 // the option: `snow fall --cover ""` wrote no cover and `render --terrain ""`
 // rendered the scene's own raster, both with exit 0.
