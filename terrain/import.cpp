@@ -309,19 +309,6 @@ HeightField warp_to_grid(const fs::path& path, const WarpPlan& plan, const Impor
   return grid;
 }
 
-// GDAL reads a pixel-interleaved file a block at a time across all its bands,
-// however few it is asked for: an 11012-cell row of some 63,000 Int16 bands is
-// 1.4 GB read for one row of band 1 (found by fuzz_raster). Checked at one
-// row, the least such a block holds.
-void require_source_row_memory(const RasterHeader& h, const fs::path& path) {
-  const int bytes = GDALGetDataTypeSizeBytes(GDALGetDataTypeByName(h.data_type.c_str()));
-  const double row = double(h.width) * h.bands * std::max(bytes, 1);
-  require_memory(static_cast<std::uint64_t>(std::min(row, 1.8e19)),
-                 "reading '" + path.string() + "' (a row of " + std::to_string(h.width) +
-                     " cells across its " + std::to_string(h.bands) + " bands)",
-                 "keep band 1 only first: gdal_translate -b 1 IN OUT.tif");
-}
-
 }  // namespace
 
 void ImportOptions::validate() const {
@@ -356,7 +343,9 @@ void ImportOptions::validate() const {
 ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   o.validate();
   const RasterHeader header = read_raster_header(path);  // clear errors for bad files
-  require_source_row_memory(header, path);
+  require_row_across_bands_memory(
+      static_cast<std::uint64_t>(header.width), header.bands,
+      GDALGetDataTypeSizeBytes(GDALGetDataTypeByName(header.data_type.c_str())), path);
   ImportResult result;
   result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
                           std::to_string(header.width) + " x " + std::to_string(header.height));

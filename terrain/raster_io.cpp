@@ -176,14 +176,8 @@ HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadO
                      std::to_string(win.height) + " cells as float32)",
                  "crop it (drift import --crop) or resample it to a coarser cell size first");
 
-  // GDAL reads a pixel-interleaved file a block across all its bands at once
-  // (import's check, terrain/import.cpp): at least a row of them.
-  const GDALDataType type = band->GetRasterDataType();
-  require_memory(static_cast<std::uint64_t>(win.width) * ds->GetRasterCount() *
-                     static_cast<std::uint64_t>(std::max(GDALGetDataTypeSizeBytes(type), 1)),
-                 "raster '" + path.string() + "' (a row of " + std::to_string(win.width) +
-                     " cells across its " + std::to_string(ds->GetRasterCount()) + " bands)",
-                 "keep band 1 only first: gdal_translate -b 1 IN OUT.tif");
+  require_row_across_bands_memory(static_cast<std::uint64_t>(win.width), ds->GetRasterCount(),
+                                  GDALGetDataTypeSizeBytes(band->GetRasterDataType()), path);
 
   GeoReference geo = georeference_of(*ds, *band);
   require_usable_georeference(geo, path);
@@ -257,6 +251,15 @@ void write_geotiff(const HeightField& grid, const fs::path& path, const WriteOpt
                 " (disk full or not writable?)");
   }
   out.commit();
+}
+
+void require_row_across_bands_memory(std::uint64_t width, int bands, int bytes_per_cell,
+                                     const fs::path& path) {
+  const double row = double(width) * std::max(bands, 1) * std::max(bytes_per_cell, 1);
+  require_memory(static_cast<std::uint64_t>(std::min(row, 1.8e19)),
+                 "raster '" + path.string() + "' (a row of " + std::to_string(width) +
+                     " cells across its " + std::to_string(bands) + " bands)",
+                 "keep band 1 only first: gdal_translate -b 1 IN OUT.tif");
 }
 
 }  // namespace drift::terrain

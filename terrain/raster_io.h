@@ -5,6 +5,7 @@
 // GeoReference::nodata keeps the declared value for information.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -38,6 +39,14 @@ struct RasterHeader {
 };
 
 RasterHeader read_raster_header(const std::filesystem::path& path);
+
+// GDAL reads a pixel-interleaved file a block at a time across all its bands,
+// however few it is asked for: an 11012-cell row of some 63,000 Int16 bands is
+// 1.4 GB read for one row of band 1 (found by fuzz_raster). Throws unless a
+// row of `width` cells across `bands` bands of `bytes_per_cell` fits, the
+// least such a block holds.
+void require_row_across_bands_memory(std::uint64_t width, int bands, int bytes_per_cell,
+                                     const std::filesystem::path& path);
 
 // Throws drift::Error naming the file for: a missing file, a file GDAL cannot
 // read as a raster, a band that does not exist, a read failure (truncated or
