@@ -73,22 +73,24 @@ void read_detail(Section& s, render::MaterialOverride& m) {
   m.detail = d;
 }
 
+// `material`: a preset's name (render/material.h), checked; empty without one.
+std::string read_preset_name(Section& s) {
+  const auto name = s.string("material");
+  if (!name) return {};
+  if (!render::material_preset(*name))
+    s.invalid("material",
+              "is '" + *name + "'; known materials: " + render::material_preset_names());
+  return *name;
+}
+
 // The material keys of [terrain], [[terrain.rule]] and [[terrain.layer]]:
 // `material` names a preset (which sets every field), and `color`,
 // `roughness` and `wetness` set (or override) one field each. `preset` gets
 // the preset's name (empty without one).
 render::MaterialOverride read_material(Section& s, std::string& preset) {
   render::MaterialOverride m;
-  preset.clear();
-  if (const auto name = s.string("material")) {
-    preset = *name;
-    const auto found = render::material_preset(*name);
-    if (!found) {
-      s.invalid("material",
-                "is '" + *name + "'; known materials: " + render::material_preset_names());
-    }
-    m = render::full_override(*found);
-  }
+  preset = read_preset_name(s);
+  if (!preset.empty()) m = render::full_override(*render::material_preset(preset));
   const Eigen::Vector3f none = Eigen::Vector3f::Constant(-1.0f);
   if (const Eigen::Vector3f c = s.color("color", none); c != none) m.albedo = c;
   if (const double r = s.number("roughness", -1.0, 0.0, render::kMaxRoughness); r >= 0.0)
@@ -433,6 +435,26 @@ void read_output(const toml::table& root, const fs::path& path, SceneFile& scene
   out.finish();
 }
 
+// A scene's [[objects]]: the shared keys (pipeline/object_list.h) and
+// `material`, a preset (render/material.h) whose albedo `color` overrides.
+std::vector<terrain::PlacedMesh> read_objects_with_materials(const toml::table& root,
+                                                             const fs::path& path) {
+  struct Choice {
+    std::string preset;
+    bool color = false;
+  };
+  std::vector<Choice> chosen;
+  std::vector<terrain::PlacedMesh> meshes = read_objects(root, path, [&](Section& s, std::size_t) {
+    chosen.push_back({read_preset_name(s), s.has("color")});
+  });
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    meshes[i].material = chosen[i].preset;
+    if (!chosen[i].preset.empty() && !chosen[i].color)
+      meshes[i].albedo = render::material_preset(chosen[i].preset)->albedo;
+  }
+  return meshes;
+}
+
 }  // namespace
 
 SceneFile read_scene_file(const fs::path& path) {
@@ -445,7 +467,7 @@ SceneFile read_scene_file(const fs::path& path) {
   read_sky(root, path, scene.input.sky);
   read_clouds(root, path, scene.input);
   read_camera(root, path, scene);
-  scene.input.meshes = read_objects(root, path);
+  scene.input.meshes = read_objects_with_materials(root, path);
   if (objects_file) {
     for (auto& placed : read_objects_file(*objects_file))
       scene.input.meshes.push_back(std::move(placed));

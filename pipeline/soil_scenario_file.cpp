@@ -107,9 +107,31 @@ void read_simulation(const toml::table& root, const std::filesystem::path& file,
   s.finish();
 }
 
+// `window` with one pixel around it where the raster has one, so that the
+// columns near the window's edge interpolate towards the DEM beyond it, as the
+// renderer's surround does, instead of holding the edge pixel's height: held,
+// the crop's edges stood up to 4 m off the DEM around it on Yarigatake's 41
+// degree slopes (a step along the crop's outline in the render).
+struct WindowWithApron {
+  terrain::RasterWindow read;  // the window and its apron
+  int left = 0, top = 0;       // apron pixels before the window
+};
+WindowWithApron with_apron(const terrain::RasterWindow& w, const terrain::RasterHeader& raster) {
+  WindowWithApron a{w};
+  const bool inside = w.width >= 1 && w.height >= 1 && w.x_off >= 0 && w.y_off >= 0 &&
+                      w.x_off + w.width <= raster.width && w.y_off + w.height <= raster.height;
+  if (!inside) return a;  // read_raster refuses it, in the user's numbers
+  a.left = w.x_off > 0 ? 1 : 0;
+  a.top = w.y_off > 0 ? 1 : 0;
+  const int right = w.x_off + w.width < raster.width ? 1 : 0;
+  const int bottom = w.y_off + w.height < raster.height ? 1 : 0;
+  a.read = {w.x_off - a.left, w.y_off - a.top, w.width + a.left + right, w.height + a.top + bottom};
+  return a;
+}
+
 // The DEM crop under the grid: `window` pixels of the raster, each cell split
-// into `upsample` x `upsample` columns (bilinear), the grid's floor `depth`
-// metres below the crop's lowest point.
+// into `upsample` x `upsample` columns (bilinear over the window and its
+// apron), the grid's floor `depth` metres below the lowest column.
 void read_dem(Section& s, const std::filesystem::path& file,
               const std::filesystem::path& dem_override, soil::SoilScenario& sc) {
   const std::filesystem::path dem =
@@ -118,25 +140,32 @@ void read_dem(Section& s, const std::filesystem::path& file,
   if (!w) s.invalid_table("with dem needs window = [x_off, y_off, width, height] (pixels)");
   const int up = s.integer("upsample", 1, 1, 64);
   const double depth = s.number("depth", 2.0, 0, 1e4);
+  const terrain::RasterWindow window{static_cast<int>((*w)[0]), static_cast<int>((*w)[1]),
+                                     static_cast<int>((*w)[2]), static_cast<int>((*w)[3])};
+  const WindowWithApron apron = with_apron(window, terrain::read_raster_header(dem));
   terrain::ReadOptions ro;
-  ro.window = terrain::RasterWindow{static_cast<int>((*w)[0]), static_cast<int>((*w)[1]),
-                                    static_cast<int>((*w)[2]), static_cast<int>((*w)[3])};
+  ro.window = apron.read;
   const terrain::HeightField crop = terrain::read_raster(dem, ro);
   require_metric_crs(crop, dem);
   const double cell = crop.geo().cell_size_x();
   sc.shape.voxel_size = cell / up;
-  sc.shape.nx = crop.width() * up;
-  sc.shape.ny = crop.height() * up;
-  float lo = INFINITY;
-  for (float v : crop.values()) lo = std::min(lo, v);
-  sc.shape.origin = {0, 0, lo - depth};
+  sc.shape.nx = window.width * up;
+  sc.shape.ny = window.height * up;
   terrain::HeightField heights(sc.shape.nx, sc.shape.ny, 0.0f, crop.geo());
   auto& gt = heights.geo().geotransform;
-  gt[1] /= up;
-  gt[5] /= up;
-  for (int r = 0; r < heights.height(); ++r)
-    for (int x = 0; x < heights.width(); ++x)
-      heights(x, r) = terrain::bilinear_clamped(crop, (x + 0.5) / up - 0.5, (r + 0.5) / up - 0.5);
+  // The window's corner, then columns of 1/up of a cell.
+  gt[0] += apron.left * gt[1] + apron.top * gt[2];
+  gt[3] += apron.left * gt[4] + apron.top * gt[5];
+  for (int i : {1, 2, 4, 5}) gt[i] /= up;
+  float lo = INFINITY;
+  for (int r = 0; r < heights.height(); ++r) {
+    for (int x = 0; x < heights.width(); ++x) {
+      heights(x, r) = terrain::bilinear_clamped(crop, apron.left + (x + 0.5) / up - 0.5,
+                                                apron.top + (r + 0.5) / up - 0.5);
+      lo = std::min(lo, heights(x, r));
+    }
+  }
+  sc.shape.origin = {0, 0, lo - depth};
   sc.geo = heights.geo();
   sc.terrain.kind = soil::TerrainSource::Kind::HeightField;
   sc.terrain.heights = std::move(heights);

@@ -54,6 +54,14 @@ struct Preset {
 // - mud: bare soil 0.10-0.25 dry, as low as 0.05 dark and wet (Oke); a dark
 //   soil (luminance 0.17) under a film of water, wetness 0.8, which darkens
 //   it to about 0.11 (render/bsdf.h, Lekner & Dorf 1988) and makes it shine.
+// - soil: freshly moved dry mineral soil (sandy loam or loam spoil, a
+//   landslide's or a tipped load's deposit): bare dry soils reflect 0.10-0.25
+//   (Oke), loams and sandy loams dry and disturbed at the upper end (Post et
+//   al. 2000, Soil Sci. Soc. Am. J. 64, 1027-1034: dry soils 0.14-0.35, the
+//   lighter the coarser and drier); luminance 0.20, brown. Clods and lumps
+//   from a few centimetres to a metre: very rough (Oren-Nayar sigma 0.6, as
+//   Oren & Nayar 1994 fit to soils and clay), strong relief over 1 m, a
+//   mottled tone. `drift soil`'s deposits render in it ([[objects]] material).
 // - grass: green grass in the visible, chlorophyll absorbing blue and red:
 //   ~0.05-0.12 with a green peak (luminance 0.10). A canopy is very rough.
 // - snow: fresh snow 0.75-0.95 (Hartmann), visible albedo of clean snow
@@ -65,7 +73,7 @@ struct Preset {
 // 31-51: joint spacing of 0.3-3 m and more in hard rock, the blocks'
 // faces the facets a photograph of a ridge shows).
 constexpr float kRough = 0.35f;
-const std::array<Preset, 10> kPresets = {{
+const std::array<Preset, 11> kPresets = {{
     // name        albedo                  rough wet  fwd   variation bump scale fracture
     {"rock", {{0.30f, 0.28f, 0.25f}, kRough, 0.0f, 0.0f, {0.25f, 0.5f, 4.0f, 0.5f}}},
     {"dark_rock", {{0.10f, 0.088f, 0.074f}, 0.4f, 0.0f, 0.0f, {0.35f, 0.6f, 4.0f, 0.3f}}},
@@ -75,6 +83,7 @@ const std::array<Preset, 10> kPresets = {{
     {"forest", {{0.036f, 0.044f, 0.024f}, 1.0f, 0.0f, 0.0f, {0.35f, 0.6f, 4.5f}}},
     {"sand", {{0.45f, 0.37f, 0.26f}, 0.3f, 0.0f, 0.0f, {0.05f, 0.0f, 4.0f}}},
     {"mud", {{0.20f, 0.16f, 0.12f}, 0.1f, 0.8f, 0.0f, {0.15f, 0.15f, 2.0f}}},
+    {"soil", {{0.25f, 0.195f, 0.14f}, 0.6f, 0.0f, 0.0f, {0.2f, 0.35f, 1.0f}}},
     {"grass", {{0.07f, 0.12f, 0.04f}, 0.6f, 0.0f, 0.0f, {0.2f, 0.25f, 3.0f}}},
     {"snow", {{0.90f, 0.92f, 0.95f}, 0.1f, 0.0f, 0.5f, {0.03f, 0.1f, 3.0f}}},
 }};

@@ -49,7 +49,7 @@ struct Material {
 Material mix(const Material& a, const Material& b, float t);
 
 // The named presets (land classes: rock, dark_rock, scree, meadow, dwarf_pine,
-// forest; and sand, mud, grass, snow), or nullopt for an unknown
+// forest; and sand, mud, soil, grass, snow), or nullopt for an unknown
 // name. Values and their sources are in material.cpp.
 std::optional<Material> material_preset(std::string_view name);
 // The presets' names, comma-separated, for error messages.

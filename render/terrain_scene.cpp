@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "render/ground_detail.h"
 #include "render/snow_flakes.h"
 #include "terrain/bilinear.h"
 #include "terrain/derivatives.h"
@@ -48,6 +49,19 @@ std::optional<terrain::HeightField> raised_ground(const SceneInput& input) {
   for (const terrain::products::HeightChange& change : input.height_changes)
     raised = add_height_change(raised ? *raised : input.terrain, change.metres);
   return raised;
+}
+
+// What an object is made of: its preset (the scene's `material`) with its
+// albedo, or plain diffuse albedo.
+Material object_material(const terrain::PlacedMesh& placed) {
+  Material m;
+  if (!placed.material.empty()) {
+    const std::optional<Material> preset = material_preset(placed.material);
+    if (!preset) throw Error("unknown object material '" + placed.material + "'");
+    m = *preset;
+  }
+  m.albedo = placed.albedo;
+  return m;
 }
 
 }  // namespace
@@ -161,7 +175,7 @@ void TerrainScene::attach_terrain_grids() {
   rtcAttachGeometryByID(embree_->scene, grid_geometry, 0);
   rtcReleaseGeometry(grid_geometry);
   terrain_geometries_ = 1;
-  mesh_albedo_.push_back(surface_.ground.albedo);
+  mesh_material_.push_back(surface_.ground);
   mesh_covers_.emplace_back();
 }
 
@@ -185,7 +199,7 @@ void TerrainScene::attach_surround(const SurroundOptions& options) {
   rtcReleaseGeometry(geometry);
   surround_reach_ = ring.reach;
   // Keep the per-geometry tables indexed by id.
-  mesh_albedo_.resize(surround_geometry_ + 1, surface_.ground.albedo);
+  mesh_material_.resize(surround_geometry_ + 1, surface_.ground);
   mesh_covers_.resize(surround_geometry_ + 1);
 }
 
@@ -209,11 +223,11 @@ void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
   rtcCommitGeometry(geom);
   const unsigned id = rtcAttachGeometry(embree_->scene, geom);
   rtcReleaseGeometry(geom);
-  if (mesh_albedo_.size() <= id) {
-    mesh_albedo_.resize(id + 1);
+  if (mesh_material_.size() <= id) {
+    mesh_material_.resize(id + 1);
     mesh_covers_.resize(id + 1);
   }
-  mesh_albedo_[id] = placed.albedo;
+  mesh_material_[id] = object_material(placed);
   // An attributed mesh (terrain/products.h) may carry the attributes the
   // object layers place their materials by (snow coverage).
   MeshCover& covers = mesh_covers_[id];
@@ -323,9 +337,22 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
 Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangle, float u, float v,
                                              const Eigen::Vector3f& ng, Hit& hit,
                                              double footprint) const {
-  hit.material = Material{mesh_albedo_[geometry]};
+  hit.material = mesh_material_[geometry];
   hit.coverage = {};  // the objects themselves have no channel
   Eigen::Vector3f n = ng.normalized();
+  const GroundDetail& detail = hit.material.detail;
+  if (detail.variation > 0.0f || detail.bump > 0.0f) {
+    // A preset's relief and mottle (render/ground_detail.h) in world space,
+    // read on the face turned up (the detail is laid out for ground); the
+    // normal turned back after, as intersect() faces it to the ray anyway.
+    const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
+    const float side = n.z() < 0.0f ? -1.0f : 1.0f;
+    const DetailedGround g =
+        ground_detail(hit.material, world.x(), world.y(), world.z(), side * n, footprint);
+    hit.material.albedo = g.albedo;
+    hit.material.roughness = g.roughness;
+    n = side * g.normal;
+  }
   if (geometry >= mesh_covers_.size()) return n;
   const MeshCover& covers = mesh_covers_[geometry];
   for (std::size_t i = 0; i < covers.values.size(); ++i) {

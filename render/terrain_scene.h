@@ -112,8 +112,8 @@ class TerrainScene {
     std::vector<std::vector<float>> values;  // by object layer
     std::vector<std::array<int, 3>> triangles;
   };
-  std::vector<Eigen::Vector3f> mesh_albedo_;  // by Embree geometry id
-  std::vector<MeshCover> mesh_covers_;        // likewise
+  std::vector<Material> mesh_material_;  // by Embree geometry id
+  std::vector<MeshCover> mesh_covers_;   // likewise
   unsigned terrain_geometries_ = 0;           // geometry ids [0, n) are terrain grids
   // The ground beyond the DEM's edge (render/surround.h): its vertex buffer,
   // grids and Embree geometry id (none: -1).

@@ -39,6 +39,9 @@ struct PlacedMesh {
   // coordinates in float would lose half a metre.
   Eigen::Vector3d position{0, 0, 0};
   Eigen::Vector3f albedo{0.5f, 0.5f, 0.5f};
+  // The renderer's material preset (render/material.h) the object is made of,
+  // with `albedo` as its albedo; empty: plain diffuse `albedo`.
+  std::string material;
 };
 
 }  // namespace drift::terrain

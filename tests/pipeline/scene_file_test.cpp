@@ -12,6 +12,7 @@
 #include "pipeline/scene_products.h"
 #include "pipeline/toml_section.h"
 #include "render/image_io.h"
+#include "render/material.h"
 #include "render/solar_position.h"
 #include "render/surface.h"
 #include "terrain/error.h"
@@ -257,6 +258,25 @@ TEST(SceneFile, ObjectsAreLoadedAndPlaced) {
   EXPECT_NEAR(v[1].y(), 2.0f, 1e-5f);
   EXPECT_NEAR(v[1].z(), 0.0f, 1e-5f);
   EXPECT_EQ(s.input.meshes[0].position, Eigen::Vector3d(100, 200, 5));
+}
+
+TEST(SceneFile, ObjectsTakeAMaterialPresetWhoseColourTheirOwnOverrides) {
+  const fs::path obj = write_scene("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string mesh = "[[objects]]\nmesh = \"" + obj.string() + "\"\n";
+  const auto s = drift::pipeline::read_scene_file(
+      write_scene("obj_material.toml", std::string(kTerrain) + mesh + "material = \"soil\"\n" +
+                                           mesh + "material = \"soil\"\ncolor = [0.3, 0.2, 0.1]\n" +
+                                           mesh + "color = [0.3, 0.2, 0.1]\n"));
+  ASSERT_EQ(s.input.meshes.size(), 3u);
+  EXPECT_EQ(s.input.meshes[0].material, "soil");
+  EXPECT_EQ(s.input.meshes[0].albedo, drift::render::material_preset("soil")->albedo);
+  EXPECT_EQ(s.input.meshes[1].material, "soil");
+  EXPECT_EQ(s.input.meshes[1].albedo, Eigen::Vector3f(0.3f, 0.2f, 0.1f));
+  EXPECT_EQ(s.input.meshes[2].material, "");
+  const std::string e = error_of(std::string(kTerrain) + mesh + "material = \"clay\"\n");
+  EXPECT_NE(e.find("objects.material"), std::string::npos) << e;
+  EXPECT_NE(e.find("'clay'"), std::string::npos) << e;
+  EXPECT_NE(e.find("soil"), std::string::npos) << e;
 }
 
 TEST(SceneFile, ReadsSnowAndRippleLayers) {

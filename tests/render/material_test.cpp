@@ -22,7 +22,7 @@ constexpr double kWholeDetail = 1e6;
 
 TEST(MaterialPresets, KnownNamesWithPlausibleAlbedos) {
   EXPECT_EQ(material_preset_names(),
-            "rock, dark_rock, scree, meadow, dwarf_pine, forest, sand, mud, grass, snow");
+            "rock, dark_rock, scree, meadow, dwarf_pine, forest, sand, mud, soil, grass, snow");
   auto lum = [](const Material& m) {
     return 0.2126f * m.albedo.x() + 0.7152f * m.albedo.y() + 0.0722f * m.albedo.z();
   };

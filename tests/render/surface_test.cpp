@@ -297,6 +297,58 @@ TEST(Snow, MeshCoverageBlendsTheObjectsMaterial) {
   EXPECT_NEAR((near_bare.material.albedo - roof.albedo).norm(), 0.0f, 0.1f);
 }
 
+TEST(Objects, APresetGivesTheirSurfaceItsReliefAndMottle) {
+  // Two horizontal 16 m squares 10 m above flat ground: one of plain albedo,
+  // one of the `soil` preset (clods over 1 m, a mottled tone), sampled by
+  // vertical rays on a 0.25 m lattice, from above and from below.
+  SceneInput in;
+  in.terrain = HeightField(64, 64, 0.0f, local_georeference(1.0));
+  auto square = [](double east, const std::string& material) {
+    drift::terrain::PlacedMesh m;
+    m.mesh.positions = {{0, 0, 10}, {16, 0, 10}, {0, 16, 10}, {16, 16, 10}};
+    m.mesh.triangles = {{0, 1, 2}, {1, 3, 2}};
+    m.position = Eigen::Vector3d(east, -40.0, 0.0);
+    m.material = material;
+    if (!material.empty()) m.albedo = material_preset(material)->albedo;
+    return m;
+  };
+  in.meshes = {square(4.0, ""), square(36.0, "soil")};
+  const TerrainScene scene(in);
+  struct Stats {
+    double mean = 0, sq = 0, tilt = 0;
+    int n = 0, facing = 0;
+  };
+  auto sample = [&](double east, float dz) {
+    Stats s;
+    for (double y = -38.0; y < -26.0; y += 0.25) {
+      for (double x = east + 2.0; x < east + 14.0; x += 0.25) {
+        Hit h;
+        const Eigen::Vector3f d(0, 0, dz);
+        EXPECT_TRUE(scene.intersect(scene.to_local(Eigen::Vector3d(x, y, 10.0 - 5.0 * dz)), d, h));
+        const double a = h.material.albedo.y();
+        s.mean += a, s.sq += a * a, s.tilt += h.normal.head<2>().norm(), ++s.n;
+        s.facing += h.normal.dot(d) < 0.0f;
+      }
+    }
+    s.mean /= s.n, s.sq /= s.n, s.tilt /= s.n;
+    return s;
+  };
+  const Stats plain = sample(4.0, -1.0f), soil = sample(36.0, -1.0f), under = sample(36.0, 1.0f);
+  // Plain: one albedo, the face's own normal.
+  EXPECT_NEAR(plain.sq - plain.mean * plain.mean, 0.0, 1e-12);
+  EXPECT_NEAR(plain.tilt, 0.0, 1e-6);
+  // Soil: its tone varies about the preset's (variation 0.2; the mean of a
+  // 12 m patch is one draw of octaves up to 128 m, so only near it) and its
+  // relief tilts the shading normal (bump 0.35), from above and below alike.
+  const double albedo = material_preset("soil")->albedo.y();
+  EXPECT_NEAR(soil.mean, albedo, 0.4 * albedo);
+  EXPECT_GT(std::sqrt(soil.sq - soil.mean * soil.mean), 0.05 * albedo);
+  EXPECT_GT(soil.tilt, 0.1);
+  EXPECT_GT(under.tilt, 0.1);
+  EXPECT_EQ(soil.facing, soil.n);
+  EXPECT_EQ(under.facing, under.n);
+}
+
 TEST(HeightChanges, EachRaisesTheTracedSurfaceInTurnAndNoneLowersIt) {
   // Flat ground at 100 m; one change lays 1 m everywhere, a second 0.5 m on
   // the western half and -3 m (counts as none) on the eastern half.

@@ -9,6 +9,7 @@
 
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -63,6 +64,37 @@ TEST(SoilCli, WritesMeshVdbSurfaceAndGround) {
   EXPECT_EQ(top.width(), 24);
   EXPECT_GT(top(12, 12), 0.6f);
   EXPECT_EQ(drift::terrain::read_raster(d / "ground.tif").width(), 24 + 64);
+}
+
+TEST(SoilCli, DemGroundFollowsTheDemUpToTheWindowsEdges) {
+  // A tilted plane of 10 m cells; a 6 x 4 window inside it split 4 x 4. The
+  // ground under the grid is the DEM's bilinear surface, the plane itself, up
+  // to its edges: they interpolate towards the pixels beyond the window (as the
+  // renderer's surround does), not hold the edge pixel (2.5 m off there).
+  const fs::path d = dir();
+  const auto plane = [](double x, double y) { return 1000.0 + 0.8 * x - 0.3 * y; };
+  drift::terrain::write_geotiff(drift::testing::dem_from(16, 10.0, 0.5, plane), d / "dem.tif");
+  std::ofstream(d / "s.toml") << "[grid]\nsize = [0, 0, 40]\nvoxel = 2.5\n"
+                                 "[terrain]\ndem = \"dem.tif\"\nwindow = [4, 5, 6, 4]\n"
+                                 "upsample = 4\ndepth = 5\n[simulation]\nsteps = 0\n";
+  ASSERT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.obj").string() + " --ground " +
+                    (d / "ground.tif").string() + " --ground-margin 0",
+                d),
+            0)
+      << output(d);
+  const auto ground = drift::terrain::read_raster(d / "ground.tif");
+  ASSERT_EQ(ground.width(), 24);
+  ASSERT_EQ(ground.height(), 16);
+  double worst = 0.0;
+  for (int row = 0; row < ground.height(); ++row) {
+    for (int x = 0; x < ground.width(); ++x) {
+      // A DEM without a CRS: the grid's own frame, from the window's SW
+      // corner (40 m east, 90 m south of the DEM's NW corner).
+      const auto c = ground.geo().cell_center(x, row);
+      worst = std::max(worst, std::abs(ground(x, row) - plane(40.0 + c[0], -90.0 + c[1])));
+    }
+  }
+  EXPECT_LT(worst, 1e-3);
 }
 
 TEST(SoilCli, BadScenariosAreErrorsNamingTheValueAndWriteNothing) {
