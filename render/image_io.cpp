@@ -4,6 +4,7 @@
 // through drift::AtomicFile: a failed write leaves no file behind.
 #include "render/image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -11,8 +12,10 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <memory>
 
 #include "render/auto_exposure.h"
+#include "render/exr_header.h"
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
@@ -94,46 +97,117 @@ Image display_image(const OIIO::ImageSpec& spec, const std::vector<float>& raw) 
   return image;
 }
 
-// OpenEXR 3.1 allocates an attribute of a type it does not know at the size
-// the file declares before reading it: a 973-byte EXR declaring a 1.9 GB
-// attribute had 1.9 GB allocated, a 46-byte one took 5 s (found by
-// fuzz_image). Walks the header(s) as OpenEXR reads them (magic, version, then
-// `name\0 type\0 int32 size, value` until an empty name, names of at most 31
-// characters, 255 with the long-names flag; multi-part files repeat headers
-// until an empty one) and refuses a size beyond the file's end. Partial: a
-// known type's value (a channel list) is parsed by its content, and where that
-// disagrees with its declared size OpenEXR reads on from elsewhere.
-void check_exr_attribute_sizes(const std::filesystem::path& path) {
+// The OpenImageIO reader for a file, chosen by its first bytes among the
+// four formats drift reads. Left to itself OpenImageIO tries every reader it
+// has (TGA, ICO, DDS, ...) on a file the named one refuses: code no one here
+// asked for, fed hostile bytes (fuzz_image reached the TGA reader so).
+const char* reader_for(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  unsigned char magic[8] = {};
-  if (!in.read(reinterpret_cast<char*>(magic), 8) || magic[0] != 0x76 || magic[1] != 0x2f ||
-      magic[2] != 0x31 || magic[3] != 0x01)
-    return;  // not an EXR: its reader checks it
-  const bool multipart = magic[5] & 0x10, long_names = magic[5] & 0x04;
-  const std::uint64_t file_size = std::filesystem::file_size(path);
-  const auto read_name = [&in, max = long_names ? 255 : 31](std::string& name) {
-    name.clear();  // as OpenEXR's Xdr::read: up to max + 1 characters or a null
-    for (char c; name.size() <= static_cast<std::size_t>(max) && in.get(c) && c != '\0';)
-      name.push_back(c);
-    return static_cast<bool>(in);
-  };
-  std::string name, type;
-  for (int attributes = 0; attributes < 100000; ++attributes) {
-    if (!read_name(name)) return;  // truncated: OpenEXR says so
-    if (name.empty()) {
-      if (!multipart || in.peek() == '\0' || in.peek() == EOF) return;
-      continue;  // the next part's header
-    }
-    std::int32_t size = 0;
-    if (!read_name(type) || !in.read(reinterpret_cast<char*>(&size), 4)) return;
-    const std::uint64_t at = static_cast<std::uint64_t>(in.tellg());
-    if (size < 0 || static_cast<std::uint64_t>(size) > file_size - std::min(at, file_size)) {
-      throw Error("cannot read image " + path.string() + ": its header attribute '" + name +
-                  "' declares " + std::to_string(size) + " bytes but the file holds " +
-                  std::to_string(file_size) + " (the file is corrupt)");
-    }
-    in.seekg(size, std::ios::cur);
+  unsigned char m[4] = {};
+  if (!in.read(reinterpret_cast<char*>(m), 4)) return nullptr;
+  if (m[0] == 0x76 && m[1] == 0x2f && m[2] == 0x31 && m[3] == 0x01) return "openexr";
+  if (m[0] == 0x89 && m[1] == 'P' && m[2] == 'N' && m[3] == 'G') return "png";
+  if (m[0] == 0xff && m[1] == 0xd8 && m[2] == 0xff) return "jpeg";
+  if ((m[0] == 'I' && m[1] == 'I' && (m[2] == 42 || m[2] == 43) && m[3] == 0) ||
+      (m[0] == 'M' && m[1] == 'M' && m[2] == 0 && (m[3] == 42 || m[3] == 43)))
+    return "tiff";
+  return nullptr;
+}
+
+// OpenImageIO 2.4's OpenEXRCore reader asks its stream for the file's size
+// with tell() (exrinput_c.cpp, oiio_exr_query_size_func), which is 0 at the
+// start: OpenEXRCore then takes the size as unknown and skips every check of
+// a declared size against it (a 192-byte file had a 1.8 GB string attribute
+// allocated so). This stream answers tell() with the file's size.
+class SizedFile final : public OIIO::Filesystem::IOFile {
+ public:
+  explicit SizedFile(const std::string& name) : IOFile(name, Read) {}
+  int64_t tell() override { return static_cast<int64_t>(size()); }
+};
+
+struct OpenedImage {
+  std::unique_ptr<SizedFile> stream;  // declared first: outlives `in`, which reads it
+  std::unique_ptr<OIIO::ImageInput> in;
+};
+
+// EXRs are read by OpenImageIO's OpenEXRCore reader (written for fuzzing; its
+// header parse is bounded first by validate_exr_header, render/exr_header.cpp).
+// It reads drift's own EXRs bit for bit as the C++ reader does, and every
+// compression but B44/B44A (values wrong in OpenEXR 3.1.5's core) and
+// DWAA/DWAB (not decoded before 3.2): those are refused, naming the fix.
+OpenedImage open_image(const std::filesystem::path& path) {
+  static const bool core_reader = OIIO::attribute("openexr:core", 1);
+  (void)core_reader;
+  const char* reader = reader_for(path);
+  if (!reader) {
+    throw Error("cannot read image " + path.string() +
+                ": it is not an EXR, PNG, JPEG or TIFF file (its first bytes say so)");
   }
+  const bool exr = std::string(reader) == "openexr";
+  OpenedImage opened;
+  opened.in = OIIO::ImageInput::create(reader);
+  if (exr) {
+    validate_exr_header(path);
+    opened.stream = std::make_unique<SizedFile>(path.string());
+    if (opened.in) opened.in->set_ioproxy(opened.stream.get());
+  }
+  OIIO::ImageSpec spec;
+  if (!opened.in || !opened.in->open(path.string(), spec)) {
+    throw Error("cannot read image " + path.string() + ": " +
+                oiio_message(opened.in ? opened.in->geterror() : OIIO::geterror()) +
+                " (the file may be truncated or corrupt)");
+  }
+  const std::string compression = spec.get_string_attribute("compression");
+  if (exr && (compression.rfind("b44", 0) == 0 || compression.rfind("dwa", 0) == 0)) {
+    throw Error("cannot read image " + path.string() + ": its compression '" + compression +
+                "' is not read correctly by OpenEXR 3.1's core reader; re-save it with zip "
+                "or piz (e.g. oiiotool in.exr --compression zip -o out.exr)");
+  }
+  return opened;
+}
+
+// What reading `spec` takes at its peak: the pixels in the file's own types
+// and as float, the float copy made for display images, and for tiled files a
+// row of tiles (a tile may be declared far larger than the image).
+std::uint64_t bytes_to_read(const OIIO::ImageSpec& spec) {
+  const std::uint64_t pixels = static_cast<std::uint64_t>(spec.width) * spec.height;
+  const std::uint64_t as_float = pixels * spec.nchannels * sizeof(float);
+  const std::uint64_t native = pixels * spec.pixel_bytes(true);
+  std::uint64_t tile_row = 0;
+  if (spec.tile_width > 0 && spec.tile_height > 0) {
+    const std::uint64_t tiles_across =
+        (static_cast<std::uint64_t>(spec.width) + spec.tile_width - 1) / spec.tile_width;
+    tile_row = tiles_across * spec.tile_width * spec.tile_height *
+               std::max<std::uint64_t>(1, spec.tile_depth) *
+               std::max<std::uint64_t>(spec.pixel_bytes(true), spec.nchannels * sizeof(float));
+  }
+  return as_float + std::max(native, as_float) + tile_row;
+}
+
+// Pixels as interleaved float. Read in the file's own types and converted
+// here: asked for float, OpenImageIO converts through a buffer of at least
+// 256 rows (ImageInput::read_scanlines), 256 times what a one-row image
+// needs and more than the check above counted.
+std::vector<float> read_as_float(OIIO::ImageInput& in, const std::filesystem::path& path) {
+  const OIIO::ImageSpec& spec = in.spec();
+  const int nc = spec.nchannels;
+  const OIIO::stride_t pixel = static_cast<OIIO::stride_t>(spec.pixel_bytes(true));
+  std::vector<unsigned char> native(static_cast<std::size_t>(spec.image_bytes(true)));
+  if (!in.read_image(0, 0, 0, nc, OIIO::TypeDesc::UNKNOWN, native.data())) {
+    throw Error("cannot read the pixels of image " + path.string() + ": " +
+                oiio_message(in.geterror()) + " (the file may be truncated or corrupt)");
+  }
+  std::vector<float> out(static_cast<std::size_t>(spec.width) * spec.height * nc);
+  const OIIO::stride_t out_pixel = nc * static_cast<OIIO::stride_t>(sizeof(float));
+  std::size_t offset = 0;  // channels may differ in type (EXR): one at a time
+  for (int c = 0; c < nc; ++c) {
+    const OIIO::TypeDesc type = spec.channelformat(c);
+    OIIO::convert_image(1, spec.width, spec.height, 1, native.data() + offset, type, pixel,
+                        pixel * spec.width, OIIO::AutoStride, out.data() + c, OIIO::TypeDesc::FLOAT,
+                        out_pixel, out_pixel * spec.width, OIIO::AutoStride);
+    offset += type.size();
+  }
+  return out;
 }
 
 }  // namespace
@@ -143,39 +217,28 @@ Image read_image(const std::filesystem::path& path) {
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw Error("image " + path.string() + " does not exist or is not a file; check the path");
   }
-  check_exr_attribute_sizes(path);
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) {
-    throw Error("cannot read image " + path.string() + ": " + oiio_message(OIIO::geterror()) +
-                " (expected EXR, PNG, JPEG or TIFF)");
-  }
+  const OpenedImage opened = open_image(path);
+  OIIO::ImageInput* in = opened.in.get();
   const OIIO::ImageSpec spec = in->spec();
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.depth > 1) {
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.depth > 1 || spec.deep) {
     throw Error("image " + path.string() + " has an unsupported shape (" +
                 std::to_string(spec.width) + "x" + std::to_string(spec.height) + ", " +
                 std::to_string(spec.nchannels) + " channels)");
   }
-  const int nc = spec.nchannels;
-  // Decoded as float and then copied: twice the declared size (a small PNG can
-  // declare 60000^2 pixels).
-  require_memory(static_cast<std::uint64_t>(spec.width) * spec.height * nc * sizeof(float) * 2,
+  // Sizes are checked before decoding: a small PNG can declare 60000^2 pixels.
+  require_memory(bytes_to_read(spec),
                  "image " + path.string() + " (" + std::to_string(spec.width) + "x" +
-                     std::to_string(spec.height) + ", " + std::to_string(nc) + " channels)",
+                     std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
+                     " channels)",
                  "use a smaller image");
-  std::vector<float> raw(static_cast<std::size_t>(spec.width) * spec.height * nc);
-  const bool ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, raw.data());
-  const std::string read_error = ok ? std::string() : in->geterror();
+  std::vector<float> raw = read_as_float(*in, path);
   in->close();
-  if (!ok) {
-    throw Error("cannot read the pixels of image " + path.string() + ": " +
-                oiio_message(read_error) + " (the file may be truncated or corrupt)");
-  }
   const bool is_float_format = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
                                spec.format.basetype == OIIO::TypeDesc::HALF ||
                                spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-  const bool is_exr =
-      lower_extension(path) == ".exr" || std::string(in->format_name()) == "openexr";
-  if (is_exr || is_float_format) return linear_image(spec, std::move(raw));
+  if (std::string(in->format_name()) == "openexr" || is_float_format) {
+    return linear_image(spec, std::move(raw));
+  }
   return display_image(spec, raw);
 }
 
