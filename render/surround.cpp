@@ -139,8 +139,7 @@ float SurroundHeight::edge_mean(float x, float y, float half_width) const {
   return static_cast<float>((integral(t + half) - integral(t - half)) / (2.0 * half));
 }
 
-float SurroundHeight::raster_height(float x, float y, float& weight, float d) const {
-  weight = 0.0f;
+std::optional<SurroundHeight::RasterSample> SurroundHeight::raster_height(float x, float y) const {
   const double wx = dem_.origin.x() + x, wy = dem_.origin.y() + y;
   const terrain::HeightField* finest = nullptr;
   float value = NAN;
@@ -149,15 +148,32 @@ float SurroundHeight::raster_height(float x, float y, float& weight, float d) co
     if (std::isnan(v)) continue;
     if (!finest || r.geo().cell_size_x() < finest->geo().cell_size_x()) finest = &r, value = v;
   }
-  if (!finest) return 0.0f;
-  const double blend = options_->blend > 0.0 ? options_->blend : 10.0 * finest->geo().cell_size_x();
-  weight = smoothstep(0.0f, static_cast<float>(blend), d);
-  return static_cast<float>(value * dem_.exaggeration - dem_.origin.z());
+  if (!finest) return std::nullopt;
+  return RasterSample{static_cast<float>(value * dem_.exaggeration - dem_.origin.z()),
+                      finest->geo().cell_size_x()};
 }
 
 float SurroundHeight::operator()(float x, float y, float spacing) const {
   const float d = outside_distance(x, y);
   if (d <= 0.0f) return dem_height(x, y);
+  const float cx = std::clamp(x, x0_, x1_), cy = std::clamp(y, y1_, y0_);
+  const float drop = static_cast<float>(double(d) * d / (2.0 * kEarthRadius)) * dem_.exaggeration;
+  const std::optional<RasterSample> raster = raster_height(x, y);
+  if (!raster) return continued_edge(x, y, d, spacing) - drop;
+  const double blend = options_->blend > 0.0 ? options_->blend : 10.0 * raster->cell;
+  const float weight = smoothstep(0.0f, static_cast<float>(blend), d);
+  if (const std::optional<RasterSample> at_edge = raster_height(cx, cy)) {
+    // The raster shifted by the seam's mismatch, the shift fading out: a
+    // surround the DEM was cut from goes on as itself (blending towards the
+    // continued edge instead laid a false, flattened band of `blend` metres
+    // round a crop), a coarser one meets the edge without a step.
+    return raster->z + (1.0f - weight) * (dem_height(cx, cy) - at_edge->z) - drop;
+  }
+  // A raster that does not reach the edge: blended in from the continued edge.
+  return (1.0f - weight) * continued_edge(x, y, d, spacing) + weight * raster->z - drop;
+}
+
+float SurroundHeight::continued_edge(float x, float y, float d, float spacing) const {
   const float cx = std::clamp(x, x0_, x1_), cy = std::clamp(y, y1_, y0_);
   // The edge continued: from the edge's own height at the seam to a mean
   // over a window growing with d, relaxing to the DEM's mean height.
@@ -170,10 +186,7 @@ float SurroundHeight::operator()(float x, float y, float spacing) const {
   // high as the DEM's own relief (three times its height deviation).
   z += smoothstep(0.0f, decay_, d) * 3.0f * deviation_ *
        ridges(dem_.origin.x() + x, dem_.origin.y() + y, spacing);
-  float weight;
-  const float from_raster = raster_height(x, y, weight, d);
-  z = (1 - weight) * z + weight * from_raster;
-  return z - static_cast<float>(double(d) * d / (2.0 * kEarthRadius)) * dem_.exaggeration;
+  return z;
 }
 
 namespace {

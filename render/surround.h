@@ -8,7 +8,10 @@
 // Its heights, at a point a distance d outside the DEM (nearest edge point
 // p), in order of preference:
 // 1. a surround raster (a coarser DEM in the same CRS; of several, the finest
-//    that covers the point wins), blended in from the edge over `blend` m;
+//    that covers the point wins), shifted by the seam's mismatch (the DEM's
+//    edge height less the raster's at the nearest edge point), the shift
+//    fading out over `blend` m: a raster the DEM was cut from goes on as
+//    itself, a coarser one meets the edge without a step;
 // 2. else the fallback: the DEM's edge continued outward and flattened, the
 //    edge heights around p averaged over a window that widens with d (d/2 on
 //    each side), relaxing to the DEM's mean height over a length of a quarter
@@ -22,6 +25,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "terrain/grid.h"
@@ -72,7 +76,15 @@ class SurroundHeight {
  private:
   float edge_mean(float x, float y, float half_width) const;
   float dem_height(float x, float y) const;
-  float raster_height(float x, float y, float& weight, float d) const;
+  // The finest surround raster covering local (x, y): its height (local z)
+  // and cell size, or none.
+  struct RasterSample {
+    float z = 0.0f;
+    double cell = 0.0;
+  };
+  std::optional<RasterSample> raster_height(float x, float y) const;
+  // The continued edge: the fallback (no raster covers the edge).
+  float continued_edge(float x, float y, float d, float spacing) const;
 
   DemVertices dem_;
   const SurroundOptions* options_;

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <vector>
 
+#include "snow/stabilise_levels.h"
 #include "snow/stabilise_settle.h"
 #include "terrain/error.h"
 #include "terrain/memory.h"
@@ -33,6 +34,8 @@ constexpr std::size_t kParallelTiles = 32;
 // and fewer than kTailShare of the tiles still active.
 constexpr int kTailPasses = 200;
 constexpr double kTailShare = 0.1;
+// The coarse-to-fine start stops before a level of fewer cells a side.
+constexpr int kCoarsestCells = 32;
 // Neighbour k and neighbour 7 - k are opposite (the order of terrain/slope_relax,
 // so that sums are formed in the same order and give the same bits).
 constexpr std::array<int, 8> kDx{-1, 0, 1, -1, 1, -1, 0, 1};
@@ -338,6 +341,33 @@ StabiliseReport settle(const terrain::Grid<float>& ground, terrain::Grid<double>
   StabiliseReport report;
   report.iterations = passes.passes();
   report.converged = converged;
+  report.level_passes = {report.iterations};
+  return report;
+}
+
+// The coarse-to-fine start (snow/stabilise_levels.h): `levels` coarser levels
+// (fewer where the grid gets smaller than kCoarsestCells a side) settled first,
+// coarsest first, each one's change handed down as the next one's start; then
+// this level's passes to convergence.
+template <class OnPass>
+StabiliseReport settle_levels(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
+                              const SettleGeometry& geo, const StabiliseOptions& options,
+                              int levels, const OnPass& on_pass) {
+  std::vector<int> level_passes;
+  if (levels > 0 && std::min(snow.width(), snow.height()) / 2 >= kCoarsestCells) {
+    CoarseLevel coarse = restrict_to_coarse(ground, snow);
+    const terrain::Grid<double> before = coarse.snow;
+    SettleGeometry coarse_geo = geo;
+    coarse_geo.dx *= 2.0, coarse_geo.dy *= 2.0;
+    level_passes =
+        settle_levels(coarse.ground, coarse.snow, coarse_geo, options, levels - 1, on_pass)
+            .level_passes;
+    prolong_change(before, coarse.snow, snow);
+  }
+  StabiliseReport report =
+      settle(ground, snow, geo, options.max_iterations, options.shortcut, on_pass);
+  level_passes.push_back(report.iterations);
+  report.level_passes = std::move(level_passes);
   return report;
 }
 
@@ -353,11 +383,17 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
   // The passes' workspace, and the shortcut's: envelope, loose snow, resting
   // cell and load (doubles and indices), marks, and a queue entry a cell at worst.
   const std::uint64_t shortcut_bytes = 4 * sizeof(double) + 1 + 16;
-  require_memory(snow.size() * (SnowPasses::bytes_per_cell() + shortcut_bytes),
+  // The coarse levels' grids (ground, snow, its copy and change: 28 bytes a
+  // coarse cell, 7 a fine one; the levels below a quarter of that) are freed
+  // before the finer level's workspace is made; counted on top as a margin.
+  const std::uint64_t coarse_bytes = options.coarse_levels > 0 ? 10 : 0;
+  require_memory(snow.size() * (SnowPasses::bytes_per_cell() + shortcut_bytes + coarse_bytes),
                  "snow stabilisation's workspace", "use a smaller or coarser ground raster");
   const SettleGeometry geo{dx, dy, tan_deg(options.repose_deg), options.tolerance};
+  if (options.coarse_levels < 0)
+    throw Error("stabilise_grid: the number of coarse levels must be 0 or more");
   const StabiliseReport report =
-      settle(ground, snow, geo, options.max_iterations, options.shortcut, [&](int, double share) {
+      settle_levels(ground, snow, geo, options, options.coarse_levels, [&](int, double share) {
         if (!progress(1.0 - share, "stabilising snow")) throw Cancelled();
       });
   progress(1.0, "stabilising snow");

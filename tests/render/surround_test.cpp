@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -99,6 +100,44 @@ TEST(Surround, FinestRasterWinsAndBlendsIn) {
   const float mid = height(-150.0f, -200.0f, 10.0f);
   EXPECT_GT(mid, std::min(edge, -500.0f) - 1.0f);
   EXPECT_LT(mid, std::max(edge, -500.0f) + 1.0f);
+}
+
+TEST(Surround, ARasterTheDemWasCutFromGoesOnAsItself) {
+  // The DEM is a crop of a raster (the same surface, 10 m cells on the DEM's
+  // vertices) given as its surround: out to the blend's width and past it, the
+  // surround is that surface, not a band flattened towards the edge.
+  const TestDem dem(41, 29, 10.0f);
+  const auto surface = [](double x, double y) {  // local metres, as TestDem
+    return 300.0 + 40.0 * std::sin(x / 70.0) + 0.3 * y;
+  };
+  terrain::GeoReference geo;
+  const int margin = 40;  // cells of raster around the DEM
+  geo.geotransform = {500000.0 - 5.0 - 10.0 * margin,  10.0, 0.0,
+                      4000000.0 + 5.0 + 10.0 * margin, 0.0,  -10.0};
+  terrain::HeightField raster(41 + 2 * margin, 29 + 2 * margin, 0.0f, geo);
+  for (int r = 0; r < raster.height(); ++r)
+    for (int c = 0; c < raster.width(); ++c)
+      raster(c, r) =
+          static_cast<float>(1000.0 + surface(10.0 * (c - margin), -10.0 * (r - margin)));
+  SurroundOptions options;
+  options.rasters = {raster};  // blend: 10 cells, 100 m
+  const SurroundHeight height(dem.view, options);
+  double worst = 0.0;
+  for (const float d : {5.0f, 20.0f, 50.0f, 90.0f, 150.0f}) {
+    for (float t = 0.0f; t <= 1.0f; t += 0.125f) {
+      const float along_x = 400.0f * t, along_y = -280.0f * t;
+      const std::array<Eigen::Vector2f, 4> points = {
+          Eigen::Vector2f(along_x, d), Eigen::Vector2f(along_x, -280.0f - d),
+          Eigen::Vector2f(-d, along_y), Eigen::Vector2f(400.0f + d, along_y)};
+      for (const Eigen::Vector2f& p : points) {
+        const double drop = double(d) * d / (2.0 * 6371000.0);
+        worst =
+            std::max(worst, std::abs(height(p.x(), p.y(), 10.0f) + drop - surface(p.x(), p.y())));
+      }
+    }
+  }
+  // Bilinear between 10 m samples of the sine: within 0.1 m of it.
+  EXPECT_LT(worst, 0.15);
 }
 
 TEST(Surround, RaysHitItAndAovsReportGround) {
