@@ -32,6 +32,18 @@ double total(const Grid<double>& g) {
 
 double tan_deg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
 
+// The north-west corner (n x n cells of 1 m) of the stabilisation benchmark's
+// mountains (tests/bench/snowfall_bench.cpp).
+Grid<float> benchmark_mountains(int n) {
+  Grid<float> ground(n, n, 0.0f);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      ground(x, y) = static_cast<float>(200 * std::sin(x / 300.0) * std::cos(y / 450.0) +
+                                        60 * std::sin(x / 70.0 + y / 90.0) +
+                                        10 * std::sin(x / 13.0) * std::cos(y / 17.0));
+  return ground;
+}
+
 // 5 x 5 cells of 1 m on flat ground at 0, holes of the given depths, 0.5 m of
 // snow on the middle cell only (too little to pass a 40-degree slope to the
 // flat neighbours: 0.5 < tan 40 = 0.84).
@@ -254,12 +266,7 @@ TEST(SnowfallStabilise, SameBitsAsTheSharedSlopeRelaxation) {
 // passes' own.
 TEST(SnowfallStabilise, ShortcutSettlesTheSlowTailToNearlyTheSameState) {
   const int n = 128;
-  Grid<float> ground(n, n, 0.0f);
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      ground(x, y) = static_cast<float>(200 * std::sin(x / 300.0) * std::cos(y / 450.0) +
-                                        60 * std::sin(x / 70.0 + y / 90.0) +
-                                        10 * std::sin(x / 13.0) * std::cos(y / 17.0));
+  const Grid<float> ground = benchmark_mountains(n);
   Grid<double> fast(n, n, 0.5), slow(n, n, 0.5);
   StabiliseOptions o;
   o.coarse_levels = 0;  // the shortcut alone (the coarse start has its own test)
@@ -392,12 +399,7 @@ TEST(SnowfallStabilise, TowerSettlesAtReposeAndTheCoarseStartALittleFlatter) {
 // 5.2 %: each level settles the snow its coarser ground lets slide).
 TEST(SnowfallStabilise, CoarseStartSettlesNearThePassesAlone) {
   const int n = 128;
-  Grid<float> ground(n, n, 0.0f);
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      ground(x, y) = static_cast<float>(200 * std::sin(x / 300.0) * std::cos(y / 450.0) +
-                                        60 * std::sin(x / 70.0 + y / 90.0) +
-                                        10 * std::sin(x / 13.0) * std::cos(y / 17.0));
+  const Grid<float> ground = benchmark_mountains(n);
   Grid<double> slow(n, n, 0.5), shortcut(n, n, 0.5);
   StabiliseOptions o;
   o.coarse_levels = 0;
