@@ -74,6 +74,7 @@ SurroundHeight::SurroundHeight(const DemVertices& dem, const SurroundOptions& op
   // clockwise from the north-west corner.
   const auto z = [&](int c, int r) { return v[static_cast<std::size_t>(r) * dem.width + c].z(); };
   std::vector<std::pair<float, float>> loop;  // (step length, height) per perimeter vertex
+  loop.reserve(2 * static_cast<std::size_t>(dem.width + dem.height));
   for (int c = 0; c < dem.width; ++c) loop.emplace_back(c ? dem.dx : 0.0f, z(c, 0));
   for (int r = 1; r < dem.height; ++r) loop.emplace_back(dem.dy, z(dem.width - 1, r));
   for (int c = dem.width - 2; c >= 0; --c) loop.emplace_back(dem.dx, z(c, dem.height - 1));

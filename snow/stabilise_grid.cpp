@@ -392,7 +392,7 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
   const SettleGeometry geo{dx, dy, tan_deg(options.repose_deg), options.tolerance};
   if (options.coarse_levels < 0)
     throw Error("stabilise_grid: the number of coarse levels must be 0 or more");
-  const StabiliseReport report =
+  StabiliseReport report =
       settle_levels(ground, snow, geo, options, options.coarse_levels, [&](int, double share) {
         if (!progress(1.0 - share, "stabilising snow")) throw Cancelled();
       });
