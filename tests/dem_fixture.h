@@ -1,6 +1,8 @@
 // Test terrain from a formula: the one helper the test suites share for it.
 #pragma once
 
+#include <cmath>
+
 #include "terrain/grid.h"
 
 namespace drift::testing {
@@ -24,6 +26,19 @@ inline terrain::HeightField flat_utm_ground(int n, float z, double cell) {
   terrain::HeightField g(n, n, z, terrain::local_georeference(cell));
   g.geo().geotransform[0] = 600000.0;
   g.geo().geotransform[3] = 4000000.0;
+  return g;
+}
+
+// The snowfall benchmark's mountains (tests/bench/snowfall_bench.cpp), whose
+// north-west corner the stabilisation tests settle: n x n cells of 1 m,
+// long slopes steeper than repose with ledges and hollows between.
+inline terrain::HeightField snowfall_mountains(int n) {
+  terrain::HeightField g(n, n, 0.0f, terrain::local_georeference(1.0));
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x)
+      g(x, y) = static_cast<float>(200 * std::sin(x / 300.0) * std::cos(y / 450.0) +
+                                   60 * std::sin(x / 70.0 + y / 90.0) +
+                                   10 * std::sin(x / 13.0) * std::cos(y / 17.0));
   return g;
 }
 

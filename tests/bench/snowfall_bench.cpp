@@ -12,20 +12,13 @@
 #include "snow/stabilise_grid.h"
 #include "terrain/mesh_io.h"
 #include "tests/bench/peak_memory.h"
+#include "tests/dem_fixture.h"
 
 namespace {
 
 using namespace drift::snow;
 
-drift::terrain::HeightField mountains(int n) {
-  drift::terrain::HeightField g(n, n, 0.0f, drift::terrain::local_georeference(1.0));
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      g(x, y) = static_cast<float>(200 * std::sin(x / 300.0) * std::cos(y / 450.0) +
-                                   60 * std::sin(x / 70.0 + y / 90.0) +
-                                   10 * std::sin(x / 13.0) * std::cos(y / 17.0));
-  return g;
-}
+drift::terrain::HeightField mountains(int n) { return drift::testing::snowfall_mountains(n); }
 
 // Hut, bench, tree and eight rocks near the middle, standing on the ground
 // (same formula as mountains(), y north = -row): ~11k triangles.

@@ -18,6 +18,7 @@
 #include "snow/stabilise_levels.h"
 #include "snow/stabilise_mesh.h"
 #include "terrain/slope_relax.h"
+#include "tests/dem_fixture.h"
 
 namespace {
 
@@ -32,16 +33,21 @@ double total(const Grid<double>& g) {
 
 double tan_deg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
 
-// The north-west corner (n x n cells of 1 m) of the stabilisation benchmark's
-// mountains (tests/bench/snowfall_bench.cpp).
-Grid<float> benchmark_mountains(int n) {
-  Grid<float> ground(n, n, 0.0f);
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      ground(x, y) = static_cast<float>(200 * std::sin(x / 300.0) * std::cos(y / 450.0) +
-                                        60 * std::sin(x / 70.0 + y / 90.0) +
-                                        10 * std::sin(x / 13.0) * std::cos(y / 17.0));
-  return ground;
+// How far a settled state lies from another: RMS and largest difference of
+// the snow (m), and how many cells differ by more than `threshold` m.
+struct StateDifference {
+  double rms = 0.0, worst = 0.0;
+  int off = 0;
+};
+StateDifference state_difference(const Grid<double>& a, const Grid<double>& b, double threshold) {
+  StateDifference r;
+  double sq = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double d = a.values()[i] - b.values()[i];
+    sq += d * d, r.worst = std::max(r.worst, std::abs(d)), r.off += std::abs(d) > threshold;
+  }
+  r.rms = std::sqrt(sq / a.size());
+  return r;
 }
 
 // 5 x 5 cells of 1 m on flat ground at 0, holes of the given depths, 0.5 m of
@@ -266,7 +272,7 @@ TEST(SnowfallStabilise, SameBitsAsTheSharedSlopeRelaxation) {
 // passes' own.
 TEST(SnowfallStabilise, ShortcutSettlesTheSlowTailToNearlyTheSameState) {
   const int n = 128;
-  const Grid<float> ground = benchmark_mountains(n);
+  const Grid<float> ground = drift::testing::snowfall_mountains(n);
   Grid<double> fast(n, n, 0.5), slow(n, n, 0.5);
   StabiliseOptions o;
   o.coarse_levels = 0;  // the shortcut alone (the coarse start has its own test)
@@ -276,13 +282,7 @@ TEST(SnowfallStabilise, ShortcutSettlesTheSlowTailToNearlyTheSameState) {
   ASSERT_TRUE(rf.converged && rs.converged);
   EXPECT_LE(max_repose_excess(ground, fast, 1.0, 1.0, o.repose_deg, o.tolerance), o.tolerance);
   EXPECT_NEAR(total(fast), total(slow), 1e-12 * total(slow));
-  double sq = 0.0, worst = 0.0;
-  int off = 0;
-  for (std::size_t i = 0; i < fast.size(); ++i) {
-    const double d = fast.values()[i] - slow.values()[i];
-    sq += d * d, worst = std::max(worst, std::abs(d)), off += std::abs(d) > 0.01;
-  }
-  const double rms = std::sqrt(sq / fast.size());
+  const auto [rms, worst, off] = state_difference(fast, slow, 0.01);
   std::printf("passes %d against %d; RMS %.4f m, max %.3f m, %.2f %% of cells off by > 1 cm\n",
               rf.iterations, rs.iterations, rms, worst, 100.0 * off / fast.size());
   EXPECT_LT(rf.iterations * 3, rs.iterations);
@@ -399,7 +399,7 @@ TEST(SnowfallStabilise, TowerSettlesAtReposeAndTheCoarseStartALittleFlatter) {
 // 5.2 %: each level settles the snow its coarser ground lets slide).
 TEST(SnowfallStabilise, CoarseStartSettlesNearThePassesAlone) {
   const int n = 128;
-  const Grid<float> ground = benchmark_mountains(n);
+  const Grid<float> ground = drift::testing::snowfall_mountains(n);
   Grid<double> slow(n, n, 0.5), shortcut(n, n, 0.5);
   StabiliseOptions o;
   o.coarse_levels = 0;
@@ -421,13 +421,7 @@ TEST(SnowfallStabilise, CoarseStartSettlesNearThePassesAlone) {
     EXPECT_LE(max_repose_excess(ground, fast, 1.0, 1.0, o.repose_deg, o.tolerance), o.tolerance);
     EXPECT_NEAR(total(fast), total(slow), 1e-12 * total(slow));
     for (double v : fast.values()) EXPECT_GE(v, -1e-12);  // the passes' rounding
-    double sq = 0.0, worst = 0.0;
-    int off = 0;
-    for (std::size_t i = 0; i < fast.size(); ++i) {
-      const double d = fast.values()[i] - slow.values()[i];
-      sq += d * d, worst = std::max(worst, std::abs(d)), off += std::abs(d) > 0.1;
-    }
-    const double rms = std::sqrt(sq / fast.size());
+    const auto [rms, worst, off] = state_difference(fast, slow, 0.1);
     std::printf(
         "%d levels: passes %d (coarsest), %d on the grid, against %d (shortcut alone) "
         "and %d (passes alone); RMS %.4f m, max %.3f m, %.2f %% of cells off by > 10 cm\n",
