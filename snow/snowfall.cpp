@@ -197,6 +197,7 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   // Ground (paper 2.2(3)).
   StabiliseOptions ground_rule = stabilise;
   ground_rule.tolerance = options.ground_tolerance;
+  ground_rule.coarse_levels = options.coarse_levels;
   const StabiliseReport gr = stabilise_grid(scene.ground, snow, scene.dx, scene.dy, ground_rule,
                                             scaled_progress(report, 0.65, 0.95));
   result.ground_iterations = gr.iterations;

@@ -58,6 +58,9 @@ struct SnowfallOptions {
   // thinner, is stable (stabilise_grid.h)
   double ground_tolerance = 1e-3;
   int max_iterations = 100000;
+  // The coarse-to-fine start of the ground's stabilisation (stabilise_grid.h
+  // StabiliseOptions::coarse_levels); 0: the passes on the grid alone.
+  int coarse_levels = 0;
 
   // Throws drift::Error naming the parameter, its value and the valid range.
   void validate() const;

@@ -362,7 +362,7 @@ StabiliseReport settle_levels(const terrain::Grid<float>& ground, terrain::Grid<
     level_passes =
         settle_levels(coarse.ground, coarse.snow, coarse_geo, options, levels - 1, on_pass)
             .level_passes;
-    prolong_change(before, coarse.snow, snow);
+    prolong_change(coarse.ground, before, coarse.snow, snow);
   }
   StabiliseReport report =
       settle(ground, snow, geo, options.max_iterations, options.shortcut, on_pass);

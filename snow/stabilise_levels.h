@@ -7,39 +7,47 @@
 // passes, each on a quarter of the cells; the finer level then has mostly its
 // own detail left. Every level ends by the passes' own convergence criterion,
 // the finest included, so whatever the start no pair is left steeper than
-// repose. But the passes only ever flatten: where a coarse level left a pile
-// flatter than the grid's own passes would (its apex and toe, which 2 x 2
-// blocks cannot draw), the finer level keeps it so. An 8 x 8 tower ends with
-// its apex 4 % lower and its diagonal flanks 1.4 degrees below repose, which
-// is why the start is an option (StabiliseOptions::coarse_levels), not the
-// default; docs/snowfall.md has the figures.
+// repose. The passes only ever flatten and never move snow uphill, so the
+// start must not leave a pile flatter than the grid's own passes would, nor
+// snow lower than they would: the restriction and the hand-down below are
+// chosen for that, and towers settle with their apex and flanks as with the
+// passes alone (within 0.6 degrees; docs/snowfall.md). The state is not the
+// passes' own (the benchmark field, one level: RMS 2.3 cm), which is why the
+// start is an option (StabiliseOptions::coarse_levels, `--coarse-levels`).
 //
 // Restriction (a coarse cell is four fine cells; the caller doubles the cell
 // size, so the repose drop per direction follows it):
 //  - the coarse surface is the block's mean surface (ground + snow);
-//  - only the layer that every cell of the block holds (the block's least
-//    depth) is the coarse cell's snow, free to move; the rest of the block's
-//    snow counts as coarse ground. Snow in a partly bare block (snow caught in
-//    a hollow, the edge of a drift) stays where the fine passes left it, as a
-//    fine cell next to bare ground gives only what it holds. With the whole
-//    block's mean as mobile snow, snow the fine ground would hold in hollows
-//    smaller than a coarse cell was carried off (at 1024^2 with four levels,
-//    54 % of the ground covered against 63 %);
+//  - the snow free to move (the coarse cell's snow) is the layer every cell of
+//    the block holds; the rest of the block's snow counts as coarse ground.
+//    Snow in a partly bare block (snow caught in a hollow, a column on its
+//    own) stays where the fine passes left it, as a fine cell next to bare
+//    ground gives only what it holds (with the whole block's mean free to
+//    move, snow the fine ground holds in hollows smaller than a coarse cell was
+//    carried off: at 1024^2 with four levels, 54 % of the ground covered
+//    against 63 %). Except at a pile's edge: where a block's lowest surface is
+//    a bare cell and a neighbouring block (8 around) is full, its whole mean
+//    moves (the snow stands over bare ground beside a moving mass; held back,
+//    a tower's half-bare edge blocks stood as a wall on the coarse level and
+//    its flanks ended 1.9 degrees flatter);
 //  - a grid of odd width or height leaves its last column or row out of the
 //    coarse level, which is closed there like any edge; the finer level's
 //    passes settle that strip.
-// Prolongation: each block's layer changes by its coarse cell's change d,
-// linearly across the block: d plus slopes towards the neighbouring blocks'
-// changes (minmod-limited, so no new extremes), scaled down where a cell would
-// lose more than it holds. The four offsets cancel, so the block's volume is
-// its coarse cell's; a piecewise-constant change (each block even) leaves
-// steps between blocks that the fine passes must creep away (at 1024^2 with
-// one level: 2,477 fine passes against 2,416, RMS 2.7 cm from the passes alone
-// against 2.3 cm). The last rounding residue goes to the block's deepest cell
-// (the first in row order among equals), so each block holds its volume to
-// rounding and the field's mass is the coarse level's, which the passes keep
-// to rounding. Each block is computed alone in a fixed order, so the result
-// does not depend on the thread count.
+// Prolongation, for each block the coarse level changed by d: its layer
+// changes by d, tilted across the block towards where the settled coarse
+// surface rises (the steeper of the one-sided differences of the change that
+// rise that way), so the block keeps snow on its uphill side and what that
+// leaves steeper than repose the grid's passes take down within the block.
+// The earlier limited slope (minmod) stood the 2 x 2 apex blocks of a pile flat
+// and left the pile flatter than repose (an 8 x 8 tower: apex 4 % lower,
+// diagonal flanks 1.4 degrees below). The four offsets cancel, so the block's
+// volume is its coarse cell's; they are scaled down where a cell would go
+// negative, and a block losing more than a cell holds (a pile's edge whose
+// mean moved) gives in proportion to what each cell holds. The last rounding
+// residue goes to the block's deepest cell (the first in row order among
+// equals), so each block holds its volume to rounding and the field's mass is
+// the coarse level's, which the passes keep to rounding. Each block is computed
+// alone in a fixed order, so the result does not depend on the thread count.
 #pragma once
 
 #include "terrain/grid.h"
@@ -48,7 +56,7 @@ namespace drift::snow {
 
 struct CoarseLevel {
   terrain::Grid<float> ground;  // mean ground + the snow that may not move
-  terrain::Grid<double> snow;   // the layer every fine cell of the block holds
+  terrain::Grid<double> snow;   // the snow that may move (see above)
 };
 
 // The coarse level of (ground, snow): floor(width / 2) x floor(height / 2) cells.
@@ -56,8 +64,9 @@ CoarseLevel restrict_to_coarse(const terrain::Grid<float>& ground,
                                const terrain::Grid<double>& snow);
 
 // Hands the coarse level's change of snow (from `before`, as restricted, to
-// `after`, settled) down to the fine snow, block by block (see above).
-void prolong_change(const terrain::Grid<double>& before, const terrain::Grid<double>& after,
-                    terrain::Grid<double>& snow);
+// `after`, settled on `coarse_ground`) down to the fine snow, block by block
+// (see above).
+void prolong_change(const terrain::Grid<float>& coarse_ground, const terrain::Grid<double>& before,
+                    const terrain::Grid<double>& after, terrain::Grid<double>& snow);
 
 }  // namespace drift::snow

@@ -57,6 +57,41 @@ TEST(SnowfallCli, WritesDepthCoverSurfaceAndMesh) {
   EXPECT_NE(output(d).find("position = [600010, 3999990, 0]"), std::string::npos) << output(d);
 }
 
+// The ground's passes from the log line "stabilised in N passes on the ground".
+int ground_passes(const std::string& log) {
+  const std::string key = "stabilised in ";
+  const auto at = log.rfind(key);
+  return at == std::string::npos ? -1 : std::atoi(log.c_str() + at + key.size());
+}
+
+double total(const drift::terrain::HeightField& f) {
+  double sum = 0.0;
+  for (float v : f.values()) sum += v;
+  return sum;
+}
+
+// --coarse-levels reaches the ground's stabilisation (stabilise_grid.h): on
+// steep mountains it settles in fewer passes on the grid, to another state
+// holding the same snow.
+TEST(SnowfallCli, CoarseLevelsStartTheGroundsStabilisation) {
+  const fs::path d = dir();
+  auto ground = drift::testing::snowfall_mountains(96);
+  ground.geo().geotransform[0] = 600000.0, ground.geo().geotransform[3] = 4000000.0;
+  drift::terrain::write_geotiff(ground, d / "ground.tif");
+  const std::string common =
+      (d / "ground.tif").string() + " --maps 1 --rate 0.05 --hours 10 --threads 1 -o ";
+  ASSERT_EQ(run(common + (d / "alone.tif").string(), d), 0) << output(d);
+  const int alone = ground_passes(output(d));
+  ASSERT_EQ(run(common + (d / "coarse.tif").string() + " --coarse-levels 1", d), 0) << output(d);
+  const int coarse = ground_passes(output(d));
+  EXPECT_GT(alone, 0);
+  EXPECT_LT(coarse, alone);
+  const auto a = drift::terrain::read_raster(d / "alone.tif");
+  const auto c = drift::terrain::read_raster(d / "coarse.tif");
+  EXPECT_NE(a.values(), c.values());
+  EXPECT_NEAR(total(c), total(a), 1e-5 * total(a));
+}
+
 TEST(SnowfallCli, BadInputIsRefusedWithAMessageAndNoOutput) {
   const fs::path d = dir(), ground = setup(d);
   const std::string out = " -o " + (d / "depth.tif").string();
@@ -69,6 +104,10 @@ TEST(SnowfallCli, BadInputIsRefusedWithAMessageAndNoOutput) {
   EXPECT_EQ(run(ground.string() + out + " --maps 0", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --spread -3", d), 2);
   EXPECT_EQ(run(ground.string() + out + " --occlusion raytrace", d), 2);
+  for (const char* levels : {"-1", "17", "1.5", "nan", "one"}) {
+    EXPECT_EQ(run(ground.string() + out + " --coarse-levels " + levels, d), 2) << levels;
+    EXPECT_NE(output(d).find("--coarse-levels"), std::string::npos) << output(d);
+  }
   EXPECT_EQ(run(ground.string() + out + " --mesh-out " + (d / "m.ply").string(), d), 2);
   std::ofstream(d / "bad.toml") << "[[objects]]\nmesh = \"rock.obj\"\nsize = 2\n";
   EXPECT_EQ(run(ground.string() + out + " --objects " + (d / "bad.toml").string(), d), 1);
