@@ -5,7 +5,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <numbers>
+#include <type_traits>
 #include <vector>
 
 #include "snow/stabilise_levels.h"
@@ -52,36 +56,333 @@ void for_list(const std::vector<int>& items, const Fn& fn) {
   tbb::parallel_for(std::size_t{0}, items.size(), [&](std::size_t k) { fn(items[k]); });
 }
 
-// The HalfSteepest passes of terrain/slope_relax, specialised for snow on
-// ground (one rule, floor 0, no ceiling) and written for speed: the snow surface
-// is kept as one array, inner cells skip the edge tests and the repose drop to
-// each neighbour is computed once. Every operation and its order are those of
-// terrain/slope_relax, so the result is the same to the bit.
+// A run of consecutive tiles in one row of tiles (tx0 <= tile x < tx1). The
+// phases work on runs, so that their inner loops run along rows of cells and
+// the cells with all 8 neighbours inside take a path without edge tests that
+// the compiler vectorises.
+struct TileRun {
+  int ty, tx0, tx1;
+};
+
+// The runs of an ascending list of tiles.
+std::vector<TileRun> runs_of(const std::vector<int>& tiles, int tiles_x) {
+  std::vector<TileRun> runs;
+  for (int t : tiles) {
+    const int ty = t / tiles_x, tx = t % tiles_x;
+    if (!runs.empty() && runs.back().ty == ty && runs.back().tx1 == tx)
+      ++runs.back().tx1;
+    else
+      runs.push_back({ty, tx, tx + 1});
+  }
+  return runs;
+}
+
+// Calls fn(run) for every run, in parallel when they hold many tiles (the
+// same result either way: each cell's values are its own).
+template <class Fn>
+void for_runs(const std::vector<TileRun>& runs, std::size_t tiles, const Fn& fn) {
+  if (tiles < kParallelTiles || runs.size() < 2) {
+    for (const TileRun& r : runs) fn(r);
+    return;
+  }
+  tbb::parallel_for(std::size_t{0}, runs.size(), [&](std::size_t k) { fn(runs[k]); });
+}
+
+// Several cells at once, as GCC vector extensions: 2 lanes (one SSE2
+// register) in the kernels built for any x86-64, 4 (one AVX2 register) in
+// those built for AVX2. Each lane does the scalar path's operations in its
+// order, so it gives the same bits. All helpers are inlined into the kernels,
+// so no vector crosses a call (hence no ABI question: -Wpsabi is quiet).
+#pragma GCC diagnostic ignored "-Wpsabi"
+// (Spelled out per width: GCC ignores a vector_size that depends on a
+// template parameter in an alias.)
+template <int kN>
+struct LaneTypes;
+template <>
+struct LaneTypes<2> {
+  using Values = double __attribute__((vector_size(16)));
+  using Mask = std::int64_t __attribute__((vector_size(16)));
+  using Bytes = std::uint8_t __attribute__((vector_size(2)));
+  using Floats = float __attribute__((vector_size(8)));
+};
+template <>
+struct LaneTypes<4> {
+  using Values = double __attribute__((vector_size(32)));
+  using Mask = std::int64_t __attribute__((vector_size(32)));
+  using Bytes = std::uint8_t __attribute__((vector_size(4)));
+  using Floats = float __attribute__((vector_size(16)));
+};
+using Lanes2 = LaneTypes<2>::Values;
+using Lanes4 = LaneTypes<4>::Values;
+static_assert(sizeof(Lanes2) == 16 && sizeof(Lanes4) == 32);
+// The number of cells in a T (double or lanes).
+template <class T>
+constexpr int kWidth = sizeof(T) / sizeof(double);
+
+template <class T>
+[[gnu::always_inline]] inline T load(const double* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+template <class T>
+[[gnu::always_inline]] inline void store(double* p, T v) {
+  std::memcpy(p, &v, sizeof v);
+}
+template <class T>
+[[gnu::always_inline]] inline T splat(double v) {
+  if constexpr (std::is_same_v<T, double>)
+    return v;
+  else
+    return T{} + v;
+}
+// Whether the flag of each cell is set: bool for one cell, a lane mask for lanes.
+template <class T>
+[[gnu::always_inline]] inline auto is_set(const std::uint8_t* p) {
+  if constexpr (std::is_same_v<T, double>) {
+    return *p != 0;
+  } else {
+    using L = LaneTypes<kWidth<T>>;
+    typename L::Bytes b;
+    std::memcpy(&b, p, sizeof b);
+    return __builtin_convertvector(b, typename L::Mask) != 0;
+  }
+}
+// Whether no lane (or the one cell) is set.
+template <class M>
+[[gnu::always_inline]] inline bool none(M set) {
+  if constexpr (std::is_same_v<M, bool>) {
+    return !set;
+  } else {
+    std::int64_t any = 0;
+    for (std::size_t l = 0; l < sizeof(M) / sizeof(std::int64_t); ++l) any |= set[l];
+    return any == 0;
+  }
+}
+// Ground heights as doubles.
+template <class T>
+[[gnu::always_inline]] inline T to_double(const float* p) {
+  if constexpr (std::is_same_v<T, double>) {
+    return static_cast<double>(*p);
+  } else {
+    typename LaneTypes<kWidth<T>>::Floats f;
+    std::memcpy(&f, p, sizeof f);
+    return __builtin_convertvector(f, T);
+  }
+}
+// std::max and std::min written so that lanes work too (the same choices).
+template <class T>
+[[gnu::always_inline]] inline T larger(T a, T b) {
+  return a < b ? b : a;
+}
+template <class T>
+[[gnu::always_inline]] inline T smaller(T a, T b) {
+  return b < a ? b : a;
+}
+
+// The per-cell rules of a pass: terrain/slope_relax's HalfSteepest passes for
+// snow on ground (one rule, floor 0, no ceiling), the same operations in the
+// same order, so the same bits. T: double for one cell, Lanes for four cells
+// of a row whose 8 neighbours are all inside. kAllInside: no edge tests;
+// otherwise `inside` has a bit per neighbour and the missing ones are skipped.
+// Every sum adds 0.0 for a neighbour that does not count and every choice is
+// made after both sides are computed, which keeps the bits of skipping (a sum
+// of positive terms plus 0.0 is itself) without branches.
+constexpr double kNotGiving = -1.0;  // below every factor (they are >= 0)
+struct PassCells {
+  const float* ground;
+  double* snow;
+  double* surface;  // ground + snow
+  // Phase 1: a giver's factor per unit of excess, kNotGiving at every cell
+  // that is not active (the later phases read a neighbour's activity from it,
+  // not from its flag: fewer loads).
+  double* give;
+  double* take;   // phase 2: the share of its offers a taker takes
+  double* delta;  // phase 3: taken - given
+  std::uint8_t* active;
+  std::uint8_t* touched;
+  std::array<std::ptrdiff_t, 8> offset;
+  std::array<double, 8> drop;  // tan(repose) x the distance to neighbour k
+  double tol;
+
+  // Phase 1, paper 003 2.1(3): a giver gives min(held, e_max / 2), shared
+  // among its steeper neighbours in proportion to their excess.
+  template <class T, bool kAllInside>
+  [[gnu::always_inline]] T give_factor(std::size_t i, unsigned inside) const {
+    T sum{}, largest{};
+    const T here = load<T>(surface + i), zero{};
+    for (int k = 0; k < 8; ++k) {
+      if (!kAllInside && !(inside >> k & 1u)) continue;
+      const T e = here - load<T>(surface + i + offset[k]) - drop[k];
+      const T over = e > tol ? e : zero;
+      sum += over;
+      largest = larger(largest, over);
+    }
+    const T room = larger(load<T>(snow + i) - 0.0, zero);
+    const T factor = smaller(room, 0.5 * largest) / (sum > 0.0 ? sum : splat<T>(1.0));
+    const T given = (sum > 0.0) & (room > tol) ? factor : zero;
+    return is_set<T>(active + i) ? given : splat<T>(kNotGiving);
+  }
+  // Phase 2: the share of its offers a taker takes (half the largest excess it
+  // is offered from), the offers being those of active steeper neighbours.
+  template <class T, bool kAllInside>
+  [[gnu::always_inline]] T take_share(std::size_t i, unsigned inside) const {
+    T in{}, largest{};
+    const T here = load<T>(surface + i), zero{};
+    for (int k = 0; k < 8; ++k) {
+      if (!kAllInside && !(inside >> k & 1u)) continue;
+      const std::size_t n = i + offset[k];
+      const T e = load<T>(surface + n) - here - drop[7 - k];
+      const T give_n = load<T>(give + n);
+      const auto offered = (give_n >= 0.0) & (e > tol);
+      const T offer = give_n * e;
+      in += offered ? offer : zero;
+      largest = larger(largest, offered ? e : zero);
+    }
+    const T share = smaller(splat<T>(1.0), 0.5 * largest / (in > 0.0 ? in : splat<T>(1.0)));
+    return in > 0.0 ? share : zero;
+  }
+  // Phase 3: the change of cell i, taken - given (stored in delta), each flow
+  // computed from the same operands by its giver and its taker; returns
+  // whether the cell gave or took. The excesses towards n and from n share one
+  // difference (its negation is the other difference, to the bit).
+  template <class T, bool kAllInside>
+  [[gnu::always_inline]] auto change(std::size_t i, unsigned inside) const {
+    T out{}, in{};
+    const T here = load<T>(surface + i), give_here = load<T>(give + i), zero{};
+    const T take_here = load<T>(take + i);
+    decltype(here > 0.0) gave{}, took{};
+    for (int k = 0; k < 8; ++k) {
+      if (!kAllInside && !(inside >> k & 1u)) continue;
+      const std::size_t n = i + offset[k];
+      const T d = here - load<T>(surface + n);
+      const T down = d - drop[k], up = -d - drop[7 - k];
+      const T flow_out = give_here * down * load<T>(take + n);
+      const T give_n = load<T>(give + n);
+      const T flow_in = give_n * up * take_here;
+      const T f = down > tol ? flow_out : zero;
+      const T g = (give_n >= 0.0) & (up > tol) ? flow_in : zero;
+      out += f, gave |= f > 0.0;
+      in += g, took |= g > 0.0;
+    }
+    const auto gives = give_here > 0.0, takes = take_here > 0.0;
+    store(delta + i, (takes ? in : zero) - (gives ? out : zero));
+    return (gives & gave) | (takes & took);
+  }
+  // The change applied, only where there is one (h + 0.0 would turn -0.0 into
+  // 0.0; and cells that did not move are not written).
+  template <class T>
+  [[gnu::always_inline]] void apply(std::size_t i) const {
+    const T d = load<T>(delta + i), h = load<T>(snow + i);
+    if (none(d != 0.0)) return;
+    const T moved = h + d, held = d == 0.0 ? h : moved;
+    store(snow + i, held);
+    store(surface + i, to_double<T>(ground + i) + held);
+  }
+  // A cell's activity; one that stops gives nothing (kNotGiving).
+  [[gnu::always_inline]] void set_active(std::size_t i, std::uint8_t a) const {
+    active[i] = a;
+    give[i] = a ? give[i] : kNotGiving;
+  }
+  // Whether cell i is active next pass: it or a neighbour gave or took.
+  template <bool kAllInside>
+  [[gnu::always_inline]] std::uint8_t next_active(std::size_t i, unsigned inside) const {
+    unsigned any = touched[i];
+    for (int k = 0; k < 8; ++k) {
+      if (!kAllInside && !(inside >> k & 1u)) continue;
+      any |= touched[i + offset[k]];
+    }
+    return any != 0;
+  }
+};
+
+// The row kernels: cells [i0, i1) of one row, all with 8 neighbours inside,
+// a vector of lanes at a time and the rest one by one.
+enum class Phase { Give, Take, Change, Apply, NextActive };
+template <class Lanes>
+[[gnu::always_inline]] inline void run_row(Phase phase, const PassCells& c, std::size_t i0,
+                                           std::size_t i1) {
+  std::size_t i = i0;
+  switch (phase) {
+    case Phase::Give:
+      for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>)
+        store(c.give + i, c.give_factor<Lanes, true>(i, 0xffu));
+      for (; i < i1; ++i) c.give[i] = c.give_factor<double, true>(i, 0xffu);
+      return;
+    case Phase::Take:
+      for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>)
+        store(c.take + i, c.take_share<Lanes, true>(i, 0xffu));
+      for (; i < i1; ++i) c.take[i] = c.take_share<double, true>(i, 0xffu);
+      return;
+    case Phase::Change:
+      for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>) {
+        const auto moved = c.change<Lanes, true>(i, 0xffu);
+        for (int l = 0; l < kWidth<Lanes>; ++l) c.touched[i + l] = moved[l] != 0;
+      }
+      for (; i < i1; ++i) c.touched[i] = c.change<double, true>(i, 0xffu);
+      return;
+    case Phase::Apply:
+      for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>) c.apply<Lanes>(i);
+      for (; i < i1; ++i) c.apply<double>(i);
+      return;
+    case Phase::NextActive:
+      for (; i < i1; ++i) c.set_active(i, c.next_active<true>(i, 0xffu));
+      return;
+  }
+}
+// The row kernels built for any x86-64 (SSE2) and for AVX2 (no FMA: each
+// product is rounded on its own, as in the scalar path). The AVX2 build is
+// used where the CPU has it, unless DRIFT_NO_AVX2 is set (the tests compare
+// the two builds' bits).
+using RowKernel = void (*)(Phase, const PassCells&, std::size_t, std::size_t);
+void rows_baseline(Phase phase, const PassCells& c, std::size_t i0, std::size_t i1) {
+  run_row<Lanes2>(phase, c, i0, i1);
+}
+__attribute__((target("avx2"))) void rows_avx2(Phase phase, const PassCells& c, std::size_t i0,
+                                               std::size_t i1) {
+  run_row<Lanes4>(phase, c, i0, i1);
+}
+RowKernel row_kernel() {
+  const bool avx2 = __builtin_cpu_supports("avx2") && std::getenv("DRIFT_NO_AVX2") == nullptr;
+  return avx2 ? rows_avx2 : rows_baseline;
+}
+
+// Jacobi passes of terrain/slope_relax's HalfSteepest rule for snow on ground,
+// written for speed (see PassCells): the snow surface is kept as one array,
+// only the 4 x 4 tiles near what moved are visited, as runs along rows of
+// tiles.
 class SnowPasses {
  public:
   SnowPasses(const terrain::Grid<float>& ground, terrain::Grid<double>& snow, double dx, double dy,
              double tan_repose, double tolerance)
-      : g_(ground.values().data()),
-        h_(snow.values().data()),
-        w_(snow.width()),
-        hgt_(snow.height()),
-        tol_(tolerance) {
-    for (int k = 0; k < 8; ++k) {
-      drop_[k] = tan_repose * std::hypot(kDx[k] * dx, kDy[k] * dy);
-      offset_[k] = static_cast<std::ptrdiff_t>(kDy[k]) * w_ + kDx[k];
-    }
+      : w_(snow.width()), hgt_(snow.height()) {
     tiles_x_ = (w_ + kTile - 1) / kTile, tiles_y_ = (hgt_ + kTile - 1) / kTile;
     const std::size_t cells = static_cast<std::size_t>(w_) * hgt_;
     surface_.resize(cells);
-    for (std::size_t i = 0; i < cells; ++i) surface_[i] = static_cast<double>(g_[i]) + h_[i];
-    give_.assign(cells, 0.0), take_.assign(cells, 0.0), delta_.assign(cells, 0.0);
-    active_.assign(cells, 0), touched_.assign(cells, 0);
+    for (std::size_t i = 0; i < cells; ++i)
+      surface_[i] = static_cast<double>(ground.values()[i]) + snow.values()[i];
+    give_.assign(cells, kNotGiving), take_.assign(cells, 0.0), delta_.assign(cells, 0.0);
+    active_.assign(cells, 1), touched_.assign(cells, 0);
+    c_ = {ground.values().data(),
+          snow.values().data(),
+          surface_.data(),
+          give_.data(),
+          take_.data(),
+          delta_.data(),
+          active_.data(),
+          touched_.data(),
+          {},
+          {},
+          tolerance};
+    for (int k = 0; k < 8; ++k) {
+      c_.drop[k] = tan_repose * std::hypot(kDx[k] * dx, kDy[k] * dy);
+      c_.offset[k] = static_cast<std::ptrdiff_t>(kDy[k]) * w_ + kDx[k];
+    }
     const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
-    tile_active_.assign(tiles, 0), tile_touched_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
+    tile_active_.assign(tiles, 1), tile_touched_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
     blocks_x_ = (w_ + kShareBlock - 1) / kShareBlock;
     block_mark_.assign(
         static_cast<std::size_t>(blocks_x_) * ((hgt_ + kShareBlock - 1) / kShareBlock), 0);
-    for (std::size_t i = 0; i < cells; ++i) activate(i);
     active_tiles_ = tiles_where_active();
   }
 
@@ -94,7 +395,7 @@ class SnowPasses {
   bool run(int max_passes, const Pause& pause) {
     while (!active_tiles_.empty() && passes_ < max_passes) {
       ++passes_;
-      pass(active_tiles_);
+      pass();
       active_tiles_ = next_active(active_tiles_);
       const double share = active_share();
       if (pause(passes_, share)) break;
@@ -106,10 +407,10 @@ class SnowPasses {
   // neighbours look again.
   void changed(const std::vector<std::size_t>& cells) {
     for (std::size_t i : cells) {
-      surface_[i] = static_cast<double>(g_[i]) + h_[i];
-      activate(i);
-      for (int k = 0; k < 8; ++k)
-        if (inside(i, k)) activate(i + offset_[k]);
+      surface_[i] = static_cast<double>(c_.ground[i]) + c_.snow[i];
+      const int x = static_cast<int>(i % w_), y = static_cast<int>(i / w_);
+      for (int j = std::max(y - 1, 0); j <= std::min(y + 1, hgt_ - 1); ++j)
+        for (int k = std::max(x - 1, 0); k <= std::min(x + 1, w_ - 1); ++k) activate(k, j);
     }
     active_tiles_ = tiles_where_active();
   }
@@ -129,136 +430,110 @@ class SnowPasses {
           0;
     return static_cast<double>(count) / block_mark_.size();
   }
-  // Calls fn(i, edge) for the cells of a tile; edge: a neighbour may be outside.
-  template <class Fn>
-  void for_cells(int tile, const Fn& fn) const {
-    const int x0 = tile % tiles_x_ * kTile, y0 = tile / tiles_x_ * kTile;
-    const int x1 = std::min(x0 + kTile, w_), y1 = std::min(y0 + kTile, hgt_);
+  // A bit per neighbour of cell (x, y) that lies inside the grid.
+  unsigned inside_bits(int x, int y) const {
+    unsigned bits = 0;
+    for (int k = 0; k < 8; ++k) {
+      const int nx = x + kDx[k], ny = y + kDy[k];
+      bits |= static_cast<unsigned>(nx >= 0 && ny >= 0 && nx < w_ && ny < hgt_) << k;
+    }
+    return bits;
+  }
+  // For each row of cells of a run: row(i0, i1) on the cells with all 8
+  // neighbours inside, edge(i, inside_bits) on the others.
+  template <class Row, class Edge>
+  void for_run_cells(const TileRun& r, const Row& row, const Edge& edge) const {
+    const int x0 = r.tx0 * kTile, x1 = std::min(r.tx1 * kTile, w_);
+    const int y0 = r.ty * kTile, y1 = std::min(y0 + kTile, hgt_);
     for (int y = y0; y < y1; ++y) {
-      const bool edge_row = y == 0 || y == hgt_ - 1;
-      for (int x = x0; x < x1; ++x)
-        fn(static_cast<std::size_t>(y) * w_ + x, edge_row || x == 0 || x == w_ - 1);
+      const std::size_t start = static_cast<std::size_t>(y) * w_;
+      int a = std::max(x0, 1), b = std::min(x1, w_ - 1);  // the inner cells [a, b)
+      if (y == 0 || y == hgt_ - 1 || a >= b) a = b = x1;
+      for (int x = x0; x < a; ++x) edge(start + x, inside_bits(x, y));
+      if (a < b) row(start + a, start + b);
+      for (int x = b; x < x1; ++x) edge(start + x, inside_bits(x, y));
     }
   }
-  bool inside(std::size_t i, int k) const {
-    const int x = static_cast<int>(i % w_) + kDx[k], y = static_cast<int>(i / w_) + kDy[k];
-    return x >= 0 && y >= 0 && x < w_ && y < hgt_;
+  // Whether a cell of tile (tx, ty) has its flag set.
+  bool any_in_tile(const std::vector<std::uint8_t>& flags, int tx, int ty) const {
+    const int x0 = tx * kTile, x1 = std::min(x0 + kTile, w_);
+    bool any = false;
+    for (int y = ty * kTile; y < std::min(ty * kTile + kTile, hgt_); ++y)
+      for (int x = x0; x < x1; ++x) any = any || flags[static_cast<std::size_t>(y) * w_ + x];
+    return any;
   }
-  // Excess of the slope from cell i down to its neighbour n in direction k.
-  double excess(std::size_t i, std::size_t n, int k) const {
-    return surface_[i] - surface_[n] - drop_[k];
+  // Sets a tile's cells' values to v.
+  template <class V>
+  void fill_tile(std::vector<V>& values, int t, V v) {
+    const int x0 = t % tiles_x_ * kTile, y0 = t / tiles_x_ * kTile;
+    const int n = std::min(x0 + kTile, w_) - x0;
+    for (int y = y0; y < std::min(y0 + kTile, hgt_); ++y)
+      std::fill_n(values.begin() + static_cast<std::ptrdiff_t>(y) * w_ + x0, n, v);
+  }
+  // Tile t's cells stop: not active, giving nothing.
+  void stop_tile(int t) {
+    fill_tile(active_, t, std::uint8_t{0}), fill_tile(give_, t, kNotGiving);
+    tile_active_[static_cast<std::size_t>(t)] = 0;
   }
 
-  // Phase 1, paper 003 2.1(3): a giver gives min(held, e_max / 2), shared among
-  // its steeper neighbours in proportion to their excess; the factor per excess.
-  double give_factor(std::size_t i, bool edge) const {
-    double sum = 0.0, largest = 0.0;
-    for (int k = 0; k < 8; ++k) {
-      if (edge && !inside(i, k)) continue;
-      // Adding 0.0 to a sum of positive terms leaves its bits: the same
-      // result as skipping, without a branch the data cannot predict.
-      const double e = excess(i, i + offset_[k], k);
-      const double over = e > tol_ ? e : 0.0;
-      sum += over;
-      largest = std::max(largest, over);
-    }
-    if (sum <= 0.0) return 0.0;
-    const double room = std::max(h_[i] - 0.0, 0.0);
-    return room > tol_ ? std::min(room, 0.5 * largest) / sum : 0.0;
-  }
-  // Calls f(n, e, offered) for each neighbour n of cell i, e the excess of its
-  // slope towards i, offered if n is active and e above the tolerance: the
-  // offers i may take from, in the fixed neighbour order. f adds 0.0 where
-  // nothing is offered (the same bits as skipping, without branches).
-  template <class F>
-  void for_each_offer_to(std::size_t i, bool edge, F&& f) const {
-    for (int k = 0; k < 8; ++k) {
-      if (edge && !inside(i, k)) continue;
-      const std::size_t n = i + offset_[k];
-      const double e = excess(n, i, 7 - k);
-      f(n, e, active_[n] && e > tol_);
-    }
-  }
-  // Phase 2: the share of its offers a taker takes (half the largest excess it
-  // is offered from).
-  double take_share(std::size_t i, bool edge) const {
-    double in = 0.0, largest = 0.0;
-    for_each_offer_to(i, edge, [&](std::size_t n, double e, bool offered) {
-      in += offered ? give_[n] * e : 0.0;
-      largest = std::max(largest, offered ? e : 0.0);
+  // One Jacobi pass: every flow from the state before it. give_, take_ and
+  // delta_ need no clearing: every pass writes them for every cell it reads
+  // them at (active cells, and the tiles near them).
+  void pass() {
+    const PassCells& c = c_;
+    for_runs(runs_of(active_tiles_, tiles_x_), active_tiles_.size(), [&](const TileRun& r) {
+      for_run_cells(
+          r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Give, c, i0, i1); },
+          [&](std::size_t i, unsigned in) { c.give[i] = c.give_factor<double, false>(i, in); });
     });
-    if (!(in > 0.0)) return 0.0;
-    return std::min(1.0, 0.5 * largest / in);
-  }
-  // Phase 3: the change of cell i, taken - given; marks it touched if it moved.
-  void change(std::size_t i, bool edge) {
-    double out = 0.0, in = 0.0;
-    bool moved = false;
-    if (give_[i] > 0.0 && active_[i])
-      for (int k = 0; k < 8; ++k) {
-        if (edge && !inside(i, k)) continue;
-        const std::size_t n = i + offset_[k];
-        const double e = excess(i, n, k);
-        const double f = e > tol_ ? give_[i] * e * take_[n] : 0.0;
-        out += f, moved = moved || f > 0.0;
-      }
-    if (take_[i] > 0.0)
-      for_each_offer_to(i, edge, [&](std::size_t n, double e, bool offered) {
-        const double f = offered ? give_[n] * e * take_[i] : 0.0;
-        in += f, moved = moved || f > 0.0;
-      });
-    delta_[i] = in - out;
-    touched_[i] = moved;
-  }
-
-  // One Jacobi pass: every flow from the state before it.
-  void pass(const std::vector<int>& active) {
-    for_list(active, [&](int t) {
-      for_cells(t, [&](std::size_t i, bool edge) {
-        if (active_[i]) give_[i] = give_factor(i, edge);
-      });
+    near_ = with_neighbours(active_tiles_);
+    const std::vector<TileRun> near = runs_of(near_, tiles_x_);
+    for_runs(near, near_.size(), [&](const TileRun& r) {
+      for_run_cells(
+          r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Take, c, i0, i1); },
+          [&](std::size_t i, unsigned in) { c.take[i] = c.take_share<double, false>(i, in); });
     });
-    near_ = with_neighbours(active);
-    for_list(near_, [&](int t) {
-      for_cells(t, [&](std::size_t i, bool edge) { take_[i] = take_share(i, edge); });
+    for_runs(near, near_.size(), [&](const TileRun& r) {
+      for_run_cells(
+          r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Change, c, i0, i1); },
+          [&](std::size_t i, unsigned in) { c.touched[i] = c.change<double, false>(i, in); });
+      for (int tx = r.tx0; tx < r.tx1; ++tx)
+        tile_touched_[static_cast<std::size_t>(r.ty) * tiles_x_ + tx] =
+            any_in_tile(touched_, tx, r.ty);
     });
-    for_list(near_, [&](int t) {
-      bool any = false;
-      for_cells(t, [&](std::size_t i, bool edge) {
-        change(i, edge);
-        any = any || touched_[i];
-      });
-      tile_touched_[static_cast<std::size_t>(t)] = any;
-    });
-    // give_, take_ and delta_ need no clearing: every pass writes them for
-    // every cell it reads them at (active cells, and the tiles near them).
-    for_list(near_, [&](int t) {
-      for_cells(t, [&](std::size_t i, bool) {
-        if (delta_[i] == 0.0) return;
-        h_[i] += delta_[i];
-        surface_[i] = static_cast<double>(g_[i]) + h_[i];
-      });
+    for_runs(near, near_.size(), [&](const TileRun& r) {
+      for_run_cells(
+          r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Apply, c, i0, i1); },
+          [&](std::size_t i, unsigned) { c.apply<double>(i); });
     });
   }
 
-  // The tiles of `tiles` and their 8 neighbours, ascending.
+  // The tiles of `tiles` and their 8 neighbours, ascending: read off the marks
+  // row by row where they are dense, sorted where they are few.
   std::vector<int> with_neighbours(const std::vector<int>& tiles) {
     std::vector<int> out;
+    int lo = tiles_y_, hi = -1;
     for (int t : tiles) {
       const int tx = t % tiles_x_, ty = t / tiles_x_;
+      lo = std::min(lo, std::max(ty - 1, 0)), hi = std::max(hi, std::min(ty + 1, tiles_y_ - 1));
       for (int j = std::max(ty - 1, 0); j <= std::min(ty + 1, tiles_y_ - 1); ++j)
         for (int i = std::max(tx - 1, 0); i <= std::min(tx + 1, tiles_x_ - 1); ++i) {
           std::uint8_t& mark = tile_mark_[static_cast<std::size_t>(j) * tiles_x_ + i];
           if (!mark) mark = 1, out.push_back(j * tiles_x_ + i);
         }
     }
-    for (int t : out) tile_mark_[static_cast<std::size_t>(t)] = 0;
-    std::sort(out.begin(), out.end());
+    if (out.size() * 16 < static_cast<std::size_t>(hi - lo + 1) * tiles_x_) {
+      for (int t : out) tile_mark_[static_cast<std::size_t>(t)] = 0;
+      std::sort(out.begin(), out.end());
+      return out;
+    }
+    out.clear();
+    for (int t = lo * tiles_x_; t < (hi + 1) * tiles_x_; ++t)
+      if (tile_mark_[static_cast<std::size_t>(t)]) out.push_back(t), tile_mark_[t] = 0;
     return out;
   }
-  void activate(std::size_t i) {
-    active_[i] = 1;
-    const int x = static_cast<int>(i % w_), y = static_cast<int>(i / w_);
+  void activate(int x, int y) {
+    active_[static_cast<std::size_t>(y) * w_ + x] = 1;
     tile_active_[static_cast<std::size_t>(y / kTile) * tiles_x_ + x / kTile] = 1;
   }
   std::vector<int> tiles_where_active() const {
@@ -266,21 +541,6 @@ class SnowPasses {
     for (std::size_t t = 0; t < tile_active_.size(); ++t)
       if (tile_active_[t]) out.push_back(static_cast<int>(t));
     return out;
-  }
-  void clear_active(int t) {
-    for_cells(t, [&](std::size_t i, bool) { active_[i] = 0; });
-    tile_active_[static_cast<std::size_t>(t)] = 0;
-  }
-  // A cell is active next pass if it or a neighbour gave or took in this one.
-  void mark_active(int t) {
-    bool any = false;
-    for_cells(t, [&](std::size_t i, bool edge) {
-      bool a = touched_[i] != 0;
-      for (int k = 0; k < 8 && !a; ++k) a = (!edge || inside(i, k)) && touched_[i + offset_[k]];
-      active_[i] = a;
-      any = any || a;
-    });
-    tile_active_[static_cast<std::size_t>(t)] = any;
   }
   // The tiles with active cells after a pass; clears the pass's marks.
   std::vector<int> next_active(const std::vector<int>& was_active) {
@@ -290,11 +550,19 @@ class SnowPasses {
     const std::vector<int> candidates = with_neighbours(touched);
     for (int t : candidates) tile_mark_[static_cast<std::size_t>(t)] = 1;
     for (int t : was_active)
-      if (!tile_mark_[static_cast<std::size_t>(t)]) clear_active(t);
+      if (!tile_mark_[static_cast<std::size_t>(t)]) stop_tile(t);
     for (int t : candidates) tile_mark_[static_cast<std::size_t>(t)] = 0;
-    for_list(candidates, [&](int t) { mark_active(t); });
+    const PassCells& c = c_;
+    for_runs(runs_of(candidates, tiles_x_), candidates.size(), [&](const TileRun& r) {
+      for_run_cells(
+          r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::NextActive, c, i0, i1); },
+          [&](std::size_t i, unsigned in) { c.set_active(i, c.next_active<false>(i, in)); });
+      for (int tx = r.tx0; tx < r.tx1; ++tx)
+        tile_active_[static_cast<std::size_t>(r.ty) * tiles_x_ + tx] =
+            any_in_tile(active_, tx, r.ty);
+    });
     for_list(touched, [&](int t) {
-      for_cells(t, [&](std::size_t i, bool) { touched_[i] = 0; });
+      fill_tile(touched_, t, std::uint8_t{0});
       tile_touched_[static_cast<std::size_t>(t)] = 0;
     });
     std::vector<int> next;
@@ -303,12 +571,9 @@ class SnowPasses {
     return next;
   }
 
-  const float* g_;
-  double* h_;
   int w_, hgt_, tiles_x_ = 0, tiles_y_ = 0;
-  double tol_;
-  std::array<double, 8> drop_{};
-  std::array<std::ptrdiff_t, 8> offset_{};
+  PassCells c_{};
+  RowKernel rows_ = row_kernel();
   std::vector<double> surface_, give_, take_, delta_;
   std::vector<std::uint8_t> active_, touched_;
   std::vector<std::uint8_t> tile_active_, tile_touched_, tile_mark_;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <numeric>
 
@@ -232,29 +233,40 @@ TEST(SnowfallStabilise, SameBitsForAnyThreadCount) {
   EXPECT_EQ(one.values(), two.values());
 }
 
+// A field with bare rock, films, piles and a column, on cells that are not
+// square (1 x 0.8 m) and a size that is no multiple of the tiles or the lanes.
+struct MixedField {
+  static constexpr int w = 70, h = 53;
+  Grid<float> ground{w, h, 0.0f};
+  Grid<double> snow{w, h, 0.0};
+  MixedField() {
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        ground(x, y) = static_cast<float>(6.0 * std::sin(x * 0.23) * std::cos(y * 0.19) + 0.3 * x);
+        snow(x, y) = std::max(0.0, 0.3 + 0.6 * std::sin(x * 1.1 + y * 0.9));
+      }
+    snow(35, 26) = 40.0;  // a column
+  }
+};
+StabiliseOptions passes_alone() {
+  StabiliseOptions o;
+  o.shortcut = false;
+  o.coarse_levels = 0;
+  return o;
+}
+
 // Snow's pass kernel (snow/stabilise_grid.cpp) is terrain/slope_relax's
 // HalfSteepest passes written for speed; both must give the same passes and the
-// same bits, on a field with bare rock, films, piles, closed edges, cells that
-// are not square and a size that is no multiple of the 16-cell tile.
+// same bits, with closed edges.
 TEST(SnowfallStabilise, SameBitsAsTheSharedSlopeRelaxation) {
-  const int w = 70, h = 53;
-  Grid<float> ground(w, h, 0.0f);
-  Grid<double> start(w, h, 0.0);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      ground(x, y) = static_cast<float>(6.0 * std::sin(x * 0.23) * std::cos(y * 0.19) + 0.3 * x);
-      start(x, y) = std::max(0.0, 0.3 + 0.6 * std::sin(x * 1.1 + y * 0.9));
-    }
-  start(35, 26) = 40.0;  // a column
-  StabiliseOptions o;
-  o.shortcut = false;  // the passes alone
-  o.coarse_levels = 0;
-  Grid<double> own = start, shared = start;
-  const auto r = stabilise_grid(ground, own, 1.0, 0.8, o);
+  const MixedField f;
+  const StabiliseOptions o = passes_alone();
+  Grid<double> own = f.snow, shared = f.snow;
+  const auto r = stabilise_grid(f.ground, own, 1.0, 0.8, o);
   const drift::terrain::SlopeRule rule{tan_deg(o.repose_deg), 0.5,
                                        drift::terrain::SlopeShare::HalfSteepest};
   drift::terrain::SlopeCells cells{{&rule, 1}};
-  cells.base = &ground;
+  cells.base = &f.ground;
   cells.min_value = 0.0;
   const auto s = drift::terrain::relax_slopes_everywhere(shared, cells,
                                                          {1.0, 0.8, o.tolerance, o.max_iterations});
@@ -262,6 +274,22 @@ TEST(SnowfallStabilise, SameBitsAsTheSharedSlopeRelaxation) {
   EXPECT_GT(r.iterations, 100);  // the field does settle
   EXPECT_EQ(r.iterations, s.passes);
   EXPECT_EQ(own.values(), shared.values());
+}
+
+// The kernel's row loops are built twice, for any x86-64 (2 lanes, SSE2) and
+// for AVX2 (4 lanes), and the CPU picks one; DRIFT_NO_AVX2 forces the first.
+// Both must give the same passes and bits (no FMA, the same operations per lane).
+TEST(SnowfallStabilise, SameBitsWithAndWithoutAvx2) {
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU: one build only";
+  const MixedField f;
+  Grid<double> avx2 = f.snow, baseline = f.snow;
+  const auto a = stabilise_grid(f.ground, avx2, 1.0, 0.8, passes_alone());
+  ASSERT_EQ(setenv("DRIFT_NO_AVX2", "1", 1), 0);
+  const auto b = stabilise_grid(f.ground, baseline, 1.0, 0.8, passes_alone());
+  unsetenv("DRIFT_NO_AVX2");
+  EXPECT_GT(a.iterations, 100);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(avx2.values(), baseline.values());
 }
 
 // The shortcut for the slow tail (snow/stabilise_settle.h) on the corner of
