@@ -10,6 +10,7 @@
 #include <cstring>
 #include <numbers>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "snow/stabilise_levels.h"
@@ -25,7 +26,7 @@ namespace {
 // Cells per tile side: small tiles follow the moving snow closely (16 did a
 // quarter more work at 1024^2, where a third of an active 16 x 16 tile's cells
 // are active).
-constexpr int kTile = 4;
+constexpr int kTile = 4;  // (any_in_tile reads a tile's row as a 32-bit word)
 // The active share that decides when the passes are in their tail is counted
 // on blocks of this many cells a side (a multiple of kTile), whatever kTile is,
 // so that the shortcut runs when it always has.
@@ -59,7 +60,7 @@ void for_list(const std::vector<int>& items, const Fn& fn) {
 // A run of consecutive tiles in one row of tiles (tx0 <= tile x < tx1). The
 // phases work on runs, so that their inner loops run along rows of cells and
 // the cells with all 8 neighbours inside take a path without edge tests that
-// the compiler vectorises.
+// does several cells at once.
 struct TileRun {
   int ty, tx0, tx1;
 };
@@ -67,12 +68,15 @@ struct TileRun {
 // The runs of an ascending list of tiles.
 std::vector<TileRun> runs_of(const std::vector<int>& tiles, int tiles_x) {
   std::vector<TileRun> runs;
+  int row_start = 0;  // the first tile of the last run's row of tiles
   for (int t : tiles) {
-    const int ty = t / tiles_x, tx = t % tiles_x;
-    if (!runs.empty() && runs.back().ty == ty && runs.back().tx1 == tx)
+    if (!runs.empty() && t == row_start + runs.back().tx1 && runs.back().tx1 < tiles_x) {
       ++runs.back().tx1;
-    else
-      runs.push_back({ty, tx, tx + 1});
+      continue;
+    }
+    const int ty = t / tiles_x;
+    row_start = ty * tiles_x;
+    runs.push_back({ty, t - row_start, t - row_start + 1});
   }
   return runs;
 }
@@ -115,6 +119,9 @@ struct LaneTypes<4> {
 using Lanes2 = LaneTypes<2>::Values;
 using Lanes4 = LaneTypes<4>::Values;
 static_assert(sizeof(Lanes2) == 16 && sizeof(Lanes4) == 32);
+// A comparison's result: bool for one cell, a lane mask for lanes.
+template <class T>
+using MaskOf = decltype(T{} > 0.0);
 // The number of cells in a T (double or lanes).
 template <class T>
 constexpr int kWidth = sizeof(T) / sizeof(double);
@@ -211,6 +218,10 @@ struct PassCells {
   [[gnu::always_inline]] T give_factor(std::size_t i, unsigned inside) const {
     T sum{}, largest{};
     const T here = load<T>(surface + i), zero{};
+    const T room = larger(load<T>(snow + i) - 0.0, zero);
+    const auto active_here = is_set<T>(active + i);
+    // Bare cells give nothing whatever their neighbours (the result below).
+    if (none(room > tol)) return active_here ? zero : splat<T>(kNotGiving);
     for (int k = 0; k < 8; ++k) {
       if (!kAllInside && !(inside >> k & 1u)) continue;
       const T e = here - load<T>(surface + i + offset[k]) - drop[k];
@@ -218,56 +229,73 @@ struct PassCells {
       sum += over;
       largest = larger(largest, over);
     }
-    const T room = larger(load<T>(snow + i) - 0.0, zero);
     const T factor = smaller(room, 0.5 * largest) / (sum > 0.0 ? sum : splat<T>(1.0));
     const T given = (sum > 0.0) & (room > tol) ? factor : zero;
-    return is_set<T>(active + i) ? given : splat<T>(kNotGiving);
+    return active_here ? given : splat<T>(kNotGiving);
   }
   // Phase 2: the share of its offers a taker takes (half the largest excess it
-  // is offered from), the offers being those of active steeper neighbours.
+  // is offered from), the offers being those of active steeper neighbours;
+  // and what it takes, since that needs nothing more: each offer times the
+  // share, the flow its giver computes in phase 3 from the same operands, summed
+  // into delta. Stores take and delta; returns whether the cell took.
   template <class T, bool kAllInside>
-  [[gnu::always_inline]] T take_share(std::size_t i, unsigned inside) const {
-    T in{}, largest{};
+  [[gnu::always_inline]] MaskOf<T> take_share(std::size_t i, unsigned inside) const {
+    T in{}, largest{}, offers[8] = {};
     const T here = load<T>(surface + i), zero{};
+    // No neighbour giving: every offer is 0.0, nothing is taken (the result below).
+    T most{};
+    for (int k = 0; k < 8; ++k)
+      if (kAllInside || inside >> k & 1u) most = larger(most, load<T>(give + i + offset[k]));
+    if (none(most > 0.0)) {
+      store(take + i, zero), store(delta + i, zero);
+      return most > 0.0;
+    }
     for (int k = 0; k < 8; ++k) {
       if (!kAllInside && !(inside >> k & 1u)) continue;
       const std::size_t n = i + offset[k];
       const T e = load<T>(surface + n) - here - drop[7 - k];
       const T give_n = load<T>(give + n);
-      const auto offered = (give_n >= 0.0) & (e > tol);
-      const T offer = give_n * e;
-      in += offered ? offer : zero;
-      largest = larger(largest, offered ? e : zero);
+      // Not offered: an excess of 0.0, so an offer of +-0.0, which leaves the
+      // sums' bits (x + -0.0 is x, +0.0 + -0.0 is +0.0).
+      const T excess = (give_n >= 0.0) & (e > tol) ? e : zero;
+      offers[k] = give_n * excess;
+      in += offers[k];
+      largest = larger(largest, excess);
     }
     const T share = smaller(splat<T>(1.0), 0.5 * largest / (in > 0.0 ? in : splat<T>(1.0)));
-    return in > 0.0 ? share : zero;
+    const auto takes = in > 0.0;
+    const T taken_share = takes ? share : zero;
+    // An offer of +-0.0 (none) flows as +-0.0: the sum's bits. The flows are
+    // >= 0, so one of them is > 0 exactly where their sum is.
+    T taken{};
+    for (int k = 0; k < 8; ++k) {
+      if (!kAllInside && !(inside >> k & 1u)) continue;
+      taken += offers[k] * taken_share;
+    }
+    store(take + i, taken_share);
+    store(delta + i, takes ? taken : zero);
+    return MaskOf<T>(takes & (taken > 0.0));
   }
-  // Phase 3: the change of cell i, taken - given (stored in delta), each flow
-  // computed from the same operands by its giver and its taker; returns
-  // whether the cell gave or took. The excesses towards n and from n share one
-  // difference (its negation is the other difference, to the bit).
+  // Phase 3: the change of cell i, taken (phase 2) - given, each outflow
+  // computed from the same operands as its taker computed it; returns whether
+  // the cell gave.
   template <class T, bool kAllInside>
-  [[gnu::always_inline]] auto change(std::size_t i, unsigned inside) const {
-    T out{}, in{};
+  [[gnu::always_inline]] MaskOf<T> change(std::size_t i, unsigned inside) const {
+    T out{};
     const T here = load<T>(surface + i), give_here = load<T>(give + i), zero{};
-    const T take_here = load<T>(take + i);
-    decltype(here > 0.0) gave{}, took{};
+    const auto gives = give_here > 0.0;
+    // Not giving: delta keeps what was taken (x - 0.0 is x), the result below.
+    if (none(gives)) return gives;
     for (int k = 0; k < 8; ++k) {
       if (!kAllInside && !(inside >> k & 1u)) continue;
       const std::size_t n = i + offset[k];
-      const T d = here - load<T>(surface + n);
-      const T down = d - drop[k], up = -d - drop[7 - k];
+      const T down = here - load<T>(surface + n) - drop[k];
       const T flow_out = give_here * down * load<T>(take + n);
-      const T give_n = load<T>(give + n);
-      const T flow_in = give_n * up * take_here;
-      const T f = down > tol ? flow_out : zero;
-      const T g = (give_n >= 0.0) & (up > tol) ? flow_in : zero;
-      out += f, gave |= f > 0.0;
-      in += g, took |= g > 0.0;
+      out += down > tol ? flow_out : zero;
     }
-    const auto gives = give_here > 0.0, takes = take_here > 0.0;
-    store(delta + i, (takes ? in : zero) - (gives ? out : zero));
-    return (gives & gave) | (takes & took);
+    store(delta + i, load<T>(delta + i) - (gives ? out : zero));
+    // A giver's flows are >= 0: one is > 0 exactly where their sum is.
+    return MaskOf<T>(gives & (out > 0.0));
   }
   // The change applied, only where there is one (h + 0.0 would turn -0.0 into
   // 0.0; and cells that did not move are not written).
@@ -278,11 +306,6 @@ struct PassCells {
     const T moved = h + d, held = d == 0.0 ? h : moved;
     store(snow + i, held);
     store(surface + i, to_double<T>(ground + i) + held);
-  }
-  // A cell's activity; one that stops gives nothing (kNotGiving).
-  [[gnu::always_inline]] void set_active(std::size_t i, std::uint8_t a) const {
-    active[i] = a;
-    give[i] = a ? give[i] : kNotGiving;
   }
   // Whether cell i is active next pass: it or a neighbour gave or took.
   template <bool kAllInside>
@@ -300,8 +323,11 @@ struct PassCells {
 // a vector of lanes at a time and the rest one by one.
 enum class Phase { Give, Take, Change, Apply, NextActive };
 template <class Lanes>
-[[gnu::always_inline]] inline void run_row(Phase phase, const PassCells& c, std::size_t i0,
+[[gnu::always_inline]] inline void run_row(Phase phase, const PassCells& cells, std::size_t i0,
                                            std::size_t i1) {
+  // A local copy: the stores (memcpy) cannot reach it, so its pointers stay in
+  // registers instead of being reloaded after every store.
+  const PassCells c = cells;
   std::size_t i = i0;
   switch (phase) {
     case Phase::Give:
@@ -310,23 +336,36 @@ template <class Lanes>
       for (; i < i1; ++i) c.give[i] = c.give_factor<double, true>(i, 0xffu);
       return;
     case Phase::Take:
-      for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>)
-        store(c.take + i, c.take_share<Lanes, true>(i, 0xffu));
-      for (; i < i1; ++i) c.take[i] = c.take_share<double, true>(i, 0xffu);
+      for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>) {
+        const auto took = c.take_share<Lanes, true>(i, 0xffu);
+        for (int l = 0; l < kWidth<Lanes>; ++l) c.touched[i + l] = took[l] != 0;
+      }
+      for (; i < i1; ++i) c.touched[i] = c.take_share<double, true>(i, 0xffu);
       return;
     case Phase::Change:
       for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>) {
         const auto moved = c.change<Lanes, true>(i, 0xffu);
-        for (int l = 0; l < kWidth<Lanes>; ++l) c.touched[i + l] = moved[l] != 0;
+        for (int l = 0; l < kWidth<Lanes>; ++l) c.touched[i + l] |= moved[l] != 0;
       }
-      for (; i < i1; ++i) c.touched[i] = c.change<double, true>(i, 0xffu);
+      for (; i < i1; ++i) c.touched[i] |= c.change<double, true>(i, 0xffu);
       return;
     case Phase::Apply:
       for (; i + kWidth<Lanes> <= i1; i += kWidth<Lanes>) c.apply<Lanes>(i);
       for (; i < i1; ++i) c.apply<double>(i);
       return;
     case Phase::NextActive:
-      for (; i < i1; ++i) c.set_active(i, c.next_active<true>(i, 0xffu));
+      for (; i + 16 <= i1; i += 16) {  // 16 cells' flags in one SSE2 register
+        using Flags = std::uint8_t __attribute__((vector_size(16)));
+        Flags any, next;
+        std::memcpy(&any, c.touched + i, sizeof any);
+        for (int k = 0; k < 8; ++k) {
+          std::memcpy(&next, c.touched + i + c.offset[k], sizeof next);
+          any |= next;
+        }
+        const Flags active = (any != 0) & 1;
+        std::memcpy(c.active + i, &active, sizeof active);
+      }
+      for (; i < i1; ++i) c.active[i] = c.next_active<true>(i, 0xffu);
       return;
   }
 }
@@ -383,7 +422,7 @@ class SnowPasses {
     blocks_x_ = (w_ + kShareBlock - 1) / kShareBlock;
     block_mark_.assign(
         static_cast<std::size_t>(blocks_x_) * ((hgt_ + kShareBlock - 1) / kShareBlock), 0);
-    active_tiles_ = tiles_where_active();
+    set_active_tiles(tiles_where_active());
   }
 
   // Bytes a grid of `cells` needs on top of the snow and the ground.
@@ -396,7 +435,7 @@ class SnowPasses {
     while (!active_tiles_.empty() && passes_ < max_passes) {
       ++passes_;
       pass();
-      active_tiles_ = next_active(active_tiles_);
+      set_active_tiles(next_active(active_tiles_));
       const double share = active_share();
       if (pause(passes_, share)) break;
     }
@@ -412,7 +451,7 @@ class SnowPasses {
       for (int j = std::max(y - 1, 0); j <= std::min(y + 1, hgt_ - 1); ++j)
         for (int k = std::max(x - 1, 0); k <= std::min(x + 1, w_ - 1); ++k) activate(k, j);
     }
-    active_tiles_ = tiles_where_active();
+    set_active_tiles(tiles_where_active());
   }
 
  private:
@@ -420,14 +459,14 @@ class SnowPasses {
   double active_share() {
     constexpr int per = kShareBlock / kTile;
     std::size_t count = 0;
-    for (int t : active_tiles_) {
-      std::uint8_t& mark = block_mark_[static_cast<std::size_t>(t / tiles_x_ / per) * blocks_x_ +
-                                       t % tiles_x_ / per];
-      count += mark == 0, mark = 1;
-    }
-    for (int t : active_tiles_)
-      block_mark_[static_cast<std::size_t>(t / tiles_x_ / per) * blocks_x_ + t % tiles_x_ / per] =
-          0;
+    const auto marks = [&](std::uint8_t value) {
+      for (const TileRun& r : active_runs_) {
+        std::uint8_t* row = block_mark_.data() + static_cast<std::size_t>(r.ty / per) * blocks_x_;
+        for (int b = r.tx0 / per; b <= (r.tx1 - 1) / per; ++b)
+          count += value && row[b] == 0, row[b] = value;
+      }
+    };
+    marks(1), marks(0);
     return static_cast<double>(count) / block_mark_.size();
   }
   // A bit per neighbour of cell (x, y) that lies inside the grid.
@@ -457,10 +496,18 @@ class SnowPasses {
   // Whether a cell of tile (tx, ty) has its flag set.
   bool any_in_tile(const std::vector<std::uint8_t>& flags, int tx, int ty) const {
     const int x0 = tx * kTile, x1 = std::min(x0 + kTile, w_);
-    bool any = false;
-    for (int y = ty * kTile; y < std::min(ty * kTile + kTile, hgt_); ++y)
-      for (int x = x0; x < x1; ++x) any = any || flags[static_cast<std::size_t>(y) * w_ + x];
-    return any;
+    std::uint32_t any = 0;
+    for (int y = ty * kTile; y < std::min(ty * kTile + kTile, hgt_); ++y) {
+      const std::uint8_t* row = flags.data() + static_cast<std::size_t>(y) * w_ + x0;
+      if (x1 - x0 == kTile) {  // a row of the tile as one word
+        std::uint32_t word;
+        std::memcpy(&word, row, sizeof word);
+        any |= word;
+      } else {
+        for (int x = 0; x < x1 - x0; ++x) any |= row[x];
+      }
+    }
+    return any != 0;
   }
   // Sets a tile's cells' values to v.
   template <class V>
@@ -481,7 +528,7 @@ class SnowPasses {
   // them at (active cells, and the tiles near them).
   void pass() {
     const PassCells& c = c_;
-    for_runs(runs_of(active_tiles_, tiles_x_), active_tiles_.size(), [&](const TileRun& r) {
+    for_runs(active_runs_, active_tiles_.size(), [&](const TileRun& r) {
       for_run_cells(
           r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Give, c, i0, i1); },
           [&](std::size_t i, unsigned in) { c.give[i] = c.give_factor<double, false>(i, in); });
@@ -491,50 +538,78 @@ class SnowPasses {
     for_runs(near, near_.size(), [&](const TileRun& r) {
       for_run_cells(
           r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Take, c, i0, i1); },
-          [&](std::size_t i, unsigned in) { c.take[i] = c.take_share<double, false>(i, in); });
+          [&](std::size_t i, unsigned in) { c.touched[i] = c.take_share<double, false>(i, in); });
     });
     for_runs(near, near_.size(), [&](const TileRun& r) {
       for_run_cells(
           r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Change, c, i0, i1); },
-          [&](std::size_t i, unsigned in) { c.touched[i] = c.change<double, false>(i, in); });
+          [&](std::size_t i, unsigned in) { c.touched[i] |= c.change<double, false>(i, in); });
       for (int tx = r.tx0; tx < r.tx1; ++tx)
         tile_touched_[static_cast<std::size_t>(r.ty) * tiles_x_ + tx] =
             any_in_tile(touched_, tx, r.ty);
     });
-    for_runs(near, near_.size(), [&](const TileRun& r) {
+    // Only cells that gave or took change (delta != 0 needs a flow).
+    touched_tiles_.clear();
+    for (int t : near_)
+      if (tile_touched_[static_cast<std::size_t>(t)]) touched_tiles_.push_back(t);
+    for_runs(runs_of(touched_tiles_, tiles_x_), touched_tiles_.size(), [&](const TileRun& r) {
       for_run_cells(
           r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::Apply, c, i0, i1); },
           [&](std::size_t i, unsigned) { c.apply<double>(i); });
     });
   }
 
-  // The tiles of `tiles` and their 8 neighbours, ascending: read off the marks
-  // row by row where they are dense, sorted where they are few.
+  // The tiles of `tiles` (ascending) and their 8 neighbours, ascending: where
+  // they are many, marked a row of tiles at a time and read off the marks
+  // (8 at a time where none is set); where they are few, marked one by one
+  // and sorted.
   std::vector<int> with_neighbours(const std::vector<int>& tiles) {
     std::vector<int> out;
-    int lo = tiles_y_, hi = -1;
+    if (tiles.empty()) return out;
+    const int lo = std::max(tiles.front() / tiles_x_ - 1, 0);
+    const int hi = std::min(tiles.back() / tiles_x_ + 1, tiles_y_ - 1);
+    const std::size_t first = static_cast<std::size_t>(lo) * tiles_x_;
+    const std::size_t last = static_cast<std::size_t>(hi + 1) * tiles_x_;
+    if (tiles.size() * 64 < last - first) return with_neighbours_sorted(tiles);
+    for (const TileRun& r : runs_of(tiles, tiles_x_)) {
+      const int x0 = std::max(r.tx0 - 1, 0), x1 = std::min(r.tx1 + 1, tiles_x_);
+      for (int j = std::max(r.ty - 1, 0); j <= std::min(r.ty + 1, tiles_y_ - 1); ++j)
+        std::fill_n(tile_mark_.begin() + static_cast<std::ptrdiff_t>(j) * tiles_x_ + x0, x1 - x0,
+                    std::uint8_t{1});
+    }
+    std::size_t t = first;
+    for (; t + 8 <= last; t += 8) {
+      std::uint64_t word;
+      std::memcpy(&word, tile_mark_.data() + t, sizeof word);
+      if (word == 0) continue;
+      for (std::size_t u = t; u < t + 8; ++u)
+        if (tile_mark_[u]) out.push_back(static_cast<int>(u)), tile_mark_[u] = 0;
+    }
+    for (; t < last; ++t)
+      if (tile_mark_[t]) out.push_back(static_cast<int>(t)), tile_mark_[t] = 0;
+    return out;
+  }
+  std::vector<int> with_neighbours_sorted(const std::vector<int>& tiles) {
+    std::vector<int> out;
     for (int t : tiles) {
       const int tx = t % tiles_x_, ty = t / tiles_x_;
-      lo = std::min(lo, std::max(ty - 1, 0)), hi = std::max(hi, std::min(ty + 1, tiles_y_ - 1));
       for (int j = std::max(ty - 1, 0); j <= std::min(ty + 1, tiles_y_ - 1); ++j)
         for (int i = std::max(tx - 1, 0); i <= std::min(tx + 1, tiles_x_ - 1); ++i) {
           std::uint8_t& mark = tile_mark_[static_cast<std::size_t>(j) * tiles_x_ + i];
           if (!mark) mark = 1, out.push_back(j * tiles_x_ + i);
         }
     }
-    if (out.size() * 16 < static_cast<std::size_t>(hi - lo + 1) * tiles_x_) {
-      for (int t : out) tile_mark_[static_cast<std::size_t>(t)] = 0;
-      std::sort(out.begin(), out.end());
-      return out;
-    }
-    out.clear();
-    for (int t = lo * tiles_x_; t < (hi + 1) * tiles_x_; ++t)
-      if (tile_mark_[static_cast<std::size_t>(t)]) out.push_back(t), tile_mark_[t] = 0;
+    for (int t : out) tile_mark_[static_cast<std::size_t>(t)] = 0;
+    std::sort(out.begin(), out.end());
     return out;
   }
   void activate(int x, int y) {
     active_[static_cast<std::size_t>(y) * w_ + x] = 1;
     tile_active_[static_cast<std::size_t>(y / kTile) * tiles_x_ + x / kTile] = 1;
+  }
+  void set_active_tiles(std::vector<int> tiles) {
+    active_tiles_ = std::move(tiles);
+    active_runs_ = runs_of(active_tiles_, tiles_x_);
   }
   std::vector<int> tiles_where_active() const {
     std::vector<int> out;
@@ -544,9 +619,7 @@ class SnowPasses {
   }
   // The tiles with active cells after a pass; clears the pass's marks.
   std::vector<int> next_active(const std::vector<int>& was_active) {
-    std::vector<int> touched;
-    for (int t : near_)
-      if (tile_touched_[static_cast<std::size_t>(t)]) touched.push_back(t);
+    const std::vector<int>& touched = touched_tiles_;
     const std::vector<int> candidates = with_neighbours(touched);
     for (int t : candidates) tile_mark_[static_cast<std::size_t>(t)] = 1;
     for (int t : was_active)
@@ -556,10 +629,14 @@ class SnowPasses {
     for_runs(runs_of(candidates, tiles_x_), candidates.size(), [&](const TileRun& r) {
       for_run_cells(
           r, [&](std::size_t i0, std::size_t i1) { rows_(Phase::NextActive, c, i0, i1); },
-          [&](std::size_t i, unsigned in) { c.set_active(i, c.next_active<false>(i, in)); });
-      for (int tx = r.tx0; tx < r.tx1; ++tx)
-        tile_active_[static_cast<std::size_t>(r.ty) * tiles_x_ + tx] =
-            any_in_tile(active_, tx, r.ty);
+          [&](std::size_t i, unsigned in) { c.active[i] = c.next_active<false>(i, in); });
+      for (int tx = r.tx0; tx < r.tx1; ++tx) {
+        const int t = r.ty * tiles_x_ + tx;
+        tile_active_[static_cast<std::size_t>(t)] = any_in_tile(active_, tx, r.ty);
+        // A tile that stops gives nothing; in one that goes on, phase 1 marks
+        // the cells that stopped.
+        if (!tile_active_[static_cast<std::size_t>(t)]) fill_tile(give_, t, kNotGiving);
+      }
     });
     for_list(touched, [&](int t) {
       fill_tile(touched_, t, std::uint8_t{0});
@@ -580,8 +657,10 @@ class SnowPasses {
   int blocks_x_ = 0;
   std::vector<std::uint8_t> block_mark_;  // active_share's scratch
   std::vector<int> active_tiles_;
+  std::vector<TileRun> active_runs_;  // the same as runs
   int passes_ = 0;
-  std::vector<int> near_;  // this pass: active tiles and their neighbours
+  std::vector<int> near_;           // this pass: active tiles and their neighbours
+  std::vector<int> touched_tiles_;  // this pass: tiles where a cell gave or took
 };
 
 // Passes, and the shortcut each time they reach their slow tail, until they
