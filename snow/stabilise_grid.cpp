@@ -189,8 +189,8 @@ template <class T>
 
 // The per-cell rules of a pass: terrain/slope_relax's HalfSteepest passes for
 // snow on ground (one rule, floor 0, no ceiling), the same operations in the
-// same order, so the same bits. T: double for one cell, Lanes for four cells
-// of a row whose 8 neighbours are all inside. kAllInside: no edge tests;
+// same order, so the same bits. T: double for one cell, lanes for several
+// cells of a row whose 8 neighbours are all inside. kAllInside: no edge tests;
 // otherwise `inside` has a bit per neighbour and the missing ones are skipped.
 // Every sum adds 0.0 for a neighbour that does not count and every choice is
 // made after both sides are computed, which keeps the bits of skipping (a sum
@@ -205,7 +205,7 @@ struct PassCells {
   // not from its flag: fewer loads).
   double* give;
   double* take;   // phase 2: the share of its offers a taker takes
-  double* delta;  // phase 3: taken - given
+  double* delta;  // phase 2: what a taker takes; phase 3: taken - given
   std::uint8_t* active;
   std::uint8_t* touched;
   std::array<std::ptrdiff_t, 8> offset;
