@@ -1,7 +1,8 @@
 #include "snow/stabilise_cells.h"
 
-#include <cstdlib>
 #include <cstring>
+
+#include "terrain/simd.h"
 
 namespace drift::snow::kernel {
 
@@ -57,21 +58,26 @@ template <class Lanes>
   }
 }
 // The row kernels built for any x86-64 (SSE2) and for AVX2 (no FMA: each
-// product is rounded on its own, as in the scalar path). The AVX2 build is
-// used where the CPU has it, unless DRIFT_NO_AVX2 is set (the tests compare
-// the two builds' bits).
+// product is rounded on its own, as in the scalar path), picked by
+// terrain/simd.h as every hot loop's twins are (DRIFT_SIMD=sse2 or a
+// simd::Limit forces the first; the tests compare the two builds' bits).
 void rows_baseline(Phase phase, const PassCells& c, std::size_t i0, std::size_t i1) {
   run_row<Lanes2>(phase, c, i0, i1);
 }
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define DRIFT_STABILISE_AVX2 1
 __attribute__((target("avx2"))) void rows_avx2(Phase phase, const PassCells& c, std::size_t i0,
                                                std::size_t i1) {
   run_row<Lanes4>(phase, c, i0, i1);
 }
+#endif
 }  // namespace
 
 RowKernel row_kernel() {
-  const bool avx2 = __builtin_cpu_supports("avx2") && std::getenv("DRIFT_NO_AVX2") == nullptr;
-  return avx2 ? rows_avx2 : rows_baseline;
+#ifdef DRIFT_STABILISE_AVX2
+  if (simd::active() == simd::Isa::Avx2) return rows_avx2;
+#endif
+  return rows_baseline;
 }
 
 }  // namespace drift::snow::kernel

@@ -149,9 +149,9 @@ struct PassCells {
 enum class Phase { Give, Take, Change, Apply, NextActive };
 // Runs `phase` on cells [i0, i1) of one row, all with 8 neighbours inside.
 using RowKernel = void (*)(Phase, const PassCells&, std::size_t, std::size_t);
-// The row kernels built for AVX2 where the CPU has it, unless the environment
-// sets DRIFT_NO_AVX2 (the tests compare the two builds' bits); else those built
-// for any x86-64 (SSE2).
+// The row kernels built for AVX2 where terrain/simd.h says the CPU runs it
+// (the tests compare the two builds' bits); else those built for any x86-64
+// (SSE2).
 RowKernel row_kernel();
 
 }  // namespace drift::snow::kernel

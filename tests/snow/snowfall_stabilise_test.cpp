@@ -18,6 +18,7 @@
 #include "snow/stabilise_grid.h"
 #include "snow/stabilise_levels.h"
 #include "snow/stabilise_mesh.h"
+#include "terrain/simd.h"
 #include "terrain/slope_relax.h"
 #include "tests/dem_fixture.h"
 
@@ -26,6 +27,7 @@ namespace {
 using drift::snow::max_repose_excess;
 using drift::snow::stabilise_grid;
 using drift::snow::StabiliseOptions;
+using drift::snow::StabiliseReport;
 using drift::terrain::Grid;
 
 double total(const Grid<double>& g) {
@@ -277,16 +279,20 @@ TEST(SnowfallStabilise, SameBitsAsTheSharedSlopeRelaxation) {
 }
 
 // The kernel's row loops are built twice, for any x86-64 (2 lanes, SSE2) and
-// for AVX2 (4 lanes), and the CPU picks one; DRIFT_NO_AVX2 forces the first.
-// Both must give the same passes and bits (no FMA, the same operations per lane).
+// for AVX2 (4 lanes), and terrain/simd.h picks one; a simd::Limit forces the
+// first. Both must give the same passes and bits (no FMA, the same operations
+// per lane).
 TEST(SnowfallStabilise, SameBitsWithAndWithoutAvx2) {
-  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU: one build only";
+  if (drift::simd::active() != drift::simd::Isa::Avx2)
+    GTEST_SKIP() << "no AVX2 on this CPU (or DRIFT_SIMD=sse2): one build only";
   const MixedField f;
   Grid<double> avx2 = f.snow, baseline = f.snow;
   const auto a = stabilise_grid(f.ground, avx2, 1.0, 0.8, passes_alone());
-  ASSERT_EQ(setenv("DRIFT_NO_AVX2", "1", 1), 0);
-  const auto b = stabilise_grid(f.ground, baseline, 1.0, 0.8, passes_alone());
-  unsetenv("DRIFT_NO_AVX2");
+  StabiliseReport b;
+  {
+    const drift::simd::Limit sse2(drift::simd::Isa::Sse2);
+    b = stabilise_grid(f.ground, baseline, 1.0, 0.8, passes_alone());
+  }
   EXPECT_GT(a.iterations, 100);
   EXPECT_EQ(a.iterations, b.iterations);
   EXPECT_EQ(avx2.values(), baseline.values());
