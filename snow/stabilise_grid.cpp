@@ -437,9 +437,10 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
     throw Error("the angle of repose of snow must lie in (0, 90) degrees");
   if (ground.width() != snow.width() || ground.height() != snow.height())
     throw Error("stabilise_grid: the ground and the snow grids differ in size");
-  // The passes' workspace, and the shortcut's: envelope, loose snow, resting
-  // cell and load (doubles and indices), marks, and a queue entry a cell at worst.
-  const std::uint64_t shortcut_bytes = 4 * sizeof(double) + 1 + 16;
+  // The passes' workspace, and the shortcut's: envelope (then load), loose
+  // snow (kept for the cut cells, a grid's worth at worst) and resting cell
+  // (doubles and indices), marks, and a queue entry a cell at worst.
+  const std::uint64_t shortcut_bytes = 3 * sizeof(double) + 1 + 16;
   // The coarse levels' grids (ground, snow, its copy and change: 28 bytes a
   // coarse cell, 7 a fine one; the levels below a quarter of that) are freed
   // before the finer level's workspace is made; counted on top as a margin.

@@ -121,14 +121,15 @@ std::size_t next_down(const SnowSurface& s, std::size_t i, bool cut) {
   return moves ? next : kNone;
 }
 
-// The cell where snow set loose at i comes to rest, memoised along the path.
-std::size_t resting_cell(const SnowSurface& s, std::size_t i, const std::vector<double>& loose,
+// The cell where snow set loose at i comes to rest, memoised along the path;
+// `cut` marks the cells the envelope cut (snow runs on down a cut surface).
+std::size_t resting_cell(const SnowSurface& s, std::size_t i, const std::vector<std::uint8_t>& cut,
                          std::vector<std::size_t>& rest, std::vector<std::size_t>& path) {
   path.clear();
   std::size_t c = i;
   while (rest[c] == kNone) {
     path.push_back(c);
-    const std::size_t next = next_down(s, c, loose[c] > 0.0);
+    const std::size_t next = next_down(s, c, cut[c] != 0);
     if (next == kNone) {
       rest[c] = c;
       break;
@@ -198,26 +199,33 @@ std::vector<std::size_t> settle_unsupported(const terrain::Grid<float>& ground,
                                             terrain::Grid<double>& snow,
                                             const SettleGeometry& geometry) {
   const SnowSurface s(ground, snow, geometry);
-  const std::vector<double> envelope = repose_envelope(s);
+  // The envelope's array holds each resting cell's load once the cut is made
+  // (a grid of doubles fewer: 128 MiB at 4096^2); the loose snow is kept for
+  // the cut cells only, and a byte a cell says which they are.
+  std::vector<double> envelope_then_load = repose_envelope(s);
   std::vector<std::size_t> changed;
-  std::vector<double> loose(s.cells(), 0.0);
+  std::vector<double> loose;
+  std::vector<std::uint8_t> cut(s.cells(), 0);
   for (std::size_t i = 0; i < s.cells(); ++i) {
-    if (!(envelope[i] < s.surface(i))) continue;
+    if (!(envelope_then_load[i] < s.surface(i))) continue;
     const double before = s.snow(i);
-    s.snow(i) = std::max(envelope[i] - s.ground(i), 0.0);
-    loose[i] = before - s.snow(i);
+    s.snow(i) = std::max(envelope_then_load[i] - s.ground(i), 0.0);
+    loose.push_back(before - s.snow(i));
+    cut[i] = loose.back() > 0.0;
     changed.push_back(i);
   }
+  std::vector<double>& load = envelope_then_load;
+  std::fill(load.begin(), load.end(), 0.0);
   std::vector<std::size_t> rest(s.cells(), kNone), path, heaps;
-  std::vector<double> load(s.cells(), 0.0);
-  std::vector<std::uint8_t> seen(s.cells(), 0);  // here: cells already listed as heaps
-  for (std::size_t i : changed) {
-    const std::size_t r = resting_cell(s, i, loose, rest, path);
-    if (!seen[r]) seen[r] = 1, heaps.push_back(r);
-    load[r] += loose[i];
+  for (std::size_t k = 0; k < changed.size(); ++k) {
+    const std::size_t r = resting_cell(s, changed[k], cut, rest, path);
+    heaps.push_back(r);
+    load[r] += loose[k];
   }
-  for (std::size_t p : heaps) seen[p] = 0;
   std::sort(heaps.begin(), heaps.end());
+  heaps.erase(std::unique(heaps.begin(), heaps.end()), heaps.end());
+  std::vector<std::uint8_t>& seen = cut;  // from here: heap_at's marks, all clear
+  std::fill(seen.begin(), seen.end(), std::uint8_t{0});
   for (std::size_t p : heaps) heap_at(s, p, load[p], seen, changed);
   std::sort(changed.begin(), changed.end());
   changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
