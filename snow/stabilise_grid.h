@@ -62,9 +62,10 @@ struct StabiliseOptions {
   // The coarse-to-fine start (snow/stabilise_levels.h): the field settled
   // first on this many levels of 2 x 2 blocks (fewer where a level would be
   // smaller than 32 cells a side); 0: the passes on the grid alone. Faster
-  // (benchmark field, one level: 2.8 x at 1024^2) with piles at repose as the
-  // passes leave them, but not the default: the state is a few cm from the
-  // passes' own (one level: RMS 2.3 cm at 1024^2), see docs/snowfall.md.
+  // (benchmark field, one level: 2.4 x at 1024^2 and 4096^2) with piles at
+  // repose as the passes leave them, but not the default: the state is a few
+  // cm from the passes' own (one level: RMS 2.3 cm at 1024^2), see
+  // docs/snowfall.md.
   int coarse_levels = 0;
 };
 
