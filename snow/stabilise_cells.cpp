@@ -64,8 +64,7 @@ template <class Lanes>
 void rows_baseline(Phase phase, const PassCells& c, std::size_t i0, std::size_t i1) {
   run_row<Lanes2>(phase, c, i0, i1);
 }
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define DRIFT_STABILISE_AVX2 1
+#ifdef DRIFT_SIMD_X86
 __attribute__((target("avx2"))) void rows_avx2(Phase phase, const PassCells& c, std::size_t i0,
                                                std::size_t i1) {
   run_row<Lanes4>(phase, c, i0, i1);
@@ -74,7 +73,7 @@ __attribute__((target("avx2"))) void rows_avx2(Phase phase, const PassCells& c, 
 }  // namespace
 
 RowKernel row_kernel() {
-#ifdef DRIFT_STABILISE_AVX2
+#ifdef DRIFT_SIMD_X86
   if (simd::active() == simd::Isa::Avx2) return rows_avx2;
 #endif
   return rows_baseline;

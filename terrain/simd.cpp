@@ -9,7 +9,7 @@ namespace drift::simd {
 namespace {
 
 Isa detect() {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#ifdef DRIFT_SIMD_X86
   const char* forced = std::getenv("DRIFT_SIMD");
   if (forced && std::strcmp(forced, "sse2") == 0) return Isa::Sse2;
   __builtin_cpu_init();

@@ -5,9 +5,15 @@
 // AVX2 (DRIFT_SIMD_TWINS below) and dispatched by the CPU it runs on. Both
 // compilations must do the same IEEE operations lane by lane: elementwise
 // float arithmetic without FMA (AVX2 alone does not enable FMA, and modules
-// with twins build with -ffp-contract=off), no reassociated reductions. Then
-// the bits are the same on any machine; tests check this by running both.
+// with twins link drift_simd_twins, which builds them with -ffp-contract=off),
+// no reassociated reductions. Then the bits are the same on any machine;
+// tests check this by running both.
 #pragma once
+
+// Defined where a loop can have an AVX2 twin (x86-64 with GCC or Clang).
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define DRIFT_SIMD_X86 1
+#endif
 
 namespace drift::simd {
 
@@ -42,7 +48,7 @@ class Limit {
 // give the kernel `__restrict` pointer parameters and write the loop in the
 // kernel itself, not in a function or lambda it calls (restrict does not
 // survive a second level of inlining or a capture by reference).
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#ifdef DRIFT_SIMD_X86
 #define DRIFT_SIMD_TWINS(name, kernel, params, args)               \
   [[gnu::target("avx2")]] void name##_avx2 params { kernel args; } \
   void name##_sse2 params { kernel args; }                         \
