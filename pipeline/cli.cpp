@@ -3,8 +3,10 @@
 #include <tbb/global_control.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 
 #include "terrain/parameter.h"
@@ -49,9 +51,9 @@ CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::s
                          std::function<void()> run) {
   CLI::App* sub = parent.add_subcommand(name, description);
   auto threads = std::make_shared<int>(0);
-  sub->add_option("--threads", *threads,
-                  "worker threads (0 = all cores); results do not depend on it")
-      ->check(CLI::Range(0, 4096));
+  whole_in_range(sub->add_option("--threads", *threads,
+                                 "worker threads (0 = all cores); results do not depend on it"),
+                 0, 4096);
   sub->callback([sub, threads, run = std::move(run)] {
     require_finite_numbers(*sub);
     require_nonempty_values(*sub);
@@ -86,7 +88,19 @@ CLI::App& command_group(CLI::App& root, const std::string& name, const std::stri
 }
 
 void add_seed_option(CLI::App& sub, unsigned long long& seed) {
+  // CLI11 reads "-1", "2^64" and "1e23" all as 2^64 - 1 without a word: a seed
+  // is the digits of a number below 2^64, nothing else.
+  const auto seed_problem = [](const std::string& text) -> std::string {
+    const std::string max = std::to_string(std::numeric_limits<unsigned long long>::max());
+    if (!whole_number(text).empty()) return "must be a whole number 0.." + max;
+    const std::string digits = text.substr(std::min(text.find_first_not_of('0'), text.size()));
+    if (digits.size() > max.size() || (digits.size() == max.size() && digits > max)) {
+      return "'" + text + "' is larger than " + max;
+    }
+    return {};
+  };
   sub.add_option("--seed", seed, "random seed; the same seed gives the same bits")
+      ->check(CLI::Validator(seed_problem, "SEED"))
       ->capture_default_str();
 }
 
@@ -109,6 +123,15 @@ std::string whole_number(const std::string& text) {
   return !text.empty() && text.find_first_not_of("0123456789") == std::string::npos
              ? std::string()
              : std::string("must be a whole number");
+}
+
+CLI::Option* whole_in_range(CLI::Option* option, long long lo, long long hi) {
+  // An optional leading minus for ranges that allow negative values.
+  const auto whole = [lo](const std::string& text) {
+    const bool negative = lo < 0 && !text.empty() && text[0] == '-';
+    return whole_number(negative ? text.substr(1) : text);
+  };
+  return option->check(CLI::Validator(whole, "WHOLE"))->check(CLI::Range(lo, hi));
 }
 
 void usage_error(const std::string& message) { throw CLI::ValidationError(message); }

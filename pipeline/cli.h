@@ -15,7 +15,8 @@
 
 namespace CLI {
 class App;
-}
+class Option;
+}  // namespace CLI
 
 namespace drift::pipeline {
 
@@ -48,6 +49,10 @@ void validate_flags(const std::function<void()>& validate, const FlagNames& flag
 // A CLI11 check for the integer rows of a parameter table: "" for a whole
 // number (digits only), else the problem.
 std::string whole_number(const std::string& text);
+
+// Checks an integer option as a whole number first ("1e3" says "must be a whole
+// number", not "not in range"), then within [lo, hi]. Returns `option`.
+CLI::Option* whole_in_range(CLI::Option* option, long long lo, long long hi);
 
 // Throws a usage error (exit 2) with `message`, e.g. for incompatible options.
 [[noreturn]] void usage_error(const std::string& message);

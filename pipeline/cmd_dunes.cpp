@@ -103,9 +103,9 @@ void add_dunes_command(CLI::App& root) {
     CLI::Option* opt = sub->add_option(p.flag, c->values[i], parameter_help(p));
     if (p.integer) opt->check(CLI::Validator(whole_number, "WHOLE"));
   }
-  sub->add_option("--snapshot-every", c->snapshot_every,
-                  "also write OUT_<step>.tif every K steps (for animations)")
-      ->check(CLI::Range(1, 10000000));
+  whole_in_range(sub->add_option("--snapshot-every", c->snapshot_every,
+                                 "also write OUT_<step>.tif every K steps (for animations)"),
+                 1, 10000000);
   add_seed_option(*sub, c->seed);
 }
 

@@ -71,16 +71,20 @@ void print_exposure(const render::Image& image, const render::DisplayTransform& 
 // --size WIDTHxHEIGHT into the settings.
 void apply_size(const std::string& size, render::RenderSettings& settings) {
   std::smatch m;
-  if (!std::regex_match(size, m, std::regex(R"((\d{1,5})x(\d{1,5}))"))) {
+  if (!std::regex_match(size, m, std::regex(R"((\d+)x(\d+))"))) {
     usage_error("--size '" + size + "' must be WIDTHxHEIGHT, e.g. 1280x720");
   }
-  settings.width = std::stoi(m[1]);
-  settings.height = std::stoi(m[2]);
+  // Well formed but too large ("100000x100000") says so, not "must be WIDTHxHEIGHT".
   constexpr int kMax = render::RenderSettings::kMaxSide;
-  if (settings.width < 1 || settings.height < 1 || settings.width > kMax ||
-      settings.height > kMax) {
-    usage_error("--size '" + size + "': each side must be 1.." + std::to_string(kMax));
-  }
+  const auto side = [&](const std::string& digits) {
+    const int value = digits.size() > 6 ? kMax + 1 : std::stoi(digits);
+    if (value < 1 || value > kMax) {
+      usage_error("--size '" + size + "': each side must be 1.." + std::to_string(kMax));
+    }
+    return value;
+  };
+  settings.width = side(m[1]);
+  settings.height = side(m[2]);
 }
 
 // The stages' product-file flags over their sections' keys; a section that
@@ -243,8 +247,8 @@ void add_render_command(CLI::App& root) {
   CLI::App* sub = add_subcommand(root, "render", "path-trace a scene file (TOML) to EXR and/or PNG",
                                  [o](const CLI::App& self) { run_render(*o, self); });
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
-  sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)")
-      ->check(CLI::Range(1, render::RenderSettings::kMaxSamplesPerPixel));
+  whole_in_range(sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)"), 1,
+                 render::RenderSettings::kMaxSamplesPerPixel);
   sub->add_option("--noise-target", o->noise_target,
                   "adaptive sampling: stop a pixel when the relative standard error of its "
                   "luminance is below this (e.g. 0.02; 0 turns it off; --spp is the most)")

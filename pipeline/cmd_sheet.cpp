@@ -65,11 +65,10 @@ void add_sheet_command(CLI::App& root) {
   sub->add_option("--columns", o->columns, "images per row (default: about square)")
       ->check(CLI::PositiveNumber);
   sub->add_option("--title", o->title, "title above the grid");
-  sub->add_option("--font-size", o->font_size, "label size in pixels, 6..128")
-      ->check(CLI::Range(6, 128))
+  whole_in_range(sub->add_option("--font-size", o->font_size, "label size in pixels, 6..128"), 6,
+                 128)
       ->capture_default_str();
-  sub->add_option("--padding", o->padding, "pixels between cells, 0..256")
-      ->check(CLI::Range(0, 256))
+  whole_in_range(sub->add_option("--padding", o->padding, "pixels between cells, 0..256"), 0, 256)
       ->capture_default_str();
   sub->add_option("--font", o->font, "TrueType font file (default DejaVu Sans)");
   sub->add_option("--tone", o->tone, "tone curve for linear EXR inputs: clamp | filmic")

@@ -4,14 +4,22 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "pipeline/cli.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 #include "terrain/temp_registry.h"
 
 int main(int argc, char** argv) try {
-  // SIGINT, SIGTERM, SIGHUP: remove temporary files, exit 130, 143, 129.
+  // SIGINT, SIGTERM, SIGHUP and every other signal that would end the process
+  // from outside: remove temporary files, exit 128 + the signal (temp_registry.h).
   drift::install_signal_cleanup();
+  // A malformed DRIFT_MEMORY_LIMIT is refused before any work, as a usage error.
+  if (const std::string problem = drift::memory_limit_problem(); !problem.empty()) {
+    std::fprintf(stderr, "drift: usage error: %s\n", problem.c_str());
+    return 2;
+  }
   CLI::App app{"Driftscape: natural ground from real elevation data, rendered.", "drift"};
   app.set_version_flag("--version", "drift 0.1.0");
   app.require_subcommand(1);

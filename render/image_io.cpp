@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <fstream>
 #include <memory>
+#include <vector>
 
 #include "render/auto_exposure.h"
 #include "render/exr_header.h"
@@ -37,7 +38,11 @@ std::string oiio_message(const std::string& detail) {
 
 // Opens `path` for writing as `spec`, writes float pixels and closes; any
 // failure (including a failed close, which is where buffered formats flush)
-// throws naming the target.
+// throws naming the target. The file is encoded in memory and written with every
+// write checked, because OpenImageIO reports no failed flush: on a full disk its
+// PNG and EXR writers left an empty or truncated file and exit status 0. The
+// encoded bytes are at most about the pixels' own size, which the callers have
+// checked against memory already.
 void write_with_oiio(const std::filesystem::path& target, const std::filesystem::path& temp,
                      const OIIO::ImageSpec& spec, const OIIO::TypeDesc& pixel_type,
                      const void* data) {
@@ -45,10 +50,16 @@ void write_with_oiio(const std::filesystem::path& target, const std::filesystem:
   if (!out) {
     throw Error("cannot write image " + target.string() + ": " + oiio_message(OIIO::geterror()));
   }
+  std::vector<unsigned char> encoded;
+  OIIO::Filesystem::IOVecOutput proxy(encoded);
+  if (!out->supports("ioproxy") || !out->set_ioproxy(&proxy)) {
+    throw Error("internal: cannot encode " + target.string() + " in memory");
+  }
   if (!out->open(temp.string(), spec) || !out->write_image(pixel_type, data) || !out->close()) {
     throw Error("cannot write image " + target.string() + ": " + oiio_message(out->geterror()) +
                 " (check the disk space and that the folder is writable)");
   }
+  write_all_bytes(temp, encoded.data(), encoded.size(), target);
 }
 
 // Linear data as stored, channel names kept (EXR names AOVs "albedo.R" etc.),

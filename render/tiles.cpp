@@ -24,7 +24,13 @@ std::pair<int, int> parse_tile(const std::string& text) {
   if (!std::regex_match(text, m, std::regex(R"((\d{1,6})/(\d{1,6}))"))) {
     throw Error("tile '" + text + "' must be INDEX/COUNT with a 0-based index, e.g. 0/8");
   }
-  return {std::stoi(m[1]), std::stoi(m[2])};
+  const int index = std::stoi(m[1]), count = std::stoi(m[2]);
+  // A tile that cannot exist in any frame is as much a usage error as "-1/3".
+  if (count < 1 || index >= count) {
+    throw Error("tile '" + text + "' does not exist: the index counts from 0 to COUNT - 1, e.g. " +
+                std::to_string(std::max(count, 1) - 1) + "/" + std::to_string(std::max(count, 1)));
+  }
+  return {index, count};
 }
 
 namespace {

@@ -20,7 +20,7 @@ struct RowRange {
 // Throws drift::Error unless 0 <= index < count <= height.
 RowRange tile_rows(int height, int index, int count);
 
-// Parses "i/n" (0-based i); throws drift::Error naming the text and the fix.
+// Parses "i/n" (0 <= i < n); throws drift::Error naming the text and the fix.
 std::pair<int, int> parse_tile(const std::string& text);
 
 // Joins tiles into the whole frame. Every row must be covered exactly once and

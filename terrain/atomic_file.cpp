@@ -1,5 +1,10 @@
 #include "terrain/atomic_file.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <system_error>
 
 #include "terrain/error.h"
@@ -58,6 +63,35 @@ void AtomicFile::commit() {
   committed_ = true;
   forget_temp(slot_);
   slot_ = -1;
+}
+
+void write_all_bytes(const fs::path& temp, const void* data, std::size_t size,
+                     const fs::path& target) {
+  const auto fail = [&](int error) {
+    throw Error("cannot write '" + target.string() + "': " + std::strerror(error) +
+                " (the existing file, if any, is left as it was)");
+  };
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (fd < 0) fail(errno);
+  const char* bytes = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, bytes, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : ENOSPC;
+      ::close(fd);
+      fail(error);
+    }
+    bytes += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  // A network or quota file system may report a failure only here.
+  if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+    const int error = errno;
+    ::close(fd);
+    fail(error);
+  }
+  if (::close(fd) != 0) fail(errno);
 }
 
 }  // namespace drift

@@ -6,6 +6,7 @@
 // is used and the set renames all its outputs together.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 
 namespace drift {
@@ -35,5 +36,13 @@ class AtomicFile {
   bool staged_ = false;  // the temporary file belongs to an OutputSet
   bool committed_ = false;
 };
+
+// Writes `size` bytes to `temp` (an AtomicFile's temporary file), checking
+// every write, the flush and the close; throws drift::Error naming `target` and
+// the system's reason ("No space left on device"). For writers whose library
+// does not report a failed flush (OpenImageIO's PNG, OpenVDB's streams): they
+// encode into memory and this writes the bytes.
+void write_all_bytes(const std::filesystem::path& temp, const void* data, std::size_t size,
+                     const std::filesystem::path& target);
 
 }  // namespace drift

@@ -1,6 +1,7 @@
 #include "terrain/memory.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -43,19 +44,60 @@ std::uint64_t cgroup_limit() {
 
 }  // namespace
 
-// DRIFT_MEMORY_LIMIT caps what a run may use (bytes, or with K, M, G suffix),
-// e.g. for batch jobs sharing a machine, and for the fuzz targets.
-std::uint64_t user_limit() {
+// DRIFT_MEMORY_LIMIT caps what a run may use (docs/outputs.md), e.g. for batch
+// jobs sharing a machine, and for the fuzz targets.
+// An empty value, as an unset shell variable gives, means no cap.
+static std::uint64_t user_limit() {
   const char* text = std::getenv("DRIFT_MEMORY_LIMIT");
   if (!text || !*text) return std::numeric_limits<std::uint64_t>::max();
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  const double scale = *end == 'K' || *end == 'k'   ? 1024.0
-                       : *end == 'M' || *end == 'm' ? 1024.0 * 1024.0
-                       : *end == 'G' || *end == 'g' ? 1024.0 * 1024.0 * 1024.0
-                                                    : 1.0;
-  if (!(v > 0) || !std::isfinite(v * scale)) return std::numeric_limits<std::uint64_t>::max();
-  return static_cast<std::uint64_t>(std::min(v * scale, 1.8e19));
+  const std::optional<std::uint64_t> bytes = parse_byte_size(text);
+  if (!bytes) throw Error(memory_limit_problem());
+  return *bytes;
+}
+
+std::optional<std::uint64_t> parse_byte_size(std::string_view text) {
+  // Digits with at most one decimal point: no sign, exponent, hex, inf or nan,
+  // which strtod would accept.
+  std::size_t i = 0;
+  bool digits = false, point = false;
+  for (; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c >= '0' && c <= '9') {
+      digits = true;
+    } else if (c == '.' && !point) {
+      point = true;
+    } else {
+      break;
+    }
+  }
+  if (!digits) return std::nullopt;
+  const std::string number(text.substr(0, i));
+  std::string_view unit = text.substr(i);
+  double scale = 1.0;
+  if (!unit.empty()) {
+    const std::string_view prefixes = "KMGT";
+    const std::size_t p = prefixes.find(static_cast<char>(std::toupper(unit[0])));
+    if (p != std::string_view::npos) {
+      scale = std::pow(1024.0, static_cast<double>(p + 1));
+      unit.remove_prefix(1);
+      if (unit == "iB" || unit == "ib" || unit == "B" || unit == "b") unit = {};
+    } else if (unit == "B" || unit == "b") {
+      unit = {};
+    }
+  }
+  if (!unit.empty()) return std::nullopt;
+  const double bytes = std::strtod(number.c_str(), nullptr) * scale;
+  // Below 2^64 (16 EiB) and at least one byte.
+  if (!(bytes >= 1.0) || !(bytes < 18446744073709551616.0)) return std::nullopt;
+  return static_cast<std::uint64_t>(bytes);
+}
+
+std::string memory_limit_problem() {
+  const char* text = std::getenv("DRIFT_MEMORY_LIMIT");
+  if (!text || !*text || parse_byte_size(text)) return {};
+  return std::string("DRIFT_MEMORY_LIMIT is '") + text +
+         "', which is not a memory size; give bytes or a number with K, M, G or T (optionally "
+         "followed by iB), e.g. DRIFT_MEMORY_LIMIT=8G, or unset it for no cap";
 }
 
 std::uint64_t available_memory_bytes() {

@@ -4,7 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 
 namespace drift {
 
@@ -16,5 +18,19 @@ std::uint64_t available_memory_bytes();
 void require_memory(std::uint64_t bytes, const std::string& what, const std::string& fix);
 
 std::string human_bytes(std::uint64_t bytes);
+
+// The documented forms of a size such as DRIFT_MEMORY_LIMIT: a whole or decimal
+// number of bytes, optionally followed by K, M, G or T (powers of 1024), with or
+// without "iB" or "B" ("512M", "8GiB", "1.5T", "4096"), no spaces, more than 0
+// and below 16 EiB. Returns the bytes, or nothing for anything else ("8 G", "1X",
+// "abc", "0", "-5", "nan", "1e3").
+std::optional<std::uint64_t> parse_byte_size(std::string_view text);
+
+// Checks DRIFT_MEMORY_LIMIT once: "" if it is unset or well formed, else the
+// message naming the variable, its value and the accepted forms. The command line
+// calls it before anything else and exits 2 on a message; available_memory_bytes()
+// throws drift::Error with the same message, so no caller reads a bad value as
+// "no cap".
+std::string memory_limit_problem();
 
 }  // namespace drift

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -16,6 +17,7 @@
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
 #include "terrain/input_path.h"
+#include "terrain/memory.h"
 
 namespace drift::terrain {
 
@@ -23,21 +25,68 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// tinyobjloader reads "v nan 0 0" (or "v 1e999 ...") as a finite vertex without
-// a word: every vertex line is checked here first, naming the line.
-void require_finite_obj_vertices(const fs::path& path) {
-  std::ifstream in(path);
+// The most vertices one OBJ face may have. tinyobjloader's ear clipping is
+// quadratic in a face's vertices (one face of 40,000 took 10 s, of 200,000 over a
+// minute); at this bound a face costs at most a few milliseconds, so reading time
+// stays proportional to the file's size.
+constexpr std::size_t kMaxFaceVertices = 1024;
+
+// A vertex coordinate as tinyobjloader would read it correctly: a plain decimal
+// number (its own parser reads "0x1p+200" as 0 and "nan" as a finite value)
+// that a float holds (1e39 would become infinity).
+bool plain_finite_float(const std::string& word) {
+  if (word.find_first_of("xXnNiI") != std::string::npos) return false;
+  char* end = nullptr;
+  const double v = std::strtod(word.c_str(), &end);
+  return end != word.c_str() && *end == '\0' && std::isfinite(v) &&
+         std::abs(v) <= static_cast<double>(std::numeric_limits<float>::max());
+}
+
+// The whole file, read after the input checks and a memory check on its size,
+// so a device or a FIFO is never opened and no read is unbounded.
+std::string read_obj_text(const fs::path& path) {
+  check_input_file(path, "mesh");
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw Error("cannot read mesh '" + path.string() + "': " + ec.message());
+  require_memory(4 * static_cast<std::uint64_t>(size), "mesh '" + path.string() + "'",
+                 "use a smaller mesh");
+  std::ifstream in(path, std::ios::binary);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  if (!in.read(text.data(), static_cast<std::streamsize>(size))) {
+    throw Error("cannot read mesh '" + path.string() + "' (it changed while being read?)");
+  }
+  return text;
+}
+
+// Checks what tinyobjloader would read silently wrong or slowly, naming the line:
+// vertex coordinates that are not finite plain numbers (with or without leading
+// spaces: "  v nan 0 0" had read as 0) and faces of more than kMaxFaceVertices.
+void check_obj_lines(const std::string& text, const fs::path& path) {
+  std::istringstream lines(text);
   std::string line;
-  for (std::size_t number = 1; std::getline(in, line); ++number) {
-    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
-    std::istringstream words(line.substr(2));
-    std::string word;
-    for (int k = 0; k < 3 && words >> word; ++k) {
-      char* end = nullptr;
-      const double v = std::strtod(word.c_str(), &end);
-      if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
-        throw Error("mesh '" + path.string() + "', line " + std::to_string(number) +
-                    ": vertex coordinate '" + word + "' is not a finite number");
+  for (std::size_t number = 1; std::getline(lines, line); ++number) {
+    std::istringstream words(line);
+    std::string key;
+    if (!(words >> key)) continue;
+    const auto where = [&] {
+      return "mesh '" + path.string() + "', line " + std::to_string(number) + ": ";
+    };
+    if (key == "v") {
+      std::string word;
+      for (int k = 0; k < 3 && words >> word; ++k) {
+        if (!plain_finite_float(word)) {
+          throw Error(where() + "vertex coordinate '" + word +
+                      "' is not a finite decimal number a float can hold");
+        }
+      }
+    } else if (key == "f") {
+      std::size_t corners = 0;
+      for (std::string word; words >> word;) ++corners;
+      if (corners > kMaxFaceVertices) {
+        throw Error(where() + "a face of " + std::to_string(corners) +
+                    " vertices; triangulate it in your modeller before export (at most " +
+                    std::to_string(kMaxFaceVertices) + " vertices a face)");
       }
     }
   }
@@ -46,13 +95,16 @@ void require_finite_obj_vertices(const fs::path& path) {
 }  // namespace
 
 Mesh read_obj(const fs::path& path, bool y_up) {
-  check_input_file(path, "mesh");
-  require_finite_obj_vertices(path);
+  const std::string text = read_obj_text(path);
+  check_obj_lines(text, path);
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path.string(), config)) {
+  // From memory, with no material text: a `mtllib` line names a file that
+  // tinyobjloader would otherwise open unchecked (/dev/zero, a FIFO), and the
+  // ground and renderer take no materials from an OBJ.
+  if (!reader.ParseFromString(text, "", config)) {
     throw Error("cannot read mesh '" + path.string() + "': " + reader.Error() +
                 " (is it a Wavefront OBJ file?)");
   }

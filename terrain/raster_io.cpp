@@ -2,13 +2,18 @@
 
 #include <cpl_conv.h>
 #include <cpl_error.h>
+#include <cpl_minixml.h>
+#include <cpl_string.h>
 #include <gdal_priv.h>
 
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <mutex>
+#include <string>
+#include <string_view>
 #include <system_error>
+#include <vector>
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
@@ -35,9 +40,51 @@ struct DatasetCloser {
 };
 using DatasetPtr = std::unique_ptr<GDALDataset, DatasetCloser>;
 
+// A VRT names other rasters (its sources, and VRTs in turn): they are inputs
+// too, checked as the VRT is before GDAL opens any of them, so a source that is
+// a FIFO or a device cannot block or feed a run for ever (`drift info` had
+// blocked on a VRT whose source was a FIFO). Paths through GDAL's virtual file
+// systems (/vsizip/, /vsicurl/, ...) are GDAL's to check, but for /vsistdin/.
+void check_vrt_sources(const fs::path& path, int depth = 0) {
+  char head[16] = {};
+  if (std::FILE* f = std::fopen(path.c_str(), "rb")) {
+    const std::size_t n = std::fread(head, 1, sizeof head - 1, f);
+    std::fclose(f);
+    head[n] = '\0';
+  }
+  if (std::string_view(head).find("<VRTDataset") == std::string_view::npos) return;
+  if (depth > 8) {
+    throw Error("cannot read raster '" + path.string() +
+                "': VRTs nested more than 8 deep (a VRT naming itself?)");
+  }
+  std::unique_ptr<CPLXMLNode, decltype(&CPLDestroyXMLNode)> root(CPLParseXMLFile(path.c_str()),
+                                                                 CPLDestroyXMLNode);
+  if (!root) return;  // GDAL says what is wrong with it when it opens it
+  std::vector<const CPLXMLNode*> stack = {root.get()};
+  while (!stack.empty()) {
+    const CPLXMLNode* node = stack.back();
+    stack.pop_back();
+    for (const CPLXMLNode* child = node->psChild; child; child = child->psNext) {
+      if (child->eType == CXT_Element) stack.push_back(child);
+    }
+    if (node->eType != CXT_Element || !EQUAL(node->pszValue, "SourceFilename")) continue;
+    const std::string name = CPLGetXMLValue(node, nullptr, "");
+    if (name.rfind("/vsistdin", 0) == 0) {
+      throw Error("cannot read raster '" + path.string() + "': its source '" + name +
+                  "' is standard input; give a file");
+    }
+    if (name.empty() || name.rfind("/vsi", 0) == 0) continue;
+    const bool relative = CPLTestBool(CPLGetXMLValue(node, "relativeToVRT", "0"));
+    const fs::path source = relative ? path.parent_path() / name : fs::path(name);
+    check_input_file(source, "source of VRT '" + path.string() + "',");
+    check_vrt_sources(source, depth + 1);
+  }
+}
+
 DatasetPtr open_raster(const fs::path& path) {
   ensure_gdal();
   check_input_file(path, "raster");
+  check_vrt_sources(path);
   g_last_gdal_message.clear();
   auto* ds = static_cast<GDALDataset*>(
       GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr, nullptr));

@@ -28,7 +28,6 @@ struct Slot {
 Slot g_slots[kSlots];
 // Held by DeferSignals; the cleanup takes it before touching any file.
 std::recursive_mutex g_defer;
-std::atomic<int> g_renaming{0};      // > 0 while outputs are being renamed into place
 std::atomic<unsigned> g_renames{0};  // how many renamings have begun
 static_assert(std::atomic<int>::is_always_lock_free, "the cleanup reads these without a lock");
 
@@ -37,14 +36,38 @@ void write_text(const char* s) {
   (void)ignored;
 }
 
+// Every signal whose default action ends the process and that can come from
+// outside it (kill, the terminal, a timer, a resource limit), with its name.
+// The synchronous ones (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, ...) mean a
+// bug and are left to their default action and the sanitizers. SIGPIPE and
+// SIGXFSZ raised by a write of ours stay pending on the writing thread, blocked
+// as they are: the write fails with EPIPE or EFBIG instead, and the writer's
+// error path removes the temporary file and exits 1 with a message.
+struct FatalSignal {
+  int number;
+  const char* name;
+};
+constexpr FatalSignal kFatalSignals[] = {
+    {SIGINT, "SIGINT"},   {SIGTERM, "SIGTERM"}, {SIGHUP, "SIGHUP"},       {SIGQUIT, "SIGQUIT"},
+    {SIGUSR1, "SIGUSR1"}, {SIGUSR2, "SIGUSR2"}, {SIGALRM, "SIGALRM"},     {SIGPIPE, "SIGPIPE"},
+    {SIGXFSZ, "SIGXFSZ"}, {SIGXCPU, "SIGXCPU"}, {SIGVTALRM, "SIGVTALRM"}, {SIGPROF, "SIGPROF"},
+    {SIGIO, "SIGIO"},     {SIGPWR, "SIGPWR"},   {SIGSTKFLT, "SIGSTKFLT"},
+};
+
+const char* signal_name(int sig) {
+  for (const FatalSignal& s : kFatalSignals) {
+    if (s.number == sig) return s.name;
+  }
+  return "a signal";
+}
+
 // Removes every live temporary file, says so in one line and exits 128 + sig.
 [[noreturn]] void clean_up_and_exit(int sig, const char* outcome) {
   for (Slot& slot : g_slots) {
     if (slot.state.load(std::memory_order_acquire) == kLive) unlink(slot.path);
   }
-  const char* name = sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGHUP";
   write_text("drift: interrupted by ");
-  write_text(name);
+  write_text(signal_name(sig));
   write_text(outcome);
   _exit(128 + sig);
 }
@@ -52,9 +75,7 @@ void write_text(const char* s) {
 sigset_t cleanup_signals() {
   sigset_t set;
   sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  sigaddset(&set, SIGHUP);
+  for (const FatalSignal& s : kFatalSignals) sigaddset(&set, s.number);
   return set;
 }
 
@@ -65,14 +86,13 @@ void await_signals(sigset_t set) {
   int sig = 0;
   while (sigwait(&set, &sig) != 0) {
   }
-  // A renaming under way when the signal came, or begun before the lock was
-  // ours, has finished by then: its outputs are all complete.
-  const unsigned renames = g_renames.load();
-  const bool renaming_now = g_renaming.load() > 0;
+  // A renaming under way when the signal came has finished once the lock is
+  // ours. Any renaming at all means some outputs are already in place (a run's
+  // set, frames, snapshots), and the message must not claim otherwise.
   g_defer.lock();
-  const bool renaming = renaming_now || g_renames.load() != renames;
-  clean_up_and_exit(sig, renaming
-                             ? " while the outputs were moved into place; they are all complete\n"
+  clean_up_and_exit(sig, g_renames.load() > 0
+                             ? "; outputs already moved into place are complete, temporary files "
+                               "removed, any other existing outputs left as they were\n"
                              : "; temporary files removed, existing outputs left as they were\n");
 }
 
@@ -130,17 +150,11 @@ void stop_here_for_tests(TestPoint point) {
   }
 }
 
-DeferSignals::DeferSignals(bool renaming) : renaming_(renaming) {
+DeferSignals::DeferSignals(bool renaming) {
   g_defer.lock();
-  if (renaming_) {
-    g_renaming.fetch_add(1);
-    g_renames.fetch_add(1);
-  }
+  if (renaming) g_renames.fetch_add(1);
 }
 
-DeferSignals::~DeferSignals() {
-  if (renaming_) g_renaming.fetch_sub(1);
-  g_defer.unlock();
-}
+DeferSignals::~DeferSignals() { g_defer.unlock(); }
 
 }  // namespace drift

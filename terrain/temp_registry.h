@@ -1,14 +1,17 @@
 // The temporary files a run has open, kept where the signal cleanup can reach
-// them: SIGINT, SIGTERM and SIGHUP remove every one of them, print one line and
-// exit 130, 143 or 129 (128 + the signal), so an interrupted run leaves no
-// temporary file and every existing output as it was.
+// them: every signal whose default action ends the process and that comes from
+// outside it (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM,
+// SIGPIPE, SIGXFSZ, SIGXCPU, SIGVTALRM, SIGPROF, SIGIO, SIGPWR, SIGSTKFLT)
+// removes every one of them, prints one line and exits 128 + the signal (130,
+// 143, 129, ...), so an interrupted run leaves no temporary file and every
+// existing output as it was.
 #pragma once
 
 #include <filesystem>
 
 namespace drift {
 
-// Blocks SIGINT, SIGTERM and SIGHUP in the calling thread (and so in every
+// Blocks those signals in the calling thread (and so in every
 // thread it starts later) and starts one thread that waits for them and does the
 // cleanup (once; the program calls it at start, before any other thread exists).
 // A handler run on whichever thread the kernel picks could not stop the other
@@ -48,9 +51,6 @@ class DeferSignals {
   ~DeferSignals();
   DeferSignals(const DeferSignals&) = delete;
   DeferSignals& operator=(const DeferSignals&) = delete;
-
- private:
-  bool renaming_;
 };
 
 }  // namespace drift

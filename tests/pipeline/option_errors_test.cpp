@@ -57,3 +57,37 @@ TEST(OptionErrors, CommandLineSpeaksOfFlags) {
   EXPECT_NE(drift_log(d).find("--L0 is 100"), std::string::npos) << drift_log(d);
   EXPECT_FALSE(fs::exists(out));
 }
+
+// No value changed without a word, and messages that say what is wrong: "--seed
+// -1", "2^64" and "1e23" had all become seed 2^64 - 1; "--spp 1e3" said "not in
+// range" for "not a whole number"; "--size 100000x100000" said "must be
+// WIDTHxHEIGHT" for "too large"; "--tile 3/3" exited 1 where "-1/3" exits 2.
+TEST(OptionErrors, NumbersAreReadAsWrittenOrRefusedSayingWhy) {
+  using drift::testing::drift_log;
+  using drift::testing::run_drift;
+  const fs::path d = drift::testing::test_dir("drift_option_numbers");
+  const std::string out = (d / "out.tif").string();
+  const std::string dunes = "dunes --size 16 --steps 1 -o " + out;
+  for (const char* seed : {"-1", "18446744073709551616", "1e23", "0x10", "1.5"}) {
+    EXPECT_EQ(run_drift(dunes + " --seed " + seed, d), 2) << seed;
+    EXPECT_NE(drift_log(d).find("--seed"), std::string::npos) << drift_log(d);
+  }
+  EXPECT_EQ(run_drift(dunes + " --seed 18446744073709551615", d), 0) << drift_log(d);
+  EXPECT_EQ(run_drift(dunes + " --seed 007", d), 0) << drift_log(d);
+  fs::remove(out);
+  const std::string scene = (d / "scene.toml").string();
+  drift::testing::put(d / "scene.toml", "[terrain]\nraster = \"missing.tif\"\n");
+  const std::string render = "render " + scene + " -o " + (d / "a.png").string();
+  EXPECT_EQ(run_drift(render + " --spp 1e3", d), 2);
+  EXPECT_NE(drift_log(d).find("whole number"), std::string::npos) << drift_log(d);
+  EXPECT_EQ(run_drift(dunes + " --threads 2.5", d), 2);
+  EXPECT_NE(drift_log(d).find("whole number"), std::string::npos) << drift_log(d);
+  EXPECT_EQ(run_drift(render + " --size 100000x100000", d), 2);
+  EXPECT_NE(drift_log(d).find("each side must be"), std::string::npos) << drift_log(d);
+  EXPECT_EQ(run_drift(render + " --size 99999999999999999999x2", d), 2);
+  EXPECT_NE(drift_log(d).find("each side must be"), std::string::npos) << drift_log(d);
+  for (const char* tile : {"3/3", "0/0", "-1/3"}) {
+    EXPECT_EQ(run_drift(render + " --tile " + tile, d), 2) << tile << ": " << drift_log(d);
+  }
+  EXPECT_FALSE(fs::exists(out) || fs::exists(d / "a.png"));
+}

@@ -8,6 +8,7 @@
 #include <signal.h>
 #include <spawn.h>
 #include <sys/file.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -280,6 +281,61 @@ TEST_P(EachCommand, RefusesPathsThatCannotBeOutputs) {
   }
 }
 
+// A full disk: a small tmpfs filled to the last page before the run. Every
+// writer's failure is caught (OpenImageIO's PNG writer had left a truncated PNG
+// over the old file and exit 0), the run exits 1 naming the output, the old
+// file is left as it was and no temporary file stays. Skipped where a tmpfs
+// cannot be mounted (not root, or in a container that forbids it).
+class FullDisk {
+ public:
+  explicit FullDisk(const fs::path& dir) : dir_(dir) {
+    fs::create_directories(dir_);
+    mounted_ = mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") == 0;
+  }
+  ~FullDisk() {
+    if (mounted_) umount(dir_.c_str());
+  }
+  bool mounted() const { return mounted_; }
+  // Puts `old` at `path`, then fills the file system to its last byte.
+  void fill_after(const fs::path& path, const std::string& old) {
+    for (const auto& e : fs::directory_iterator(dir_)) fs::remove_all(e.path());
+    put(path, old);
+    const int fd = open((dir_ / "filler").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    const std::string block(4096, 'x');
+    while (write(fd, block.data(), block.size()) > 0) {
+    }
+    while (write(fd, "x", 1) > 0) {
+    }
+    close(fd);
+  }
+
+ private:
+  fs::path dir_;
+  bool mounted_ = false;
+};
+
+TEST_P(EachCommand, FullDiskFailsAndKeepsTheOldOutput) {
+  const Command& c = command();
+  const fs::path d = test_dir();
+  FullDisk disk(d / "full");
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a tmpfs here (needs root): not tested";
+  std::vector<std::pair<std::string, fs::path>> runs = {
+      {with_output(c, d / "full" / ("out" + c.ext)), d / "full" / ("out" + c.ext)}};
+  // The other image format of the commands that write either.
+  if (c.name == "render" || c.name == "merge") {
+    const std::string other = c.ext == ".png" ? ".exr" : ".png";
+    runs.push_back({with_output(c, d / "full" / ("out" + other)), d / "full" / ("out" + other)});
+  }
+  for (const auto& [args, out] : runs) {
+    disk.fill_after(out, "old");
+    const Result r = drift(args, d);
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.log;
+    EXPECT_NE(r.log.find(out.filename().string()), std::string::npos) << r.log;
+    EXPECT_EQ(slurp(out), "old") << args;
+    EXPECT_TRUE(hidden_files(d / "full").empty()) << args;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(OutputsCli, EachCommand, ::testing::ValuesIn(kCommandNames), test_name);
 
 // The inputs of a run are refused as its outputs however they are spelled.
@@ -410,20 +466,26 @@ TEST(OutputsCli, SeveralOutputsAreAllOrNothing) {
   EXPECT_TRUE(hidden_files(d).empty());
 }
 
-// SIGINT, SIGTERM and SIGHUP during the computation, as the first output is
-// being written and as the second is: exit 128 + signal with one line, no
-// temporary file left, the existing outputs untouched.
+// Every signal whose default action ends the process (SIGINT, SIGTERM and
+// SIGHUP, and also SIGQUIT, SIGUSR1, SIGALRM, SIGPIPE, SIGXFSZ, ..., which had
+// left temporary files behind) during the computation, as the first output is
+// being written and as the second is: exit 128 + signal with one line naming
+// it, no temporary file left, the existing outputs untouched.
 TEST(OutputsCli, SignalsRemoveTemporaryFilesAndKeepOutputs) {
   const Inputs in = make_inputs();
   const std::string render = "render " + in.scene.string() + " --size 16x8 --spp 1 --threads 2 -o ";
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGPIPE, SIGXFSZ,
+                  SIGXCPU, SIGVTALRM, SIGPROF}) {
     for (int at : {1, 2}) {
       const fs::path d = test_dir(), a = d / "a.png", b = d / "b.exr";
       put(a, "old a");
       put(b, "old b");
       const Result r = drift(render + a.string() + " -o " + b.string(), d, {Stop::write, at}, sig);
       EXPECT_EQ(r.status, 128 + sig) << "signal " << sig << " at write " << at << ": " << r.log;
-      EXPECT_NE(r.log.find("interrupted by SIG"), std::string::npos) << r.log;
+      EXPECT_NE(r.log.find(std::string("interrupted by SIG") + sigabbrev_np(sig)),
+                std::string::npos)
+          << r.log;
+      EXPECT_NE(r.log.find("existing outputs left as they were"), std::string::npos) << r.log;
       EXPECT_EQ(slurp(a), "old a");
       EXPECT_EQ(slurp(b), "old b");
       EXPECT_TRUE(hidden_files(d).empty()) << "signal " << sig << " at write " << at;
@@ -440,7 +502,29 @@ TEST(OutputsCli, SignalsRemoveTemporaryFilesAndKeepOutputs) {
     EXPECT_FALSE(fs::exists(d / "dunes_00020.tif")) << "went on past the stop";
     EXPECT_EQ(slurp(out), "old");
     EXPECT_TRUE(hidden_files(d).empty()) << "signal " << sig << " during the computation";
+    // The snapshots already in place are complete, and the message says so.
+    EXPECT_NE(r.log.find("outputs already moved into place are complete"), std::string::npos)
+        << r.log;
   }
+}
+
+// A file-size limit (ulimit -f) reached while writing: the write fails (its
+// SIGXFSZ stays blocked), the run exits 1 naming the output, and no temporary
+// file is left (SIGXFSZ's default action had left .NAME.tmp-* behind).
+TEST(OutputsCli, FileSizeLimitLeavesNoTemporaryFile) {
+  const Inputs in = make_inputs();
+  const fs::path d = test_dir(), out = d / "big.exr";
+  put(out, "old");
+  const std::string cmd = "ulimit -f 4; timeout 60 " + std::string(DRIFT_EXECUTABLE) + " render " +
+                          in.scene.string() + " --size 256x128 --spp 1 -o " + out.string() + " > " +
+                          (d / "log.txt").string() + " 2>&1";
+  const int raw = std::system(("bash -c '" + cmd + "'").c_str());
+  const std::string log = slurp(d / "log.txt");
+  ASSERT_TRUE(WIFEXITED(raw)) << log;
+  EXPECT_EQ(WEXITSTATUS(raw), 1) << log;
+  EXPECT_NE(log.find("big.exr"), std::string::npos) << log;
+  EXPECT_EQ(slurp(out), "old");
+  EXPECT_TRUE(hidden_files(d).empty());
 }
 
 }  // namespace

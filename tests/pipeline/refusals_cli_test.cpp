@@ -133,6 +133,51 @@ TEST(RefusalsCli, FifosAsInputsFailAtOnce) {
   }
 }
 
+// Files named inside inputs are inputs too: a VRT's sources (a FIFO had
+// blocked info and import for ever) and an OBJ's mtllib (/dev/zero had been read
+// without end, a FIFO had blocked marks and snow fall).
+TEST(RefusalsCli, FilesNamedInsideInputsObeyTheInputRules) {
+  const fs::path d = test_dir(), fifo = d / "pipe.tif";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  const std::string vrt_head =
+      "<VRTDataset rasterXSize=\"16\" rasterYSize=\"16\">\n"
+      "<VRTRasterBand dataType=\"Float32\" band=\"1\"><SimpleSource>\n";
+  const std::string vrt_tail =
+      "<SourceBand>1</SourceBand></SimpleSource></VRTRasterBand></VRTDataset>\n";
+  put(d / "fifo.vrt",
+      vrt_head + "<SourceFilename relativeToVRT=\"1\">pipe.tif</SourceFilename>" + vrt_tail);
+  put(d / "nested.vrt",
+      vrt_head + "<SourceFilename relativeToVRT=\"1\">fifo.vrt</SourceFilename>" + vrt_tail);
+  put(d / "device.vrt",
+      vrt_head + "<SourceFilename relativeToVRT=\"0\">/dev/zero</SourceFilename>" + vrt_tail);
+  const std::string o = " -o " + (d / "o.tif").string();
+  for (const char* vrt : {"fifo.vrt", "nested.vrt"}) {
+    const std::string v = (d / vrt).string();
+    EXPECT_REFUSED(drift("info " + v, d), 1, "pipe.tif");
+    EXPECT_REFUSED(drift("import " + v + o, d), 1, "pipe.tif");
+  }
+  EXPECT_REFUSED(drift("info " + (d / "device.vrt").string(), d), 1, "/dev/zero");
+  // A VRT of a regular file still reads.
+  dem(d);
+  put(d / "good.vrt",
+      vrt_head + "<SourceFilename relativeToVRT=\"1\">dem.tif</SourceFilename>" + vrt_tail);
+  EXPECT_EQ(drift("info " + (d / "good.vrt").string(), d).status, 0);
+  // An OBJ whose mtllib is a FIFO or /dev/zero reads as the mesh it is.
+  put(d / "fifo.obj", "mtllib pipe.tif\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  put(d / "zero.obj",
+      "mtllib ../../../../../../../../../dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  for (const char* obj : {"fifo.obj", "zero.obj"}) {
+    put(d / "objects.toml",
+        std::string("[[objects]]\nmesh = \"") + obj + "\"\nposition = [80, -80, 100]\n");
+    EXPECT_EQ(drift("snow fall " + (d / "dem.tif").string() + " --maps 1 --spread 0 --objects " +
+                        (d / "objects.toml").string() + o,
+                    d)
+                  .status,
+              0)
+        << obj;
+  }
+}
+
 TEST(RefusalsCli, ImportRefusesEmptyCropsLatitudesOffTheGlobeAndHugeGrids) {
   const fs::path d = test_dir(), in = dem(d), out = d / "out.tif";
   put(out, "old");
@@ -269,6 +314,26 @@ TEST(RefusalsCli, SizesAreCheckedAgainstMemoryBeforeAllocating) {
                        d),
                  1, "--mesh-edge");
   EXPECT_FALSE(fs::exists(d / "depth.tif") || fs::exists(d / "s.png"));
+}
+
+// DRIFT_MEMORY_LIMIT is read strictly, in every subcommand, before any work:
+// "1T" had read as 1 byte, "8 G" as 8 bytes, and "abc", "0", "-5", "nan" as no cap.
+TEST(RefusalsCli, MalformedMemoryLimitIsAUsageErrorNamingTheVariable) {
+  const fs::path d = test_dir(), in = dem(d), out = d / "out.tif";
+  put(out, "old");
+  for (const char* bad : {"abc", "0", "-5", "nan", "'8 G'", "1X"}) {
+    for (const std::string& args :
+         {"info " + in.string(), "import " + in.string() + " -o " + out.string()}) {
+      EXPECT_REFUSED(drift(args, d, std::string("DRIFT_MEMORY_LIMIT=") + bad), 2,
+                     "DRIFT_MEMORY_LIMIT is");
+    }
+  }
+  EXPECT_EQ(slurp(out), "old");
+  // The documented forms work, "1T" as a terabyte rather than a byte.
+  for (const char* good : {"1T", "1TiB", "8G", "4096M", ""}) {
+    EXPECT_EQ(drift("info " + in.string(), d, std::string("DRIFT_MEMORY_LIMIT=") + good).status, 0)
+        << good;
+  }
 }
 
 TEST(RefusalsCli, SoilRefusesValuesOutOfRangeAndGridsLargerThanMemory) {

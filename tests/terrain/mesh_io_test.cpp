@@ -1,11 +1,16 @@
 // PLY meshes: a write/read round trip keeps positions, attributes and the CRS
-// origin; splitting by an attribute; malformed files are clear errors.
+// origin; splitting by an attribute; malformed files are clear errors. OBJ
+// meshes: what tinyobjloader would misread, block on or take quadratic time over
+// is refused or avoided.
 #include "terrain/mesh_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "terrain/error.h"
 
@@ -69,4 +74,64 @@ TEST(MeshIo, MalformedPlyIsAClearError) {
   EXPECT_THROW(read_ply(path), drift::Error);
   EXPECT_THROW(read_ply(fs::temp_directory_path() / "drift_no_such_mesh.ply"), drift::Error);
   fs::remove(path);
+}
+
+namespace {
+
+// The message of read_obj's refusal of `text`, or "" if it was read.
+std::string obj_refusal(const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / "drift_mesh_check.obj";
+  std::ofstream(path) << text;
+  try {
+    read_obj(path);
+    return "";
+  } catch (const drift::Error& e) {
+    return e.what();
+  }
+}
+
+std::string polygon(std::size_t corners) {
+  std::string text;
+  for (std::size_t i = 0; i < corners; ++i) {
+    const double a = 6.283185307179586 * static_cast<double>(i) / static_cast<double>(corners);
+    text += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+  }
+  text += "f";
+  for (std::size_t i = 1; i <= corners; ++i) text += " " + std::to_string(i);
+  return text + "\n";
+}
+
+}  // namespace
+
+// tinyobjloader reads "  v nan 0 0" (leading spaces) as 0, "0x1p+200" as 0 and
+// 1e39 as infinity: each is refused naming the line.
+TEST(MeshIo, ObjCoordinatesThatWouldBeMisreadAreRefusedNamingTheLine) {
+  const std::string tail = "v 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  EXPECT_EQ(obj_refusal("v 0 0 0\n" + tail), "");
+  EXPECT_EQ(obj_refusal("  v 0 0 -1.5e3\n" + tail), "");
+  for (const char* bad :
+       {"  v nan 0 0\n", "\tv 0 inf 0\n", "v 0x1p+200 0 0\n", "v 0 0 1e39\n", "v 0 0 -nan\n"}) {
+    const std::string message = obj_refusal(bad + tail);
+    EXPECT_NE(message.find("line 1: vertex coordinate"), std::string::npos) << bad << message;
+  }
+}
+
+// One face of 40,000 vertices took 10 s to triangulate (quadratic): faces are
+// bounded, and a face within the bound still reads.
+TEST(MeshIo, ObjFacesOfTooManyVerticesAreRefused) {
+  EXPECT_EQ(obj_refusal(polygon(1024)), "");
+  const std::string message = obj_refusal(polygon(40000));
+  EXPECT_NE(message.find("a face of 40000 vertices"), std::string::npos) << message;
+}
+
+// An OBJ's `mtllib` is never opened: "mtllib ../../dev/zero" had read /dev/zero
+// for ever and a FIFO had blocked.
+TEST(MeshIo, ObjMaterialLibrariesAreNotOpened) {
+  const fs::path fifo = fs::temp_directory_path() / "drift_mesh_fifo.mtl";
+  fs::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string tail = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  EXPECT_EQ(obj_refusal("mtllib drift_mesh_fifo.mtl\nusemtl a\n" + tail), "");
+  EXPECT_EQ(obj_refusal("mtllib ../../../../../../../../dev/zero\n" + tail), "");
+  fs::remove(fifo);
 }
