@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "terrain/error.h"
@@ -91,14 +92,15 @@ std::string obj_refusal(const std::string& text) {
 }
 
 std::string polygon(std::size_t corners) {
-  std::string text;
+  std::ostringstream text;
   for (std::size_t i = 0; i < corners; ++i) {
     const double a = 6.283185307179586 * static_cast<double>(i) / static_cast<double>(corners);
-    text += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+    text << "v " << std::cos(a) << ' ' << std::sin(a) << " 0\n";
   }
-  text += "f";
-  for (std::size_t i = 1; i <= corners; ++i) text += " " + std::to_string(i);
-  return text + "\n";
+  text << 'f';
+  for (std::size_t i = 1; i <= corners; ++i) text << ' ' << i;
+  text << '\n';
+  return text.str();
 }
 
 }  // namespace
@@ -107,11 +109,11 @@ std::string polygon(std::size_t corners) {
 // 1e39 as infinity: each is refused naming the line.
 TEST(MeshIo, ObjCoordinatesThatWouldBeMisreadAreRefusedNamingTheLine) {
   const std::string tail = "v 1 0 0\nv 0 1 0\nf 1 2 3\n";
-  EXPECT_EQ(obj_refusal("v 0 0 0\n" + tail), "");
-  EXPECT_EQ(obj_refusal("  v 0 0 -1.5e3\n" + tail), "");
+  EXPECT_EQ(obj_refusal(std::string("v 0 0 0\n").append(tail)), "");
+  EXPECT_EQ(obj_refusal(std::string("  v 0 0 -1.5e3\n").append(tail)), "");
   for (const char* bad :
        {"  v nan 0 0\n", "\tv 0 inf 0\n", "v 0x1p+200 0 0\n", "v 0 0 1e39\n", "v 0 0 -nan\n"}) {
-    const std::string message = obj_refusal(bad + tail);
+    const std::string message = obj_refusal(std::string(bad).append(tail));
     EXPECT_NE(message.find("line 1: vertex coordinate"), std::string::npos) << bad << message;
   }
 }
@@ -131,7 +133,7 @@ TEST(MeshIo, ObjMaterialLibrariesAreNotOpened) {
   fs::remove(fifo);
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   const std::string tail = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-  EXPECT_EQ(obj_refusal("mtllib drift_mesh_fifo.mtl\nusemtl a\n" + tail), "");
-  EXPECT_EQ(obj_refusal("mtllib ../../../../../../../../dev/zero\n" + tail), "");
+  EXPECT_EQ(obj_refusal(std::string("mtllib drift_mesh_fifo.mtl\nusemtl a\n").append(tail)), "");
+  EXPECT_EQ(obj_refusal(std::string("mtllib ../../../../../../../../dev/zero\n").append(tail)), "");
   fs::remove(fifo);
 }
