@@ -170,13 +170,13 @@ void PathTracer::cross_clouds(Path& path, float distance, int depth, PixelSample
 
 PathTracer::Path PathTracer::camera_path(int px, int py, SampleStream& rng) const {
   Path path;
-  const float jx = rng.next(), jy = rng.next();
-  // Lens samples only for a thin lens, so pinhole renders keep their bits.
-  const float lu = camera_.lens_radius > 0.0f ? rng.next() : 0.0f;
-  const float lv = camera_.lens_radius > 0.0f ? rng.next() : 0.0f;
+  // Pixel and lens from one 4-D set: the pixel's samples are stratified in
+  // the film plane (coordinates 0 and 1, a (0,2)-sequence) and on the lens.
+  const auto [jx, jy, lu, lv] = rng.next4d();
   camera_.ray(static_cast<float>(px) + jx, static_cast<float>(py) + jy, lu, lv, path.origin,
               path.dir);
-  path.shaft_jitter = shafts_ ? rng.next() : 0.0f;  // likewise only when used
+  const float shaft = rng.next1d();  // drawn whether used or not: see render/random.h
+  path.shaft_jitter = shafts_ ? shaft : 0.0f;
   // Camera rays start as wide as a pixel's angle; see RayCone.
   path.cone = {0.0f, 2.0f * camera_.tan_half / static_cast<float>(settings_.height)};
   return path;
@@ -207,11 +207,13 @@ PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& 
     const Vector3f wo = -path.dir;
     const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
     const GroundBsdf bsdf(hit.normal, wo, hit.material);
-    const float u1 = rng.next(), u2 = rng.next();
+    // Every vertex draws the same sets in the same order, used or not, so
+    // that a set stands for the same integral in all of a pixel's samples
+    // and keeps its stratification (render/random.h).
+    const auto [u1, u2] = rng.next2d();
     if (sun_up_) sample_sun(path, hit, p, bsdf, u1, u2, out, rays);
-    // The sky's own samples at the first vertex only (both numbers drawn
-    // at every vertex, so the stream, and vertex 0, keep their bits).
-    const float s1 = rng.next(), s2 = rng.next();
+    // The sky's own samples at the first vertex only.
+    const auto [s1, s2] = rng.next2d();
     if (depth < kSkySampledVertices) sample_sky(path, hit, p, bsdf, s1, s2, out, rays);
     if (!bounce(path, hit, p, bsdf, depth, rng)) break;
   }
@@ -299,10 +301,10 @@ void PathTracer::sample_sky(const Path& path, const Hit& hit, const Vector3f& p,
 bool PathTracer::bounce(Path& path, const Hit& hit, const Vector3f& p, const GroundBsdf& bsdf,
                         int depth, SampleStream& rng) const {
   // Cosine-weighted on dry ground (weight: the albedo times the Oren-Nayar
-  // factor), the wet coat's lobe by its probability. Dry ground draws no
-  // lobe number.
-  const float u_lobe = bsdf.specular_probability() > 0.0f ? rng.next() : 0.0f;
-  const float b1 = rng.next(), b2 = rng.next();
+  // factor), the wet coat's lobe by its probability.
+  const float u_lobe = rng.next1d();
+  const auto [b1, b2] = rng.next2d();
+  const float u_roulette = rng.next1d();
   GroundBsdf::Sample sample;
   if (!bsdf.sample(u_lobe, b1, b2, sample)) return false;
   path.bounce_pdf = sample.pdf;
@@ -319,7 +321,7 @@ bool PathTracer::bounce(Path& path, const Hit& hit, const Vector3f& p, const Gro
   // of the rays but nearly double the relMSE (docs/rendering.md, "Speed").
   if (depth >= 1) {
     const float q = std::min(0.95f, path.throughput.maxCoeff());
-    if (rng.next() >= q) return false;
+    if (u_roulette >= q) return false;
     path.throughput /= q;
   }
   return true;
