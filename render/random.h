@@ -11,8 +11,10 @@
 // Within a set the samples of a pixel are a (0,m,2)-net in the first two
 // coordinates; sets and pixels are decorrelated by their seeds, so the
 // integrator must draw the same sets in the same order in every sample of a
-// pixel (render/path_tracer.cpp draws a fixed number per vertex) for each
-// set to stand for one integral.
+// pixel (render/path_tracer.cpp takes a fixed number per vertex, skipping
+// those a sample does not use) for each set to stand for one integral. The
+// coordinates of a set are independent of how many are taken: next2d() gives
+// the first two of what next4d() would.
 #pragma once
 
 #include <array>
@@ -33,6 +35,9 @@ class SampleStream {
   float next1d() { return next<1>()[0]; }
   std::array<float, 2> next2d() { return next<2>(); }
   std::array<float, 4> next4d() { return next<4>(); }
+  // Passes over a set that this sample does not use, at no cost; the next
+  // set is the one it would have been.
+  void skip() { ++set_; }
 
  private:
   template <int N>

@@ -99,14 +99,17 @@ TEST(Sobol, MatricesAreJoeAndKuos) {
           << "dimension " << d << " column " << k;
   // Column k (m_{k+1} odd, below 2^(k+1)) ends in digit k + 1: the matrix
   // is triangular with a unit diagonal, so each dimension alone is a
-  // (0,1)-sequence. And dimension 0's shortcut is its matrix.
+  // (0,1)-sequence.
   for (int d = 0; d < sobol::kDimensions; ++d)
     for (int k = 0; k < 32; ++k) EXPECT_EQ(std::countr_zero(sobol::kMatrices[d][k]), 31 - k);
-  for (std::uint32_t i : {0u, 1u, 6u, 1234567u, 0xffffffffu}) {
-    std::uint32_t x = 0;
-    for (int k = 0; k < 32; ++k)
-      if ((i >> k) & 1u) x ^= sobol::kMatrices[0][k];
-    EXPECT_EQ(sobol::sample_bits(i, 0), x);
+  // Each dimension's shortcut (bits reversed, byte tables) is its matrix.
+  for (int d = 0; d < sobol::kDimensions; ++d) {
+    for (std::uint32_t i : {0u, 1u, 6u, 1234567u, 0x89abcdefu, 0xffffffffu}) {
+      std::uint32_t x = 0;
+      for (int k = 0; k < 32; ++k)
+        if ((i >> k) & 1u) x ^= sobol::kMatrices[d][k];
+      EXPECT_EQ(sobol::sample_bits(i, d), x) << "dimension " << d << " index " << i;
+    }
   }
 }
 
@@ -207,6 +210,16 @@ TEST(Sampler, PureFunctionOfSeedPixelSampleAndSet) {
       EXPECT_LT(v, 1.0f);
     }
   }
+  // A skipped set leaves the next one as it was; a 2-D draw is the first two
+  // coordinates of the 4-D one (the pinhole and the thin lens agree).
+  SampleStream drawn(9, 123, 45), skipped(9, 123, 45);
+  drawn.next1d();
+  skipped.skip();
+  EXPECT_EQ(drawn.next2d(), skipped.next2d());
+  const auto two = SampleStream(9, 123, 45).next2d();
+  const auto four = SampleStream(9, 123, 45).next4d();
+  EXPECT_EQ(two[0], four[0]);
+  EXPECT_EQ(two[1], four[1]);
   EXPECT_NE(SampleStream(9, 123, 45).next2d(), SampleStream(10, 123, 45).next2d());
   EXPECT_NE(SampleStream(9, 123, 45).next2d(), SampleStream(9, 124, 45).next2d());
   EXPECT_NE(SampleStream(9, 123, 45).next2d(), SampleStream(9, 123, 46).next2d());
