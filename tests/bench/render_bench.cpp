@@ -9,6 +9,7 @@
 // Needs out/yarigatake_utm.tif (run `make -C data/scenes default` or
 // `drift import data/yarigatake_gsi_dem10b_jgd2000.tif -o out/yarigatake_utm.tif`).
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -35,6 +36,15 @@ struct Fixture {
   std::unique_ptr<render::TerrainScene> embree;
   render::Camera camera;
 };
+
+// CPU seconds of the whole process, every thread (user + system): on a
+// shared machine rays per CPU second compare runs that wall time cannot.
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+  return seconds(u.ru_utime) + seconds(u.ru_stime);
+}
 
 Fixture& fixture() {
   static Fixture f = [] {
@@ -104,11 +114,15 @@ BENCHMARK(BM_TerrainSceneBuild)
 void trace_frames(benchmark::State& state, const render::SceneInput& input) {
   Fixture& f = fixture();
   render::RenderStats stats;
+  double cpu = 0.0;
   for (auto _ : state) {
+    const double start = process_cpu_seconds();
     auto img =
         render::render_image(*f.embree, input, f.camera, f.scene.settings, no_progress, &stats);
+    cpu += process_cpu_seconds() - start;
     benchmark::DoNotOptimize(img.pixels.data());
   }
+  state.counters["rays/cpu_s"] = static_cast<double>(stats.rays) * state.iterations() / cpu;
   state.counters["rays/s"] = benchmark::Counter(
       static_cast<double>(stats.rays) * state.iterations(), benchmark::Counter::kIsRate);
   state.counters["samples/s"] = benchmark::Counter(
@@ -144,7 +158,9 @@ void BM_RawEmbreeCameraRays(benchmark::State& state) {
         dirs[(static_cast<std::size_t>(y) * rs.width + x) * spp + s] =
             pinhole.direction(x + (s + 0.5f) / spp, y + 0.5f);
   std::atomic<std::uint64_t> hits{0};
+  double cpu = 0.0;
   for (auto _ : state) {
+    const double start = process_cpu_seconds();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirs.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         std::uint64_t local = 0;
@@ -153,9 +169,11 @@ void BM_RawEmbreeCameraRays(benchmark::State& state) {
                         }
                         hits += local;
                       });
+    cpu += process_cpu_seconds() - start;
   }
   state.counters["rays/s"] = benchmark::Counter(
       static_cast<double>(dirs.size()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["rays/cpu_s"] = static_cast<double>(dirs.size()) * state.iterations() / cpu;
   state.counters["hit_fraction"] =
       static_cast<double>(hits) / (static_cast<double>(dirs.size()) * state.iterations());
   state.counters["peak_MiB"] = bench::peak_resident_mib();
@@ -209,7 +227,9 @@ void BM_RawEmbreeSameRays(benchmark::State& state) {
   const std::vector<RecordedRay> rays = record_path_tracer_rays();
   const render::TerrainScene& scene = *fixture().embree;
   std::atomic<std::uint64_t> hits{0};
+  double cpu = 0.0;
   for (auto _ : state) {
+    const double start = process_cpu_seconds();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         std::uint64_t local = 0;
@@ -221,11 +241,13 @@ void BM_RawEmbreeSameRays(benchmark::State& state) {
                         }
                         hits += local;
                       });
+    cpu += process_cpu_seconds() - start;
   }
   const auto shadow =
       std::count_if(rays.begin(), rays.end(), [](const auto& r) { return r.shadow; });
   state.counters["rays/s"] = benchmark::Counter(
       static_cast<double>(rays.size()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["rays/cpu_s"] = static_cast<double>(rays.size()) * state.iterations() / cpu;
   state.counters["rays"] = static_cast<double>(rays.size());
   state.counters["shadow_fraction"] =
       static_cast<double>(shadow) / static_cast<double>(rays.size());
