@@ -277,8 +277,10 @@ Eigen::Vector3f TerrainScene::surround_normal(unsigned grid, float u, float v) c
   return terrain::bilinear_blend(n(0, 0), n(1, 0), n(0, 1), n(1, 1), tu, tv).normalized();
 }
 
-bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
-                             const RayCone& cone) const {
+namespace {
+
+// The nearest hit of a ray from o along d (geomID invalid: none).
+RTCRayHit nearest_hit(RTCScene scene, const Eigen::Vector3f& o, const Eigen::Vector3f& d) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh{};
@@ -288,7 +290,20 @@ bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
   rh.ray.tfar = std::numeric_limits<float>::infinity();
   rh.ray.mask = 0xffffffffu;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(embree_->scene, &context, &rh);
+  rtcIntersect1(scene, &context, &rh);
+  return rh;
+}
+
+}  // namespace
+
+bool TerrainScene::hits(const Eigen::Vector3f& o, const Eigen::Vector3f& d) const {
+  return nearest_hit(embree_->scene, o, d).hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+
+bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
+                             const RayCone& cone) const {
+  if (recorder_) recorder_->traced(o, d, std::numeric_limits<float>::infinity(), false);
+  const RTCRayHit rh = nearest_hit(embree_->scene, o, d);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;
@@ -375,6 +390,7 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
 
 bool TerrainScene::occluded(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                             float max_distance) const {
+  if (recorder_) recorder_->traced(o, d, max_distance, true);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray{};

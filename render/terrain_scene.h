@@ -37,6 +37,17 @@ struct RayCone {
   float width_at(float distance) const { return width + spread * distance; }
 };
 
+// Sees every ray a TerrainScene traces, from any thread: benchmarks record
+// the path tracer's own rays with it and replay them raw
+// (tests/bench/render_bench.cpp, BM_RawEmbreeSameRays).
+class RayRecorder {
+ public:
+  virtual ~RayRecorder() = default;
+  // `shadow`: an occlusion ray within max_distance; else a nearest-hit ray.
+  virtual void traced(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float max_distance,
+                      bool shadow) = 0;
+};
+
 class TerrainScene {
  public:
   // Throws drift::Error for an empty or all-nodata terrain. NaN (nodata) cells
@@ -53,6 +64,12 @@ class TerrainScene {
   // True if anything lies on the ray within (0, max_distance).
   bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
                 float max_distance) const;
+  // Raw Embree: whether the ray meets anything (rtcIntersect1 alone, nothing
+  // shaded, not recorded). The ceiling intersect() is measured against.
+  bool hits(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) const;
+  // Every ray intersect() and occluded() trace goes to `recorder` too (none:
+  // nullptr); for benchmarks, not to be changed while rays are traced.
+  void record_rays(RayRecorder* recorder) { recorder_ = recorder; }
 
   // CRS -> local coordinates and back.
   Eigen::Vector3d origin() const { return origin_; }
@@ -96,6 +113,7 @@ class TerrainScene {
 
   struct Embree;
   std::unique_ptr<Embree> embree_;
+  RayRecorder* recorder_ = nullptr;
   int width_ = 0, height_ = 0;
   float dx_ = 1.0f, dy_ = 1.0f;
   float exaggeration_ = 1.0f;
@@ -114,7 +132,7 @@ class TerrainScene {
   };
   std::vector<Material> mesh_material_;  // by Embree geometry id
   std::vector<MeshCover> mesh_covers_;   // likewise
-  unsigned terrain_geometries_ = 0;           // geometry ids [0, n) are terrain grids
+  unsigned terrain_geometries_ = 0;      // geometry ids [0, n) are terrain grids
   // The ground beyond the DEM's edge (render/surround.h): its vertex buffer,
   // grids and Embree geometry id (none: -1).
   void attach_surround(const SurroundOptions& options);

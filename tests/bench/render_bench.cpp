@@ -1,16 +1,20 @@
 // Renderer throughput on the default scene (Yarigatake, imported to UTM) at
 // 1280x720, 64 spp: wall time, samples and rays per second of the whole path
-// tracer next to Embree's raw throughput on the same scene (the same camera
-// rays, intersection only); with peak memory. And the cost of the terrain
+// tracer next to Embree's raw throughput on the same scene (its camera rays,
+// and the path tracer's own rays replayed, intersection only); with peak
+// memory. And the cost of the terrain
 // scene itself for large DEMs (4096^2 and 8192^2): build time and bytes per
 // DEM vertex, resident and at the peak of the build.
 //
 // Needs out/yarigatake_utm.tif (run `make -C data/scenes default` or
 // `drift import data/yarigatake_gsi_dem10b_jgd2000.tif -o out/yarigatake_utm.tif`).
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -32,6 +36,15 @@ struct Fixture {
   std::unique_ptr<render::TerrainScene> embree;
   render::Camera camera;
 };
+
+// CPU seconds of the whole process, every thread (user + system): on a
+// shared machine rays per CPU second compare runs that wall time cannot.
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+  return seconds(u.ru_utime) + seconds(u.ru_stime);
+}
 
 Fixture& fixture() {
   static Fixture f = [] {
@@ -101,11 +114,15 @@ BENCHMARK(BM_TerrainSceneBuild)
 void trace_frames(benchmark::State& state, const render::SceneInput& input) {
   Fixture& f = fixture();
   render::RenderStats stats;
+  double cpu = 0.0;
   for (auto _ : state) {
+    const double start = process_cpu_seconds();
     auto img =
         render::render_image(*f.embree, input, f.camera, f.scene.settings, no_progress, &stats);
+    cpu += process_cpu_seconds() - start;
     benchmark::DoNotOptimize(img.pixels.data());
   }
+  state.counters["rays/cpu_s"] = static_cast<double>(stats.rays) * state.iterations() / cpu;
   state.counters["rays/s"] = benchmark::Counter(
       static_cast<double>(stats.rays) * state.iterations(), benchmark::Counter::kIsRate);
   state.counters["samples/s"] = benchmark::Counter(
@@ -126,8 +143,8 @@ void BM_PathTracerLightShafts(benchmark::State& state) {
 BENCHMARK(BM_PathTracerLightShafts)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 // Raw Embree: the same 1280x720x64 camera rays, generated before timing, traced
-// with TerrainScene::intersect (rtcIntersect1 plus the hit record) over the same
-// TBB threads: the ceiling the path tracer's camera rays could reach.
+// with TerrainScene::hits (rtcIntersect1 alone, nothing shaded) over the same
+// TBB threads: the most coherent rays of the frame.
 void BM_RawEmbreeCameraRays(benchmark::State& state) {
   Fixture& f = fixture();
   const auto& rs = f.scene.settings;
@@ -141,24 +158,103 @@ void BM_RawEmbreeCameraRays(benchmark::State& state) {
         dirs[(static_cast<std::size_t>(y) * rs.width + x) * spp + s] =
             pinhole.direction(x + (s + 0.5f) / spp, y + 0.5f);
   std::atomic<std::uint64_t> hits{0};
+  double cpu = 0.0;
   for (auto _ : state) {
+    const double start = process_cpu_seconds();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirs.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         std::uint64_t local = 0;
-                        render::Hit hit;
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          local += f.embree->intersect(pinhole.eye, dirs[i], hit);
+                          local += f.embree->hits(pinhole.eye, dirs[i]);
                         }
                         hits += local;
                       });
+    cpu += process_cpu_seconds() - start;
   }
   state.counters["rays/s"] = benchmark::Counter(
       static_cast<double>(dirs.size()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["rays/cpu_s"] = static_cast<double>(dirs.size()) * state.iterations() / cpu;
   state.counters["hit_fraction"] =
       static_cast<double>(hits) / (static_cast<double>(dirs.size()) * state.iterations());
   state.counters["peak_MiB"] = bench::peak_resident_mib();
 }
 BENCHMARK(BM_RawEmbreeCameraRays)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+// The path tracer's own rays (camera, bounce, shadow and cloud rays, in the
+// order each thread traced them), recorded once from the default frame at
+// kRecordedSpp samples a pixel (the mix of rays is BM_PathTracer's; 64 spp
+// would take 5 GB).
+constexpr int kRecordedSpp = 4;
+
+struct RecordedRay {
+  Eigen::Vector3f origin, dir;
+  float max_distance;
+  bool shadow;
+};
+
+class Recorder final : public render::RayRecorder {
+ public:
+  void traced(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float max_distance,
+              bool shadow) override {
+    rays_.local().push_back({origin, dir, max_distance, shadow});
+  }
+  std::vector<RecordedRay> take() {
+    std::vector<RecordedRay> all;
+    for (auto& part : rays_) all.insert(all.end(), part.begin(), part.end());
+    return all;
+  }
+
+ private:
+  tbb::enumerable_thread_specific<std::vector<RecordedRay>> rays_;
+};
+
+std::vector<RecordedRay> record_path_tracer_rays() {
+  Fixture& f = fixture();
+  render::RenderSettings settings = f.scene.settings;
+  settings.samples_per_pixel = kRecordedSpp;
+  Recorder recorder;
+  f.embree->record_rays(&recorder);
+  render::render_image(*f.embree, f.scene.input, f.camera, settings, no_progress);
+  f.embree->record_rays(nullptr);
+  return recorder.take();
+}
+
+// Raw Embree on the path tracer's own rays: rtcIntersect1 (TerrainScene::hits)
+// or rtcOccluded1 (TerrainScene::occluded), nothing shaded, over the same TBB
+// threads. BM_PathTracer's rays/s over this one's is how much of the frame's
+// time goes to Embree's traversal.
+void BM_RawEmbreeSameRays(benchmark::State& state) {
+  const std::vector<RecordedRay> rays = record_path_tracer_rays();
+  const render::TerrainScene& scene = *fixture().embree;
+  std::atomic<std::uint64_t> hits{0};
+  double cpu = 0.0;
+  for (auto _ : state) {
+    const double start = process_cpu_seconds();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        std::uint64_t local = 0;
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const RecordedRay& ray = rays[i];
+                          local += ray.shadow
+                                       ? scene.occluded(ray.origin, ray.dir, ray.max_distance)
+                                       : scene.hits(ray.origin, ray.dir);
+                        }
+                        hits += local;
+                      });
+    cpu += process_cpu_seconds() - start;
+  }
+  const auto shadow =
+      std::count_if(rays.begin(), rays.end(), [](const auto& r) { return r.shadow; });
+  state.counters["rays/s"] = benchmark::Counter(
+      static_cast<double>(rays.size()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["rays/cpu_s"] = static_cast<double>(rays.size()) * state.iterations() / cpu;
+  state.counters["rays"] = static_cast<double>(rays.size());
+  state.counters["shadow_fraction"] =
+      static_cast<double>(shadow) / static_cast<double>(rays.size());
+  state.counters["hit_fraction"] =
+      static_cast<double>(hits) / (static_cast<double>(rays.size()) * state.iterations());
+}
+BENCHMARK(BM_RawEmbreeSameRays)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
 
 }  // namespace
 

@@ -29,7 +29,8 @@ Vector3f albedo_by_sampling(const GroundBsdf& bsdf, int n) {
   Eigen::Vector3d sum(0, 0, 0);
   for (int i = 0; i < n; ++i) {
     SampleStream rng(7, 0, static_cast<std::uint64_t>(i));
-    const float u = rng.next(), u1 = rng.next(), u2 = rng.next();
+    const float u = rng.next1d();
+    const auto [u1, u2] = rng.next2d();
     GroundBsdf::Sample s;
     if (bsdf.sample(u, u1, u2, s)) sum += s.weight.cast<double>();
   }
@@ -193,7 +194,8 @@ TEST(SnowBsdf, ForwardLobeSamplingKeepsTheWeightsSmallAtGrazingViews) {
     const int n = 100000;
     for (int i = 0; i < n; ++i) {
       SampleStream rng(11, 0, static_cast<std::uint64_t>(i));
-      const float u = rng.next(), u1 = rng.next(), u2 = rng.next();
+      const float u = rng.next1d();
+      const auto [u1, u2] = rng.next2d();
       GroundBsdf::Sample s;
       const double w = bsdf.sample(u, u1, u2, s) ? s.weight.x() : 0.0;
       sum += w;

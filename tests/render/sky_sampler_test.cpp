@@ -102,7 +102,7 @@ TEST(SkySampler, PdfIsADensityAndMatchesItsSamples) {
   EXPECT_NEAR(sphere_integral([&](const Vector3f& d) { return sampler.pdf(d); }), 1.0, 2e-3);
   for (int i = 0; i < 1000; ++i) {
     SampleStream rng(3, 0, static_cast<std::uint64_t>(i));
-    const float u1 = rng.next(), u2 = rng.next();
+    const auto [u1, u2] = rng.next2d();
     SkySampler::Sample s;
     ASSERT_TRUE(sampler.sample(u1, u2, s));
     EXPECT_NEAR(s.dir.norm(), 1.0f, 1e-5f);
@@ -122,7 +122,7 @@ TEST(SkySampler, EstimatesTheSkysIntegralWithLowVariance) {
   double sum = 0, sum2 = 0, usum = 0, usum2 = 0;
   for (int i = 0; i < n; ++i) {
     SampleStream rng(5, 0, static_cast<std::uint64_t>(i));
-    const float u1 = rng.next(), u2 = rng.next();
+    const auto [u1, u2] = rng.next2d();
     SkySampler::Sample s;
     ASSERT_TRUE(sampler.sample(u1, u2, s));
     const double x = luminance(glow_sky(s.dir)) / s.pdf;
