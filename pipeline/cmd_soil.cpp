@@ -1,7 +1,6 @@
 // drift soil SCENARIO.toml -o OUT.ply: voxel soil that pours, slides, piles
 // and is pushed, dug and lifted (paper 004, terrain/soil/simulation.h).
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -123,34 +122,29 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
   soil::SoilSimulation sim = soil::make_simulation(sc);  // checks sizes and memory first
   const soil::SurfaceOptions surface{
       c.no_ridge_fix ? soil::RidgeFix::Off : soil::RidgeFix::StraightSlopes, 3, 0.0};
-  const double mass0 = sim.state().mass();
-  const ProgressFn progress = terminal_progress("soil");
-  const auto t0 = std::chrono::steady_clock::now();
-  progress(0.0, "simulating");
-  for (int step = 1; step <= sc.steps; ++step) {
-    sim.step();
-    if (!c.frames.empty() && step % c.frame_every == 0) {
+  soil::SoilRunOptions run;
+  run.steps = sc.steps;
+  if (!c.frames.empty()) {
+    run.frame_every = c.frame_every;
+    run.frame = [&](const soil::SoilSimulation& s, int step) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-      write_mesh(soil::soil_surface(sim.state(), surface, sc.options.soil.moisture),
+      write_mesh(soil::soil_surface(s.state(), surface, sc.options.soil.moisture),
                  fs::path(c.frames) / name);
-    }
-    if (!progress(static_cast<double>(step) / std::max(1, sc.steps), "simulating"))
-      throw Cancelled();
+    };
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  progress(1.0, "done");
+  const soil::SoilRunStats stats = soil::run_soil(sim, run, terminal_progress("soil"));
 
   const std::vector<std::string> wrote = write_products(c, sc, sim.state(), surface);
   outputs.commit();
   for (const std::string& line : wrote) std::printf("soil: wrote %s\n", line.c_str());
-  const double mass1 = sim.state().mass();
+  const double mass0 = stats.mass_before, mass1 = stats.mass_after;
   std::printf(
       "soil: %d steps of %dx%dx%d voxels (%.3g m) in %.2f s (%.1f steps/s); soil %.6g -> "
       "%.6g voxels (relative change %.2g)\n",
-      sc.steps, sc.shape.nx, sc.shape.ny, sc.shape.nz, sc.shape.voxel_size, seconds,
-      sc.steps / std::max(seconds, 1e-9), mass0, mass1, mass0 > 0 ? (mass1 - mass0) / mass0 : 0.0);
+      sc.steps, sc.shape.nx, sc.shape.ny, sc.shape.nz, sc.shape.voxel_size, stats.seconds,
+      sc.steps / std::max(stats.seconds, 1e-9), mass0, mass1,
+      mass0 > 0 ? (mass1 - mass0) / mass0 : 0.0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <unordered_set>
 
 #include "terrain/soil/transport.h"
 
@@ -73,9 +74,13 @@ void for_each_dirty_column(const terrain::Grid3Shape& g, const ColumnMask* dirty
   });
 }
 
+bool solid(const SoilState& s, std::size_t i) { return s.psi[i] >= kFull; }
+
 // One Jacobi pass of "up one voxel", in place per column: the excess of
 // voxel z is computed from the values before the pass (z is read before it is
-// written, and the carry holds what z - 1 sent up).
+// written, and the carry holds what z - 1 sent up). Excess under a solid
+// body voxel stays where it is (bodies are solid, SPEC 5: soil never passes
+// through them); settle_overflow sends it sideways.
 void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
   for_each_dirty_column(g, dirty, [&](std::size_t c) {
@@ -83,7 +88,8 @@ void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
     for (int z = 0; z < g.nz; ++z) {
       const std::size_t i = c + z;
       const float r = s.rho[i];
-      const float ex = z + 1 < g.nz ? std::max(0.0f, r - room(s, i)) : 0.0f;
+      const bool up_open = z + 1 < g.nz && !solid(s, i + 1);
+      const float ex = up_open ? std::max(0.0f, r - room(s, i)) : 0.0f;
       if (ex == 0 && carry == 0) continue;
       const float u[3] = {s.ux[i], s.uy[i], s.uz[i]};
       const float kept = r - ex, now = kept + carry;
@@ -177,24 +183,106 @@ void resolve_overflow(SoilState& s, OverflowHeuristic h, int passes, const Colum
   }
 }
 
+namespace {
+
+// Settles one run [a, b) of open (not solid) voxels of a column: the excess
+// is carried up to the next room, and from the run's top back down into room
+// below; returns what found no room in the run (left in its top voxel).
+float settle_run(SoilState& s, std::size_t c, int a, int b) {
+  float carry = 0;
+  for (int z = a; z < b; ++z) {
+    float& r = s.rho[c + z];
+    r += carry;
+    carry = std::max(0.0f, r - room(s, c + z));
+    r -= carry;
+  }
+  for (int z = b - 1; z >= a && carry > 0; --z) {
+    float& r = s.rho[c + z];
+    const float take = std::min(carry, std::max(0.0f, room(s, c + z) - r));
+    r += take;
+    carry -= take;
+  }
+  if (carry > 0) s.rho[c + b - 1] += carry;
+  return carry;
+}
+
+// Sends the excess of voxel i sideways: a breadth-first walk from it through
+// open voxels (face neighbours, up first, then x, y, down), filling the room
+// it meets; deterministic (a fixed order, one voxel at a time).
+void spread_sideways(SoilState& s, std::size_t i) {
+  const terrain::Grid3Shape& g = s.shape;
+  float carry = s.rho[i] - room(s, i);
+  if (carry <= 0) return;
+  s.rho[i] -= carry;
+  std::vector<std::size_t> queue{i};
+  std::unordered_set<std::size_t> seen{i};
+  constexpr int kOff[6][3] = {{0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}};
+  for (std::size_t head = 0; head < queue.size() && carry > 0; ++head) {
+    const std::size_t v = queue[head];
+    const int z = static_cast<int>(v % g.nz), xy = static_cast<int>(v / g.nz);
+    const int x = xy % g.nx, y = xy / g.nx;
+    for (const auto& o : kOff) {
+      if (!g.contains(x + o[0], y + o[1], z + o[2])) continue;
+      const std::size_t n = g.index(x + o[0], y + o[1], z + o[2]);
+      if (solid(s, n) || !seen.insert(n).second) continue;
+      const float take = std::min(carry, std::max(0.0f, room(s, n) - s.rho[n]));
+      s.rho[n] += take;
+      carry -= take;
+      queue.push_back(n);
+    }
+  }
+  s.rho[i] += carry;  // nowhere to go in the whole open region: keep the mass
+}
+
+// Soil inside a solid body voxel (a body moved onto it faster than the
+// deformation pushed it out) goes to the nearest open voxel of its column,
+// the body's nearer face (upwards on a tie), never through to the far side.
+// Returns false if the column has no open voxel at all.
+bool expel_from_body(SoilState& s, std::size_t c, int nz) {
+  bool placed = true;
+  for (int z = 0; z < nz; ++z) {
+    if (!solid(s, c + z) || s.rho[c + z] <= 0) continue;
+    int up = z + 1, down = z - 1;
+    while (up < nz && solid(s, c + up)) ++up;
+    while (down >= 0 && solid(s, c + down)) --down;
+    const bool has_up = up < nz, has_down = down >= 0;
+    if (!has_up && !has_down) {
+      placed = false;
+      continue;
+    }
+    const int to = !has_down || (has_up && up - z <= z - down) ? up : down;
+    s.rho[c + to] += s.rho[c + z];
+    s.rho[c + z] = 0;
+  }
+  return placed;
+}
+
+}  // namespace
+
 void settle_overflow(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
+  std::vector<std::uint8_t> left(g.columns(), 0);  // columns with excess no run could hold
   for_each_dirty_column(g, dirty, [&](std::size_t c) {
-    float carry = 0;
-    for (int z = 0; z < g.nz; ++z) {
-      float& r = s.rho[c + z];
-      r += carry;
-      carry = std::max(0.0f, r - room(s, c + z));
-      r -= carry;
+    if (!expel_from_body(s, c, g.nz)) left[c / g.nz] = 1;
+    for (int a = 0; a < g.nz;) {
+      if (solid(s, c + a)) {
+        ++a;
+        continue;
+      }
+      int b = a;
+      while (b < g.nz && !solid(s, c + b)) ++b;
+      if (settle_run(s, c, a, b) > 0) left[c / g.nz] = 1;
+      a = b;
     }
-    for (int z = g.nz - 1; z >= 0 && carry > 0; --z) {
-      float& r = s.rho[c + z];
-      const float take = std::min(carry, std::max(0.0f, room(s, c + z) - r));
-      r += take;
-      carry -= take;
-    }
-    if (carry > 0) s.rho[c + g.nz - 1] += carry;  // a column full to the top: keep the mass
   });
+  // Rare (soil pressed between bodies, or under one against the floor), so
+  // sequential, in column order: the same bits on any thread count.
+  for (std::size_t col = 0; col < left.size(); ++col) {
+    if (!left[col]) continue;
+    const std::size_t c = col * g.nz;
+    for (int z = 0; z < g.nz; ++z)
+      if (s.rho[c + z] > room(s, c + z)) spread_sideways(s, c + z);
+  }
 }
 
 void apply_gravity(SoilState& s, double gravity, double dt) {

@@ -76,7 +76,10 @@ TEST(SoilCli, DemGroundFollowsTheDemUpToTheWindowsEdges) {
   drift::terrain::write_geotiff(drift::testing::dem_from(16, 10.0, 0.5, plane), d / "dem.tif");
   std::ofstream(d / "s.toml") << "[grid]\nsize = [0, 0, 40]\nvoxel = 2.5\n"
                                  "[terrain]\ndem = \"dem.tif\"\nwindow = [4, 5, 6, 4]\n"
-                                 "upsample = 4\ndepth = 5\n[simulation]\nsteps = 0\n";
+                                 "upsample = 4\ndepth = 5\n[simulation]\nsteps = 0\n"
+                                 // Some soil: a run without any is an error (no surface).
+                                 "[[soil_body]]\non_ground = true\nposition = [30, 20, 4]\n"
+                                 "[[soil_body.primitive]]\nshape = \"sphere\"\nradius = 6\n";
   ASSERT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.obj").string() + " --ground " +
                     (d / "ground.tif").string() + " --ground-margin 0",
                 d),
