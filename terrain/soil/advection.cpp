@@ -185,53 +185,48 @@ void resolve_overflow(SoilState& s, OverflowHeuristic h, int passes, const Colum
 
 namespace {
 
-// Settles one run [a, b) of open (not solid) voxels of a column: the excess
-// is carried up to the next room, and from the run's top back down into room
-// below; returns what found no room in the run (left in its top voxel).
-float settle_run(SoilState& s, std::size_t c, int a, int b) {
-  float carry = 0;
-  for (int z = a; z < b; ++z) {
-    float& r = s.rho[c + z];
-    r += carry;
-    carry = std::max(0.0f, r - room(s, c + z));
-    r -= carry;
-  }
-  for (int z = b - 1; z >= a && carry > 0; --z) {
-    float& r = s.rho[c + z];
-    const float take = std::min(carry, std::max(0.0f, room(s, c + z) - r));
-    r += take;
-    carry -= take;
-  }
-  if (carry > 0) s.rho[c + b - 1] += carry;
-  return carry;
-}
-
-// Sends the excess of voxel i sideways: a breadth-first walk from it through
-// open voxels (face neighbours, up first, then x, y, down), filling the room
-// it meets; deterministic (a fixed order, one voxel at a time).
-void spread_sideways(SoilState& s, std::size_t i) {
+// Sends `carry` of voxel i's excess to the nearest room: a breadth-first
+// walk from it through open voxels, face neighbours in a fixed order (up
+// first, then x, y; down only if `down`), filling the room it meets; returns
+// what found none. Nearest rather than straight up: the excess of a pile
+// pressed by a body grows the pile where its surface is nearest (a heap ahead
+// of a blade, windrows beside it) instead of a wall of soil climbing the
+// body's face to its top, from where it spilled into the blade's path.
+// Without downward steps it never passes under a body's cutting edge into
+// the room behind it.
+float route_excess(SoilState& s, std::size_t i, float carry, bool down) {
   const terrain::Grid3Shape& g = s.shape;
-  float carry = s.rho[i] - room(s, i);
-  if (carry <= 0) return;
-  s.rho[i] -= carry;
+  constexpr int kOff[6][3] = {{0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}};
+  constexpr std::size_t kMaxVisits = 1 << 16;
   std::vector<std::size_t> queue{i};
   std::unordered_set<std::size_t> seen{i};
-  constexpr int kOff[6][3] = {{0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}};
   for (std::size_t head = 0; head < queue.size() && carry > 0; ++head) {
     const std::size_t v = queue[head];
     const int z = static_cast<int>(v % g.nz), xy = static_cast<int>(v / g.nz);
     const int x = xy % g.nx, y = xy / g.nx;
-    for (const auto& o : kOff) {
+    for (int k = 0; k < (down ? 6 : 5) && carry > 0; ++k) {
+      const int* o = kOff[k];
       if (!g.contains(x + o[0], y + o[1], z + o[2])) continue;
       const std::size_t n = g.index(x + o[0], y + o[1], z + o[2]);
       if (solid(s, n) || !seen.insert(n).second) continue;
       const float take = std::min(carry, std::max(0.0f, room(s, n) - s.rho[n]));
       s.rho[n] += take;
       carry -= take;
-      queue.push_back(n);
+      if (queue.size() < kMaxVisits) queue.push_back(n);
     }
   }
-  s.rho[i] += carry;  // nowhere to go in the whole open region: keep the mass
+  return carry;
+}
+
+// Settles voxel i: its excess over its room goes to the nearest room,
+// upwards and sideways first, then also downwards; what finds none stays.
+void settle_voxel(SoilState& s, std::size_t i) {
+  float carry = s.rho[i] - room(s, i);
+  if (carry <= 0) return;
+  s.rho[i] -= carry;
+  carry = route_excess(s, i, carry, false);
+  if (carry > 0) carry = route_excess(s, i, carry, true);
+  s.rho[i] += carry;
 }
 
 // Soil inside a solid body voxel (a body moved onto it faster than the
@@ -261,27 +256,17 @@ bool expel_from_body(SoilState& s, std::size_t c, int nz) {
 
 void settle_overflow(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
-  std::vector<std::uint8_t> left(g.columns(), 0);  // columns with excess no run could hold
+  std::vector<std::uint8_t> over(g.columns(), 0);  // columns with excess somewhere
   for_each_dirty_column(g, dirty, [&](std::size_t c) {
-    if (!expel_from_body(s, c, g.nz)) left[c / g.nz] = 1;
-    for (int a = 0; a < g.nz;) {
-      if (solid(s, c + a)) {
-        ++a;
-        continue;
-      }
-      int b = a;
-      while (b < g.nz && !solid(s, c + b)) ++b;
-      if (settle_run(s, c, a, b) > 0) left[c / g.nz] = 1;
-      a = b;
-    }
+    expel_from_body(s, c, g.nz);
+    for (int z = 0; z < g.nz && !over[c / g.nz]; ++z)
+      over[c / g.nz] = s.rho[c + z] > room(s, c + z);
   });
-  // Rare (soil pressed between bodies, or under one against the floor), so
-  // sequential, in column order: the same bits on any thread count.
-  for (std::size_t col = 0; col < left.size(); ++col) {
-    if (!left[col]) continue;
-    const std::size_t c = col * g.nz;
-    for (int z = 0; z < g.nz; ++z)
-      if (s.rho[c + z] > room(s, c + z)) spread_sideways(s, c + z);
+  // Sequential, in column order and upwards (the walks write other columns):
+  // the same bits on any thread count. Only overflowed voxels walk.
+  for (std::size_t col = 0; col < over.size(); ++col) {
+    if (!over[col]) continue;
+    for (int z = 0; z < g.nz; ++z) settle_voxel(s, col * g.nz + z);
   }
 }
 
