@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <unordered_set>
 
 #include "terrain/soil/transport.h"
 
@@ -198,8 +197,10 @@ float route_excess(SoilState& s, std::size_t i, float carry, bool down) {
   const terrain::Grid3Shape& g = s.shape;
   constexpr int kOff[6][3] = {{0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}};
   constexpr std::size_t kMaxVisits = 1 << 16;
-  std::vector<std::size_t> queue{i};
-  std::unordered_set<std::size_t> seen{i};
+  std::vector<std::size_t>& queue = s.back.walk;
+  std::vector<std::uint8_t>& seen = s.back.visited;
+  queue.assign(1, i);
+  seen[i] = 1;
   for (std::size_t head = 0; head < queue.size() && carry > 0; ++head) {
     const std::size_t v = queue[head];
     const int z = static_cast<int>(v % g.nz), xy = static_cast<int>(v / g.nz);
@@ -208,13 +209,15 @@ float route_excess(SoilState& s, std::size_t i, float carry, bool down) {
       const int* o = kOff[k];
       if (!g.contains(x + o[0], y + o[1], z + o[2])) continue;
       const std::size_t n = g.index(x + o[0], y + o[1], z + o[2]);
-      if (solid(s, n) || !seen.insert(n).second) continue;
+      if (solid(s, n) || seen[n] || queue.size() >= kMaxVisits) continue;
+      seen[n] = 1;
+      queue.push_back(n);
       const float take = std::min(carry, std::max(0.0f, room(s, n) - s.rho[n]));
       s.rho[n] += take;
       carry -= take;
-      if (queue.size() < kMaxVisits) queue.push_back(n);
     }
   }
+  for (std::size_t v : queue) seen[v] = 0;
   return carry;
 }
 

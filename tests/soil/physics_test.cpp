@@ -102,7 +102,7 @@ TEST(SoilPhysics, SoilNeverPassesThroughABody) {
 // the ground behind it stays below the layer's top by at least half the
 // cut's depth along 90 % or more of its travel, with a heap ahead. Before:
 // 15 % with a 0.6 m blade (soil carried up through the blade and up its
-// face fell back into the path), 28 % with this 1.2 m one. (The 0.6 m blade
+// face fell back into the path), 53 % with this 1.2 m one. (The 0.6 m blade
 // stands only 0.38 m above the layer: the 0.79 m^3 it pushes, heaped at
 // 25 degrees before its 1.2 m width, stands about 0.7 m high, so it spills
 // over that blade whatever the model; a dozer's blade is 3-5 cuts tall.)
