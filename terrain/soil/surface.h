@@ -54,8 +54,11 @@ terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<fl
 terrain::Mesh soil_surface(const SoilState& state, const SurfaceOptions& options,
                            double moisture = 0.0);
 
-// Writes grids "density" (rho) and "collision" (psi) as fog volumes, voxel
-// size and origin in metres, atomically. Throws drift::Error naming the file.
-void write_density_vdb(const SoilState& state, const std::filesystem::path& path);
+// Writes grids "density" (rho), "collision" (psi) and "wetness" (`moisture`
+// where there is soil) as fog volumes and "velocity" (m/s, a vector grid),
+// voxel size and origin in metres, atomically; the same state gives the same
+// bytes. Throws drift::Error naming the file.
+void write_density_vdb(const SoilState& state, const std::filesystem::path& path,
+                       double moisture = 0.0);
 
 }  // namespace drift::soil

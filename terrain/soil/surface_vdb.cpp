@@ -103,21 +103,45 @@ terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>
   return mesh;
 }
 
-void write_density_vdb(const SoilState& s, const std::filesystem::path& path) {
+void write_density_vdb(const SoilState& s, const std::filesystem::path& path, double moisture) {
   init_openvdb();
   const terrain::Grid3Shape& g = s.shape;
   auto transform = openvdb::math::Transform::createLinearTransform(g.voxel_size);
   transform->postTranslate(openvdb::Vec3d(g.origin.x() + 0.5 * g.voxel_size,
                                           g.origin.y() + 0.5 * g.voxel_size,
                                           g.origin.z() + 0.5 * g.voxel_size));
+  // The wetness of the soil (thesis 5.3.4, for a renderer's wet coat): the
+  // scenario's moisture wherever there is soil.
+  std::vector<float> wetness(s.size(), 0.0f);
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.rho[i] > 0) wetness[i] = static_cast<float>(moisture);
   openvdb::GridPtrVec grids;
-  for (auto [name, field] : {std::pair{"density", &s.rho}, std::pair{"collision", &s.psi}}) {
+  for (auto [name, field] :
+       {std::pair{"density", &s.rho}, std::pair{"collision", &s.psi},
+        std::pair{"wetness", static_cast<const std::vector<float>*>(&wetness)}}) {
     openvdb::FloatGrid::Ptr grid = to_grid(g, *field, 1.0f);
     grid->setName(name);
     grid->setGridClass(openvdb::GRID_FOG_VOLUME);
     grid->setTransform(transform);
     grids.push_back(grid);
   }
+  // Velocity (m/s) where there is soil: "velocity" is the name Blender and
+  // Houdini read for motion blur.
+  openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  {
+    auto acc = velocity->getAccessor();
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x)
+        for (int z = 0; z < g.nz; ++z) {
+          const std::size_t i = g.index(x, y, z);
+          const openvdb::Vec3s v(s.ux[i], s.uy[i], s.uz[i]);
+          if (s.rho[i] > 0 && v != openvdb::Vec3s(0.0f)) acc.setValue(openvdb::Coord(x, y, z), v);
+        }
+  }
+  velocity->setName("velocity");
+  velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  velocity->setTransform(transform);
+  grids.push_back(velocity);
   AtomicFile out(path);
   try {
     openvdb::io::File file(out.temp_path().string());
