@@ -25,13 +25,28 @@ std::size_t slot(std::size_t column, int pile, int dir) {
   return (column * Slippage::kMaxPiles + pile) * Slippage::kDirections + dir;
 }
 
+// Largest drop (voxels) from a pile's bottom to a neighbour's pile that
+// still counts as one continuous slope of the ground rather than an edge.
+// A DEM or voxel terrain steeper than 45 degrees is a staircase of one-voxel
+// steps (more along a knight's run): with eq. 31's overlap alone, thin soil
+// on each step met its lower neighbour only through a zero-height edge span
+// at its own bottom, so only its thickness counted and it lay on the
+// mountainside as a blanket instead of sliding (issue 33, item 6). A
+// body's top (a block, a blade) stands higher above its neighbours and
+// keeps the thesis's edge span (fig. 35).
+constexpr float kGroundStep = 2.5f;
+
 // The lower pile of column n that pile p slides onto: the highest pile below
-// p's top that meets it (eq. 31, >= 0). -1 if none.
+// p's top that meets it (eq. 31, >= 0), or one at most kGroundStep below
+// p's bottom with nothing above it up to p's top. -1 if none.
 int lower_pile(const HeightSpan& p, const HeightSpan* n, int count) {
   int best = -1;
   for (int q = 0; q < count; ++q) {
     if (n[q].type != SpanType::Piled || n[q].top >= p.top) continue;
-    if (std::min(p.top, n[q].top) - std::max(p.bottom, n[q].bottom) >= 0) best = q;
+    const float above = q + 1 < count ? n[q + 1].bottom : 1e30f;
+    if (std::min(p.top, n[q].top) - std::max(p.bottom, n[q].bottom) >= 0 ||
+        (n[q].top >= p.bottom - kGroundStep && above >= p.top))
+      best = q;
   }
   return best;
 }

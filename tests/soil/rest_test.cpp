@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "terrain/soil/scenario.h"
 #include "terrain/soil/soil_slice.h"
 #include "tests/soil/soil_fixtures.h"
 
@@ -162,6 +163,49 @@ TEST(SoilRest, DrySandConeComesToRestRound) {
   std::printf(
       "dry sand cone: %.1f degrees, moved %.2g m over 10 s, half-height radius spread %.1f %%\n",
       angle, moved, 100 * spread);
+}
+
+// Soil on ground steeper than its friction angle slides down it and comes to
+// rest at the foot (issue 33, item 6): a 1.2 m layer of sandy loam over
+// x = 4-16 m of a 45-degree slope of a height-field terrain (1 m voxels, a
+// staircase of one-voxel steps; the foot at x = 20 m) gathers in a deposit
+// about the foot: its centroid moves from x = 10 to beyond 16 m and under
+// 5 % stays above x = 12 m. Before, each step's soil met its lower
+// neighbour only through a zero-height edge span, so only its thickness
+// counted: centroid 13.3 m, 33 % left as a blanket on the upper slope.
+TEST(SoilRest, SoilOnASteepSlopeSlidesToTheFoot) {
+  SoilScenario sc;
+  sc.name = "slope";
+  sc.shape = {40, 8, 30, 1.0, {0, 0, 0}};
+  sc.options = soil_options("sandy_loam", 0.05);
+  sc.terrain.kind = TerrainSource::Kind::HeightField;
+  sc.terrain.heights = terrain::HeightField(40, 8, 0.0f, terrain::local_georeference(1.0));
+  for (int row = 0; row < 8; ++row)
+    for (int x = 0; x < 40; ++x)
+      sc.terrain.heights(x, row) = static_cast<float>(2.0 + std::max(0.0, 20.0 - (x + 0.5)));
+  sc.soil.push_back(
+      {"layer", {{PrimitiveKind::Cuboid, {0, 0, 0.6}, {6.0, 4.0, 0.6}}}, {10.0, 4.0, 0.0}, true});
+  SoilSimulation sim = make_simulation(sc);
+  const double total = sim.state().mass();
+  ASSERT_GT(total, 50.0);
+  sim.run(600);  // 30 s
+  const SoilState& s = sim.state();
+  // Per column x: soil (voxels, summed over y).
+  std::vector<double> along(40, 0.0);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 40; ++x)
+      for (int z = 0; z < 30; ++z) along[x] += s.rho[s.shape.index(x, y, z)];
+  double upper = 0, centre = 0;
+  for (int x = 0; x < 40; ++x) {
+    if (x < 12) upper += along[x];
+    centre += along[x] * (x + 0.5) / total;
+    std::printf("%.0f ", along[x]);
+  }
+  std::printf(
+      "\nsoil on a 45 degree slope: centroid x %.1f m (was 10), %.1f %% left above x = 12 m\n",
+      centre, 100 * upper / total);
+  EXPECT_GT(centre, 16.0);
+  EXPECT_LT(upper / total, 0.05);
 }
 
 }  // namespace
