@@ -3,8 +3,12 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string_view>
+#include <vector>
 
+#include "terrain/error.h"
 #include "terrain/soil/advection.h"
 #include "tests/soil/soil_fixtures.h"
 
@@ -220,6 +224,34 @@ TEST(SoilPhysics, TracesOfSoilStayFinite) {
     ASSERT_TRUE(std::isfinite(s.rho[k]) && std::isfinite(s.ux[k]) && std::isfinite(s.uy[k]) &&
                 std::isfinite(s.uz[k]))
         << k;
+}
+
+// run_soil, the stage's time loop as a library call: progress 0 first and 1
+// last, monotone; frames every k steps; a progress that returns false
+// cancels (drift::Cancelled) and no further step runs.
+TEST(SoilPhysics, RunSoilReportsProgressFramesAndCancels) {
+  SoilSimulation sim = make_simulation(fixtures::pour_block_scenario(16));
+  std::vector<double> seen;
+  std::vector<int> frames;
+  SoilRunOptions o;
+  o.steps = 10;
+  o.frame_every = 4;
+  o.frame = [&](const SoilSimulation&, int step) { frames.push_back(step); };
+  const SoilRunStats stats = run_soil(sim, o, [&](double f, std::string_view) {
+    seen.push_back(f);
+    return true;
+  });
+  ASSERT_GE(seen.size(), 2u);
+  EXPECT_EQ(seen.front(), 0.0);
+  EXPECT_EQ(seen.back(), 1.0);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(frames, (std::vector<int>{4, 8}));
+  EXPECT_EQ(stats.steps, 10);
+  EXPECT_EQ(sim.steps(), 10);
+  EXPECT_NEAR(stats.mass_after / stats.mass_before, 1.0, 1e-6);
+  int calls = 0;
+  EXPECT_THROW(run_soil(sim, o, [&](double, std::string_view) { return ++calls < 3; }), Cancelled);
+  EXPECT_EQ(sim.steps(), 12);  // progress 0, then after steps 1 and 2: cancelled
 }
 
 // Same bits on 1, 2 and 4 threads (an arena of each size: TBB splits the rows
