@@ -1,7 +1,6 @@
 // drift soil SCENARIO.toml -o OUT.ply: voxel soil that pours, slides, piles
 // and is pushed, dug and lifted (paper 004, terrain/soil/simulation.h).
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -28,7 +27,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct SoilCommand {
-  std::string scenario, output, vdb, surface, collision, frames, soil_type, terrain, ground;
+  std::string scenario, output, vdb, surface, collision, frames, vdb_frames, soil_type, terrain,
+      ground;
   int ground_margin = 32;
   int steps = -1, frame_every = 10;
   // --phi, --cohesion, --gamma, --moisture (terrain/soil/soil_parameters.h):
@@ -77,8 +77,8 @@ std::vector<std::string> write_products(const SoilCommand& c, const soil::SoilSc
     wrote.push_back(c.collision + " (" + std::to_string(bodies.triangle_count()) + " triangles)");
   }
   if (!c.vdb.empty()) {
-    soil::write_density_vdb(state, c.vdb);
-    wrote.push_back(c.vdb + " (grids density, collision)");
+    soil::write_density_vdb(state, c.vdb, sc.options.soil.moisture);
+    wrote.push_back(c.vdb + " (grids density, collision, wetness, velocity)");
   }
   if (!c.surface.empty()) {
     terrain::HeightField top = soil::top_surface(
@@ -109,10 +109,12 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
                    "--ground raster of " + std::to_string(w) + " x " + std::to_string(h) + " cells",
                    "lower --ground-margin");
   }
-  if (!c.frames.empty() && !fs::is_directory(c.frames)) {
-    throw Error("--frames directory '" + c.frames + "' " +
-                (fs::exists(c.frames) ? "is not a directory; name a directory"
-                                      : "does not exist; create it first"));
+  for (const auto& [flag, dir] :
+       {std::pair{"--frames", &c.frames}, std::pair{"--vdb-frames", &c.vdb_frames}}) {
+    if (dir->empty() || fs::is_directory(*dir)) continue;
+    throw Error(std::string(flag) + " directory '" + *dir + "' " +
+                (fs::exists(*dir) ? "is not a directory; name a directory"
+                                  : "does not exist; create it first"));
   }
 
   // Frames are each complete when written; the products replace their files
@@ -123,34 +125,35 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
   soil::SoilSimulation sim = soil::make_simulation(sc);  // checks sizes and memory first
   const soil::SurfaceOptions surface{
       c.no_ridge_fix ? soil::RidgeFix::Off : soil::RidgeFix::StraightSlopes, 3, 0.0};
-  const double mass0 = sim.state().mass();
-  const ProgressFn progress = terminal_progress("soil");
-  const auto t0 = std::chrono::steady_clock::now();
-  progress(0.0, "simulating");
-  for (int step = 1; step <= sc.steps; ++step) {
-    sim.step();
-    if (!c.frames.empty() && step % c.frame_every == 0) {
+  soil::SoilRunOptions run;
+  run.steps = sc.steps;
+  if (!c.frames.empty() || !c.vdb_frames.empty()) {
+    run.frame_every = c.frame_every;
+    run.frame = [&](const soil::SoilSimulation& s, int step) {
       char name[32];
-      std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-      write_mesh(soil::soil_surface(sim.state(), surface, sc.options.soil.moisture),
-                 fs::path(c.frames) / name);
-    }
-    if (!progress(static_cast<double>(step) / std::max(1, sc.steps), "simulating"))
-      throw Cancelled();
+      if (!c.frames.empty()) {
+        std::snprintf(name, sizeof name, "frame_%05d.ply", step);
+        write_mesh(soil::soil_surface(s.state(), surface, sc.options.soil.moisture),
+                   fs::path(c.frames) / name);
+      }
+      if (!c.vdb_frames.empty()) {  // soil_00010.vdb, ...: a volume sequence
+        std::snprintf(name, sizeof name, "soil_%05d.vdb", step);
+        soil::write_density_vdb(s.state(), fs::path(c.vdb_frames) / name, sc.options.soil.moisture);
+      }
+    };
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  progress(1.0, "done");
+  const soil::SoilRunStats stats = soil::run_soil(sim, run, terminal_progress("soil"));
 
   const std::vector<std::string> wrote = write_products(c, sc, sim.state(), surface);
   outputs.commit();
   for (const std::string& line : wrote) std::printf("soil: wrote %s\n", line.c_str());
-  const double mass1 = sim.state().mass();
+  const double mass0 = stats.mass_before, mass1 = stats.mass_after;
   std::printf(
       "soil: %d steps of %dx%dx%d voxels (%.3g m) in %.2f s (%.1f steps/s); soil %.6g -> "
       "%.6g voxels (relative change %.2g)\n",
-      sc.steps, sc.shape.nx, sc.shape.ny, sc.shape.nz, sc.shape.voxel_size, seconds,
-      sc.steps / std::max(seconds, 1e-9), mass0, mass1, mass0 > 0 ? (mass1 - mass0) / mass0 : 0.0);
+      sc.steps, sc.shape.nx, sc.shape.ny, sc.shape.nz, sc.shape.voxel_size, stats.seconds,
+      sc.steps / std::max(stats.seconds, 1e-9), mass0, mass1,
+      mass0 > 0 ? (mass1 - mass0) / mass0 : 0.0);
 }
 
 }  // namespace
@@ -172,8 +175,12 @@ void add_soil_command(CLI::App& root) {
       ->check(CLI::IsMember({"dry_sand", "sandy_loam", "loam"}));
   c->parameters.add_to(*sub);
   sub->add_option("--frames", c->frames, "directory for a surface mesh every --frame-every steps");
+  sub->add_option("--vdb-frames", c->vdb_frames,
+                  "directory for an OpenVDB file (density, collision, wetness, velocity) every "
+                  "--frame-every steps, soil_NNNNN.vdb: a volume sequence for Blender, Houdini");
   sub->add_option("--frame-every", c->frame_every, "steps between frames")->capture_default_str();
-  sub->add_option("--vdb", c->vdb, "OpenVDB file of the density and collision grids");
+  sub->add_option("--vdb", c->vdb,
+                  "OpenVDB file of the density, collision, wetness and velocity grids");
   sub->add_option("--surface", c->surface,
                   "GeoTIFF of the top of the soil and what it rests on (m), georeferenced");
   sub->add_option("--collision", c->collision, "mesh of the terrain and bodies (iso-0.5 of psi)");

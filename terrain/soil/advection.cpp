@@ -73,9 +73,13 @@ void for_each_dirty_column(const terrain::Grid3Shape& g, const ColumnMask* dirty
   });
 }
 
+bool solid(const SoilState& s, std::size_t i) { return s.psi[i] >= kFull; }
+
 // One Jacobi pass of "up one voxel", in place per column: the excess of
 // voxel z is computed from the values before the pass (z is read before it is
-// written, and the carry holds what z - 1 sent up).
+// written, and the carry holds what z - 1 sent up). Excess under a solid
+// body voxel stays where it is (bodies are solid, SPEC 5: soil never passes
+// through them); settle_overflow sends it sideways.
 void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
   for_each_dirty_column(g, dirty, [&](std::size_t c) {
@@ -83,7 +87,8 @@ void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
     for (int z = 0; z < g.nz; ++z) {
       const std::size_t i = c + z;
       const float r = s.rho[i];
-      const float ex = z + 1 < g.nz ? std::max(0.0f, r - room(s, i)) : 0.0f;
+      const bool up_open = z + 1 < g.nz && !solid(s, i + 1);
+      const float ex = up_open ? std::max(0.0f, r - room(s, i)) : 0.0f;
       if (ex == 0 && carry == 0) continue;
       const float u[3] = {s.ux[i], s.uy[i], s.uz[i]};
       const float kept = r - ex, now = kept + carry;
@@ -177,24 +182,95 @@ void resolve_overflow(SoilState& s, OverflowHeuristic h, int passes, const Colum
   }
 }
 
-void settle_overflow(SoilState& s, const ColumnMask* dirty) {
+namespace {
+
+// Sends `carry` of voxel i's excess to the nearest room: a breadth-first
+// walk from it through open voxels, face neighbours in a fixed order (up
+// first, then x, y; down only if `down`), filling the room it meets; returns
+// what found none. Nearest rather than straight up: the excess of a pile
+// pressed by a body grows the pile where its surface is nearest (a heap ahead
+// of a blade, windrows beside it) instead of a wall of soil climbing the
+// body's face to its top, from where it spilled into the blade's path.
+// Without downward steps it never passes under a body's cutting edge into
+// the room behind it.
+float route_excess(SoilState& s, std::size_t i, float carry, bool down) {
   const terrain::Grid3Shape& g = s.shape;
-  for_each_dirty_column(g, dirty, [&](std::size_t c) {
-    float carry = 0;
-    for (int z = 0; z < g.nz; ++z) {
-      float& r = s.rho[c + z];
-      r += carry;
-      carry = std::max(0.0f, r - room(s, c + z));
-      r -= carry;
-    }
-    for (int z = g.nz - 1; z >= 0 && carry > 0; --z) {
-      float& r = s.rho[c + z];
-      const float take = std::min(carry, std::max(0.0f, room(s, c + z) - r));
-      r += take;
+  constexpr int kOff[6][3] = {{0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}};
+  constexpr std::size_t kMaxVisits = 1 << 16;
+  std::vector<std::size_t>& queue = s.back.walk;
+  std::vector<std::uint8_t>& seen = s.back.visited;
+  queue.assign(1, i);
+  seen[i] = 1;
+  for (std::size_t head = 0; head < queue.size() && carry > 0; ++head) {
+    const std::size_t v = queue[head];
+    const int z = static_cast<int>(v % g.nz), xy = static_cast<int>(v / g.nz);
+    const int x = xy % g.nx, y = xy / g.nx;
+    for (int k = 0; k < (down ? 6 : 5) && carry > 0; ++k) {
+      const int* o = kOff[k];
+      if (!g.contains(x + o[0], y + o[1], z + o[2])) continue;
+      const std::size_t n = g.index(x + o[0], y + o[1], z + o[2]);
+      if (solid(s, n) || seen[n] || queue.size() >= kMaxVisits) continue;
+      seen[n] = 1;
+      queue.push_back(n);
+      const float take = std::min(carry, std::max(0.0f, room(s, n) - s.rho[n]));
+      s.rho[n] += take;
       carry -= take;
     }
-    if (carry > 0) s.rho[c + g.nz - 1] += carry;  // a column full to the top: keep the mass
+  }
+  for (std::size_t v : queue) seen[v] = 0;
+  return carry;
+}
+
+// Settles voxel i: its excess over its room goes to the nearest room,
+// upwards and sideways first, then also downwards; what finds none stays.
+void settle_voxel(SoilState& s, std::size_t i) {
+  float carry = s.rho[i] - room(s, i);
+  if (carry <= 0) return;
+  s.rho[i] -= carry;
+  carry = route_excess(s, i, carry, false);
+  if (carry > 0) carry = route_excess(s, i, carry, true);
+  s.rho[i] += carry;
+}
+
+// Soil inside a solid body voxel (a body moved onto it faster than the
+// deformation pushed it out) goes to the nearest open voxel of its column,
+// the body's nearer face (upwards on a tie), never through to the far side.
+// Returns false if the column has no open voxel at all.
+bool expel_from_body(SoilState& s, std::size_t c, int nz) {
+  bool placed = true;
+  for (int z = 0; z < nz; ++z) {
+    if (!solid(s, c + z) || s.rho[c + z] <= 0) continue;
+    int up = z + 1, down = z - 1;
+    while (up < nz && solid(s, c + up)) ++up;
+    while (down >= 0 && solid(s, c + down)) --down;
+    const bool has_up = up < nz, has_down = down >= 0;
+    if (!has_up && !has_down) {
+      placed = false;
+      continue;
+    }
+    const int to = !has_down || (has_up && up - z <= z - down) ? up : down;
+    s.rho[c + to] += s.rho[c + z];
+    s.rho[c + z] = 0;
+  }
+  return placed;
+}
+
+}  // namespace
+
+void settle_overflow(SoilState& s, const ColumnMask* dirty) {
+  const terrain::Grid3Shape& g = s.shape;
+  std::vector<std::uint8_t> over(g.columns(), 0);  // columns with excess somewhere
+  for_each_dirty_column(g, dirty, [&](std::size_t c) {
+    expel_from_body(s, c, g.nz);
+    for (int z = 0; z < g.nz && !over[c / g.nz]; ++z)
+      over[c / g.nz] = s.rho[c + z] > room(s, c + z);
   });
+  // Sequential, in column order and upwards (the walks write other columns):
+  // the same bits on any thread count. Only overflowed voxels walk.
+  for (std::size_t col = 0; col < over.size(); ++col) {
+    if (!over[col]) continue;
+    for (int z = 0; z < g.nz; ++z) settle_voxel(s, col * g.nz + z);
+  }
 }
 
 void apply_gravity(SoilState& s, double gravity, double dt) {

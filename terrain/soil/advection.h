@@ -27,16 +27,21 @@ using ColumnMask = std::vector<std::uint8_t>;
 
 // `passes` Jacobi passes of the heuristic: the excess rho - (1 - psi) of each
 // overflowed voxel moves to the heuristic's neighbours that are inside the
-// grid and not solid rigid body (psi < 1). With `dirty`, "up" passes visit
-// only the columns it marks (the spreading heuristics visit every column).
+// grid and not solid rigid body (psi < 1); "up" keeps the excess of a voxel
+// under a solid one (soil never passes through a body). With `dirty`, "up"
+// passes visit only the columns it marks (the spreading heuristics visit
+// every column).
 void resolve_overflow(SoilState& state, OverflowHeuristic heuristic, int passes,
                       const ColumnMask* dirty = nullptr);
 
-// Guarantees eq. 17 after resolve_overflow: per column, bottom to top, any
-// excess is carried up to the next voxel with room (and from the top back
-// down into room below, should the column be full to the top). Soil never
-// stays inside a rigid body. Beyond the thesis, which accepted leftover
-// overflow; mass is unchanged. With `dirty`, only the columns it marks.
+// Guarantees eq. 17 after resolve_overflow without moving soil through a
+// body (SPEC 5): soil inside a solid body voxel goes to the nearer face of
+// the body in its column; per run of open voxels of a column, bottom to top,
+// any excess is carried up to the next voxel with room and from the run's
+// top back down; what a run cannot hold (soil pressed under a body) goes
+// sideways, breadth-first through open voxels to the nearest room. Beyond the
+// thesis, which accepted leftover overflow; mass is unchanged. With `dirty`,
+// only the columns it marks.
 void settle_overflow(SoilState& state, const ColumnMask* dirty = nullptr);
 
 // Eq. 29: u += g dt where rho > 0, u = 0 (and f = 0) where there is no soil.

@@ -1,6 +1,7 @@
 #include "terrain/soil/simulation.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "terrain/error.h"
@@ -72,6 +73,24 @@ void SoilSimulation::step() {
   apply_gravity(state_, options_.gravity, dt);
   if (options_.slippage) slippage_.step(state_, options_.soil, options_.gravity, dt);
   ++steps_;
+}
+
+SoilRunStats run_soil(SoilSimulation& sim, const SoilRunOptions& o, const ProgressFn& progress) {
+  SoilRunStats stats;
+  stats.mass_before = sim.state().mass();
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!progress(0.0, "simulating")) throw Cancelled();
+  for (int step = 1; step <= o.steps; ++step) {
+    sim.step();
+    if (o.frame && o.frame_every > 0 && step % o.frame_every == 0) o.frame(sim, step);
+    if (step < o.steps && !progress(static_cast<double>(step) / o.steps, "simulating"))
+      throw Cancelled();
+  }
+  stats.steps = o.steps;
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stats.mass_after = sim.state().mass();
+  if (!progress(1.0, "done")) throw Cancelled();
+  return stats;
 }
 
 void add_soil(SoilState& s, const std::vector<Primitive>& prims, const Eigen::Vector3d& pos) {

@@ -13,9 +13,11 @@
 // holds) and slippage (Li & Moshell slippage on).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
+#include "terrain/progress.h"
 #include "terrain/soil/advection.h"
 #include "terrain/soil/primitives.h"
 #include "terrain/soil/slippage.h"
@@ -71,6 +73,25 @@ class SoilSimulation {
   double time_ = 0;
   long steps_ = 0;
 };
+
+// The soil stage's time loop as one library call, like the other stages'
+// entry functions: `steps` steps of `sim`, handing every `frame_every`-th
+// state to `frame` (a mesh or VDB writer), progress 0 first and 1 last; a
+// progress that returns false cancels (drift::Cancelled).
+struct SoilRunOptions {
+  int steps = 600;
+  int frame_every = 0;  // 0: no frames
+  std::function<void(const SoilSimulation&, int step)> frame;
+};
+
+struct SoilRunStats {
+  int steps = 0;
+  double seconds = 0;                      // wall time of the steps (frames included)
+  double mass_before = 0, mass_after = 0;  // sum of rho, voxels
+};
+
+SoilRunStats run_soil(SoilSimulation& sim, const SoilRunOptions& options,
+                      const ProgressFn& progress = no_progress);
 
 // Adds soil where the union of `primitives` (at `position`) covers voxels,
 // up to the room the collision field leaves (rho + psi <= 1).

@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "terrain/soil/soil_slice.h"
@@ -11,21 +12,41 @@ namespace drift::soil {
 
 namespace {
 
-// Neighbour offsets, paired so that d ^ 1 is the opposite direction.
-constexpr int kDx[8] = {1, -1, 0, 0, 1, -1, 1, -1};
-constexpr int kDy[8] = {0, 0, 1, -1, 1, -1, -1, 1};
+// Neighbour offsets, paired so that d ^ 1 is the opposite direction: the 4
+// faces, the 4 diagonals, the 8 knight's moves.
+constexpr int kDx[16] = {1, -1, 0, 0, 1, -1, 1, -1, 2, -2, 1, -1, 2, -2, 1, -1};
+constexpr int kDy[16] = {0, 0, 1, -1, 1, -1, -1, 1, 1, -1, 2, -2, -1, 1, -2, 2};
+constexpr int kNear = 8;  // directions 0-7 are the adjacent columns
+constexpr float kSolid = 1.0f - 1e-5f;
+
+double run_of(int d) { return std::hypot(kDx[d], kDy[d]); }  // in voxels
 
 std::size_t slot(std::size_t column, int pile, int dir) {
   return (column * Slippage::kMaxPiles + pile) * Slippage::kDirections + dir;
 }
 
+// Largest drop (voxels) from a pile's bottom to a neighbour's pile that
+// still counts as one continuous slope of the ground rather than an edge.
+// A DEM or voxel terrain steeper than 45 degrees is a staircase of one-voxel
+// steps (more along a knight's run): with eq. 31's overlap alone, thin soil
+// on each step met its lower neighbour only through a zero-height edge span
+// at its own bottom, so only its thickness counted and it lay on the
+// mountainside as a blanket instead of sliding (issue 33, item 6). A
+// body's top (a block, a blade) stands higher above its neighbours and
+// keeps the thesis's edge span (fig. 35).
+constexpr float kGroundStep = 2.5f;
+
 // The lower pile of column n that pile p slides onto: the highest pile below
-// p's top that meets it (eq. 31, >= 0). -1 if none.
+// p's top that meets it (eq. 31, >= 0), or one at most kGroundStep below
+// p's bottom with nothing above it up to p's top. -1 if none.
 int lower_pile(const HeightSpan& p, const HeightSpan* n, int count) {
   int best = -1;
   for (int q = 0; q < count; ++q) {
     if (n[q].type != SpanType::Piled || n[q].top >= p.top) continue;
-    if (std::min(p.top, n[q].top) - std::max(p.bottom, n[q].bottom) >= 0) best = q;
+    const float above = q + 1 < count ? n[q + 1].bottom : 1e30f;
+    if (std::min(p.top, n[q].top) - std::max(p.bottom, n[q].bottom) >= 0 ||
+        (n[q].top >= p.bottom - kGroundStep && above >= p.top))
+      best = q;
   }
   return best;
 }
@@ -53,14 +74,19 @@ void remove_down(float* rho, int top, int floor, float amount) {
 }
 
 // Adds `amount` of soil from voxel `from` upwards into the room left by soil
-// and body; what finds no room stays in the top voxel (mass is kept).
+// and body, up to the first solid body voxel (soil never passes through a
+// body); what finds no room stays in the last open voxel (mass is kept; the
+// next step's settle sends it sideways).
 void add_up(float* rho, const float* psi, int from, int nz, float amount) {
-  for (int z = std::max(0, from); z < nz && amount > 0; ++z) {
+  int last = std::clamp(from, 0, nz - 1);
+  for (int z = last; z < nz && amount > 0; ++z) {
+    if (psi[z] >= kSolid && z > from) break;
+    last = z;
     const float put = std::min(amount, std::max(0.0f, 1.0f - psi[z] - rho[z]));
     rho[z] += put;
     amount -= put;
   }
-  if (amount > 0) rho[nz - 1] += amount;
+  if (amount > 0) rho[last] += amount;
 }
 
 }  // namespace
@@ -68,56 +94,179 @@ void add_up(float* rho, const float* psi, int from, int nz, float amount) {
 Slippage::Slippage(const terrain::Grid3Shape& shape)
     : shape_(shape),
       out_(shape.columns() * kMaxPiles * kDirections),
-      speed_(shape.columns() * kMaxPiles * kDirections, 0.0f) {}
+      speed_(shape.columns() * kMaxPiles * kDirections, 0.0f),
+      pile_span_(shape.columns() * kMaxPiles, -1),
+      down_(shape.columns() * kMaxPiles, -1),
+      up_(shape.columns() * kMaxPiles, -1),
+      toe_(shape.columns() * kMaxPiles),
+      crest_(shape.columns() * kMaxPiles),
+      hop_(shape.columns() * kMaxPiles),
+      rest_(shape.columns() * kMaxPiles, 0.0f) {}
 
 void Slippage::step(SoilState& state, const SoilType& soil, double gravity, double dt) {
   build_height_spans(shape_, state.rho, state.psi, spans_);
+  link_piles();
+  rest_angles(soil);
   compute_slices(soil, gravity, dt);
   apply(state);
 }
 
-void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
-  const SliceConstants k{shape_.voxel_size,
-                         soil.phi_deg * M_PI / 180.0,
-                         soil.effective_cohesion(),
-                         soil.gamma,
-                         gravity,
-                         dt,
-                         static_cast<float>(shape_.nz)};
-  tbb::parallel_for(0, shape_.ny, [&](int y) {
-    for (int x = 0; x < shape_.nx; ++x) {
-      const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
+double Slippage::rest_angle_of(std::size_t column, int pile) const {
+  const std::size_t node = column * kMaxPiles + pile;
+  return pile_span_[node] < 0 ? -1.0 : rest_[node];
+}
+
+void Slippage::link_piles() {
+  const int nx = shape_.nx, ny = shape_.ny;
+  tbb::parallel_for(0, ny, [&](int y) {
+    for (int x = 0; x < nx; ++x) {
+      const std::size_t col = static_cast<std::size_t>(y) * nx + x;
       const HeightSpan* spans = spans_.column(col);
-      const int count = spans_.count[col];
       int pile = 0;
-      for (int s = 0; s < count && pile < kMaxPiles; ++s) {
-        if (spans[s].type != SpanType::Piled) continue;
-        slide_pile(x, y, pile, spans[s], k);
-        ++pile;
-      }
-      for (; pile < kMaxPiles; ++pile)
-        for (int d = 0; d < kDirections; ++d) {
-          out_[slot(col, pile, d)] = Out{};
-          speed_[slot(col, pile, d)] = 0;
+      for (int s = 0; s < spans_.count[col] && pile < kMaxPiles; ++s)
+        if (spans[s].type == SpanType::Piled)
+          pile_span_[col * kMaxPiles + pile++] = static_cast<std::int8_t>(s);
+      for (; pile < kMaxPiles; ++pile) pile_span_[col * kMaxPiles + pile] = -1;
+    }
+  });
+  // The node of span s of column col, -1 if it is not one of its sliding piles.
+  auto node_of = [&](std::size_t col, int s) -> int {
+    for (int k = 0; k < kMaxPiles; ++k)
+      if (pile_span_[col * kMaxPiles + k] == s) return static_cast<int>(col * kMaxPiles + k);
+    return -1;
+  };
+  tbb::parallel_for(0, ny, [&](int y) {
+    for (int x = 0; x < nx; ++x) {
+      const std::size_t col = static_cast<std::size_t>(y) * nx + x;
+      for (int k = 0; k < kMaxPiles; ++k) {
+        const std::size_t node = col * kMaxPiles + k;
+        down_[node] = up_[node] = -1;
+        if (pile_span_[node] < 0) continue;
+        const HeightSpan& p = spans_.column(col)[pile_span_[node]];
+        double steepest_down = 0, steepest_up = 0;
+        for (int d = 0; d < kNear; ++d) {
+          const int ax = x + kDx[d], ay = y + kDy[d];
+          if (ax < 0 || ay < 0 || ax >= nx || ay >= ny) continue;
+          const std::size_t ncol = static_cast<std::size_t>(ay) * nx + ax;
+          const HeightSpan* n = spans_.column(ncol);
+          const int count = spans_.count[ncol];
+          // Down: only a pile that holds soil belongs to a slope and leads on.
+          const int q = p.soil >= kSlopeSoil ? lower_pile(p, n, count) : -1;
+          const int qn = q >= 0 ? node_of(ncol, q) : -1;
+          if (qn >= 0) {
+            const double slope = (p.top - n[q].top) / run_of(d);
+            if (slope > steepest_down) steepest_down = slope, down_[node] = qn;
+          }
+          // Up: a neighbour pile holding soil that would slide onto this one.
+          for (int s = 0; s < count; ++s) {
+            if (n[s].type != SpanType::Piled || n[s].soil < kSlopeSoil || n[s].top <= p.top)
+              continue;
+            const int jn = node_of(ncol, s);
+            if (jn < 0 ||
+                lower_pile(n[s], spans_.column(col), spans_.count[col]) != pile_span_[node])
+              continue;
+            const double slope = (n[s].top - p.top) / run_of(d);
+            if (slope > steepest_up) steepest_up = slope, up_[node] = jn;
+          }
         }
+      }
     }
   });
 }
 
+namespace {
+
+// Follows `link` to its end from every node by pointer doubling (the chains
+// strictly descend or ascend, so they end): end[i] = the last node of i's
+// chain. Parallel rounds over double buffers: the same result on any thread
+// count.
+void chain_ends(const std::vector<int>& link, std::vector<int>& end, std::vector<int>& scratch) {
+  const std::size_t n = link.size();
+  tbb::parallel_for(std::size_t{0}, n,
+                    [&](std::size_t i) { end[i] = link[i] >= 0 ? link[i] : static_cast<int>(i); });
+  for (;;) {
+    std::atomic<bool> changed{false};
+    tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+      scratch[i] = end[end[i]];
+      if (scratch[i] != end[i]) changed.store(true, std::memory_order_relaxed);
+    });
+    end.swap(scratch);
+    if (!changed) return;
+  }
+}
+
+}  // namespace
+
+void Slippage::rest_angles(const SoilType& soil) {
+  std::vector<int> scratch(toe_.size());
+  chain_ends(down_, toe_, scratch);
+  chain_ends(up_, crest_, scratch);
+  const double h = shape_.voxel_size, phi = soil.phi_deg * M_PI / 180.0;
+  const double c = soil.effective_cohesion();
+  auto top = [&](std::size_t node) {
+    return spans_.column(node / kMaxPiles)[pile_span_[node]].top;
+  };
+  tbb::parallel_for(std::size_t{0}, rest_.size(), [&](std::size_t i) {
+    if (pile_span_[i] < 0) return;
+    const HeightSpan& p = spans_.column(i / kMaxPiles)[pile_span_[i]];
+    // The slope's real height: crest to toe, at least the pile's own height.
+    const double rise = std::max(top(crest_[i]) - top(toe_[i]), p.top - p.bottom) * h;
+    rest_[i] = static_cast<float>(rest_angle(rise, c, phi, soil.gamma));
+  });
+}
+
+void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
+  const SliceConstants k{shape_.voxel_size, soil.gamma, gravity, dt, static_cast<float>(shape_.nz)};
+  tbb::parallel_for(0, shape_.ny, [&](int y) {
+    for (int x = 0; x < shape_.nx; ++x) {
+      const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
+      for (int pile = 0; pile < kMaxPiles; ++pile) {
+        const int s = pile_span_[col * kMaxPiles + pile];
+        if (s >= 0) {
+          slide_pile(x, y, pile, spans_.column(col)[s], k);
+          continue;
+        }
+        for (int d = 0; d < kDirections; ++d) {
+          out_[slot(col, pile, d)] = Out{};
+          speed_[slot(col, pile, d)] = 0;
+        }
+      }
+    }
+  });
+}
+
+bool Slippage::open_path(int x, int y, int d, const HeightSpan& p) const {
+  const int sx = kDx[d] > 0 ? 1 : -1, sy = kDy[d] > 0 ? 1 : -1;
+  const bool along_x = std::abs(kDx[d]) == 2;
+  const int cross[2][2] = {{x + sx, along_x ? y : y + sy}, {along_x ? x + sx : x, y + sy}};
+  for (const auto& c : cross) {
+    const std::size_t col = static_cast<std::size_t>(c[1]) * shape_.nx + c[0];
+    const HeightSpan* n = spans_.column(col);
+    const int count = spans_.count[col];
+    const int q = lower_pile(p, n, count);
+    if (q < 0) return false;
+    const float ceiling = q + 1 < count ? n[q + 1].bottom : static_cast<float>(shape_.nz);
+    if (ceiling < p.top) return false;
+  }
+  return true;
+}
+
 void Slippage::slide_pile(int x, int y, int pile, const HeightSpan& p, const SliceConstants& k) {
   const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
+  const double rest = rest_[col * kMaxPiles + pile];
   double total = 0;
   for (int d = 0; d < kDirections; ++d) {
     Out& o = out_[slot(col, pile, d)];
     float& v = speed_[slot(col, pile, d)];
     o = Out{};
     const int nx = x + kDx[d], ny = y + kDy[d];
-    if (nx < 0 || ny < 0 || nx >= shape_.nx || ny >= shape_.ny) {
+    if (nx < 0 || ny < 0 || nx >= shape_.nx || ny >= shape_.ny ||
+        (d >= kNear && !open_path(x, y, d, p))) {
       v = 0;
       continue;
     }
     const std::size_t ncol = static_cast<std::size_t>(ny) * shape_.nx + nx;
-    slide_slice(p, spans_.column(ncol), spans_.count[ncol], d, k, o, v);
+    slide_slice(p, spans_.column(ncol), spans_.count[ncol], d, rest, k, o, v);
     total += o.dh;
   }
   // A pile cannot give more soil than it holds.
@@ -127,7 +276,7 @@ void Slippage::slide_pile(int x, int y, int pile, const HeightSpan& p, const Sli
   }
 }
 
-void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d,
+void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d, double rest,
                            const SliceConstants& k, Out& o, float& v) const {
   float low_top, ceiling;
   const int q = lower_pile(p, n, ncount);
@@ -148,17 +297,19 @@ void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount,
     return;
   }
   const double h = k.voxel;
-  const float rise = std::min(p.top, ceiling) - low_top;
-  const double dx = h * ((d < 4) ? 1.0 : M_SQRT2);
-  const auto theta = failure_plane(rise * h, dx, k.cohesion, k.phi, k.gamma);
-  if (!theta) {
+  const double rise = (std::min(p.top, ceiling) - low_top) * h;  // m
+  const double dx = h * run_of(d);
+  // Fails above its rest angle; once stopped, only above the static one.
+  const double margin = (v > 0 ? kStopDeg : kStaticDeg) * M_PI / 180.0;
+  const double wedge = rise - std::tan(rest) * dx;  // above the rest plane, m
+  if (!(rise > 0) || std::atan2(rise, dx) <= rest + margin || (v > 0 && wedge <= kStopHeight)) {
     v = 0;
     return;
   }
-  const double w = wedge_weight(rise * h, dx, *theta, k.gamma);
-  v += static_cast<float>(k.gravity * net_force(rise * h, dx, *theta, k.gamma) / w * k.dt);
+  const double w = wedge_weight(rise, dx, rest, k.gamma);
+  v += static_cast<float>(k.gravity * net_force(rise, dx, rest, k.gamma) / w * k.dt);
   const double share = std::min(kMaxShare, v * k.dt / dx);  // eq. 10's v dt / dx
-  o.dh = static_cast<float>((rise * h - std::tan(*theta) * dx) * share / h);
+  o.dh = static_cast<float>(wedge * share / h);
 }
 
 void Slippage::apply(SoilState& state) const {
@@ -171,13 +322,12 @@ void Slippage::apply(SoilState& state) const {
       const HeightSpan* spans = spans_.column(col);
       const int count = spans_.count[col];
       float net[HeightSpans::kMaxSpans] = {};
-      int pile = 0;
-      for (int s = 0; s < count && pile < kMaxPiles; ++s) {
-        if (spans[s].type != SpanType::Piled) continue;
+      for (int pile = 0; pile < kMaxPiles; ++pile) {
+        const int s = pile_span_[col * kMaxPiles + pile];
+        if (s < 0) continue;
         for (int d = 0; d < kDirections; ++d) net[s] -= out_[slot(col, pile, d)].dh;
-        ++pile;
       }
-      // What the 8 neighbours send here, in a fixed order.
+      // What the 16 neighbours send here, in a fixed order.
       float edge[kDirections * kMaxPiles];
       int edge_voxel[kDirections * kMaxPiles];
       int edges = 0;

@@ -1,18 +1,35 @@
 // Soil slippage on the multi-level heightfield (paper 004, sec. 3.2.3, with
 // Li & Moshell's slices, sec. 2.1.2).
 //
-// Every piled span meets the piled spans of its 8 neighbouring columns
-// (diagonals at sqrt(2) voxels, so that cones come out round rather than
-// square) in soil slices: two piles with a non-negative intersection of
-// heights (eq. 31, zero admitted so that soil slides across a body's top onto a
-// pile level with it), rise h = min(T_high, B_next above the low pile) -
-// T_low (eq. 32). A pile resting on a body with no span beside its bottom
-// gets an edge span of zero height there (fig. 34-35), so its soil slides off
-// and falls. Each slice with a failure plane (eq. 4) accelerates its wedge
-// (eqs. 8-9, a = g f / W) and moves eq. 10's height from the higher pile to
-// the lower; the slice's speed is kept from step to step and reset when it is
-// stable. Each pile's net change is applied to its density column from its
-// top voxel (fig. 36): removed downwards, added upwards.
+// Every piled span meets the piled spans of 16 neighbouring columns in soil
+// slices: the 8 around it (diagonals at sqrt(2) voxels) and the 8 a knight's
+// move away (sqrt(5) voxels), so that the slopes' lattice metric is within
+// 3 % of the Euclidean one and cones come out round (with 8 directions a
+// collapsed column rests as an octagonal pyramid whose half-height radius
+// varies 8-18 % with direction). Two piles form a slice with a non-negative
+// intersection of heights (eq. 31, zero admitted so that soil slides across
+// a body's top onto a pile level with it), rise h = min(T_high, B_next above
+// the low pile) - T_low (eq. 32). A knight's slice needs the two columns it
+// crosses to be open between the two piles (soil never hops through a body).
+// A pile resting on a body with no span beside its bottom gets an edge span
+// of zero height there (fig. 34-35), so its soil slides off and falls.
+//
+// Failure (SPEC 5, decisions where the thesis is silent): Li & Moshell's
+// factor of safety is taken over the pile's real height in metres, not over
+// one voxel's step, so cohesion acts the same at any voxel size. Each pile
+// follows its steepest descent to the toe of its slope (the first pile
+// without soil, or a flat) and its steepest ascent to the crest; the slope
+// height H = crest - toe gives the steepest angle the slope stands at
+// (rest_angle, Culmann's wedge: phi without cohesion, vertical below the
+// critical height 4 c / gamma tan(45 + phi / 2)). A slice whose slope is
+// steeper fails on the plane at that angle: the wedge above it accelerates
+// (eqs. 8-9, a = g f / W) and eq. 10's height moves from the higher pile to
+// the lower; the slice's speed is kept from step to step. A sliding slice
+// stops once its slope is within kStopDeg of the rest angle (or its wedge is
+// under kStopHeight thick); a slice at rest starts again only kStaticDeg above it (static
+// friction), so piles come to rest instead of creeping for ever. Each pile's net change is applied
+// to its density column from its top voxel (fig. 36): removed downwards, added upwards into open
+// voxels (never through a body).
 //
 // Each slice is computed once, by its higher column, and the lower column
 // gathers what it receives, so the same bits come out on any thread count and
@@ -30,10 +47,23 @@ namespace drift::soil {
 class Slippage {
  public:
   static constexpr int kMaxPiles = 4;  // per column that can slide; higher piles stay put
-  static constexpr int kDirections = 8;
-  // Largest share of a wedge one slice moves in a step: 8 slices may drain a
+  static constexpr int kDirections = 16;
+  // Largest share of a wedge one slice moves in a step: 16 slices may drain a
   // pile at once, and together they must not take it below its neighbours.
-  static constexpr double kMaxShare = 0.125;
+  static constexpr double kMaxShare = 1.0 / kDirections;
+  // Static friction: the angle of maximum stability of a granular slope lies
+  // about 2 degrees above its angle of repose (Jaeger, Nagel & Behringer 1996,
+  // "Granular solids, liquids, and gases", Rev. Mod. Phys. 68, sec. III).
+  static constexpr double kStaticDeg = 2.0;
+  // A sliding slice stops this close to its rest angle, or once the wedge
+  // above the rest plane is thinner than kStopHeight metres: otherwise the
+  // wedges of a whole flank feed one another, shrink geometrically and never
+  // reach it (the creep of issue 33: moved soil halving every 5 s).
+  static constexpr double kStopDeg = 0.5;
+  static constexpr double kStopHeight = 0.002;
+  // Soil (voxels) a pile needs to count as part of a slope; the toe of a
+  // slope is the first pile below it with less.
+  static constexpr float kSlopeSoil = 0.02f;
 
   explicit Slippage(const terrain::Grid3Shape& shape);
 
@@ -41,6 +71,9 @@ class Slippage {
   void step(SoilState& state, const SoilType& soil, double gravity, double dt);
 
   const HeightSpans& spans() const { return spans_; }
+  // Rest angle (radians) of pile `pile` of column `column` from the last step
+  // (-1 if the column has no such pile).
+  double rest_angle_of(std::size_t column, int pile) const;
 
  private:
   struct Out {
@@ -48,24 +81,34 @@ class Slippage {
     std::int16_t target = -1;  // span index in the neighbour column; -1 edge span
     std::int16_t edge_voxel = -1;
   };
-  // What every slice of a step shares: voxel size (m), friction angle (rad),
-  // effective cohesion, unit weight, gravity, time step and the grid's top.
+  // What every slice of a step shares: voxel size (m), unit weight, gravity,
+  // time step and the grid's top.
   struct SliceConstants {
-    double voxel, phi, cohesion, gamma, gravity, dt;
+    double voxel, gamma, gravity, dt;
     float grid_top;
   };
+  // Per pile ("node" = column * kMaxPiles + pile): its span, the neighbours
+  // of steepest descent and ascent, and from them the rest angle.
+  void link_piles();
+  void rest_angles(const SoilType& soil);
   void compute_slices(const SoilType& soil, double gravity, double dt);
-  // The slices of pile `pile` (span p) of column (x, y) towards its 8 neighbours.
+  // The slices of pile `pile` (span p) of column (x, y) towards its 16 neighbours.
   void slide_pile(int x, int y, int pile, const HeightSpan& p, const SliceConstants& k);
   // One slice from pile p to the column n along direction d: o.dh and the speed v.
-  void slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d,
+  void slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d, double rest,
                    const SliceConstants& k, Out& o, float& v) const;
+  // A knight's slice from (x, y) along d crosses two columns: both must hold
+  // a pile below p's top with nothing solid between it and p's top.
+  bool open_path(int x, int y, int d, const HeightSpan& p) const;
   void apply(SoilState& state) const;
 
   terrain::Grid3Shape shape_;
   HeightSpans spans_;
-  std::vector<Out> out_;      // columns x kMaxPiles x kDirections
-  std::vector<float> speed_;  // same layout: slice speeds, m/s
+  std::vector<Out> out_;                            // columns x kMaxPiles x kDirections
+  std::vector<float> speed_;                        // same layout: slice speeds, m/s
+  std::vector<std::int8_t> pile_span_;              // per node: span index, -1 none
+  std::vector<int> down_, up_, toe_, crest_, hop_;  // per node
+  std::vector<float> rest_;                         // per node: rest angle, rad
 };
 
 }  // namespace drift::soil

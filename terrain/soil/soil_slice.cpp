@@ -1,5 +1,6 @@
 #include "terrain/soil/soil_slice.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace drift::soil {
@@ -23,6 +24,15 @@ std::optional<double> failure_plane(double h, double dx, double c, double phi, d
   const double theta = 0.5 * (beta + phi - std::acos(q));
   if (theta < 0 || theta >= beta) return std::nullopt;
   return theta;
+}
+
+double rest_angle(double height, double c, double phi, double gamma) {
+  if (!(c > 0)) return phi;
+  if (!(height > 0)) return M_PI / 2;
+  const double k = 4.0 * c * std::cos(phi) / (gamma * height);
+  const double a = std::cos(phi), b = std::sin(phi) + k;
+  const double r = std::hypot(a, b);
+  return std::min(M_PI / 2, std::atan2(b, a) + std::acos(std::min(1.0, 1.0 / r)));
 }
 
 double net_force(double h, double dx, double theta, double gamma) {

@@ -31,6 +31,20 @@ double factor_of_safety(double h, double dx, double theta, double c, double phi,
 // the failure plane. Cohesionless soil (c = 0) fails on theta = phi.
 std::optional<double> failure_plane(double h, double dx, double c, double phi, double gamma);
 
+// The steepest angle (radians) at which a slope of real height `height` (m)
+// stands: Li & Moshell's failure test (eq. 4) applied to the whole slope,
+// a wedge of rise H and run H / tan(beta), rather than to one voxel's step.
+// failure_plane(H, H / tan(beta), ...) finds no plane exactly when
+//   H <= 4 c / gamma * sin(beta) cos(phi) / (1 - cos(beta - phi))
+// (Culmann's critical height; at beta = 90 degrees Terzaghi's
+// 4 c / gamma tan(45 + phi / 2)). Solved for beta: with
+// k = 4 c cos(phi) / (gamma H), cos(beta) cos(phi) + sin(beta) (sin(phi) + k) = 1,
+// beta = atan2(sin(phi) + k, cos(phi)) + acos(1 / R), R the norm of
+// (cos(phi), sin(phi) + k). phi for c = 0, pi / 2 once H is below the
+// critical height of a vertical cut. In metres, so the same heap settles the
+// same at any voxel size (SPEC 5, decisions).
+double rest_angle(double height, double c, double phi, double gamma);
+
 // Eq. 8: net force on the wedge sliding above the plane at theta (Li &
 // Moshell's infinitesimal dovetails), t per metre.
 double net_force(double h, double dx, double theta, double gamma);

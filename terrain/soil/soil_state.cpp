@@ -4,7 +4,7 @@
 
 namespace drift::soil {
 
-// 9 fields in the state, 8 back buffers for the passes, one accept byte.
+// 9 fields in the state, 8 back buffers for the passes, one byte the settle's walks mark.
 std::uint64_t soil_state_bytes(const terrain::Grid3Shape& shape) {
   return static_cast<std::uint64_t>(shape.count()) * (17 * sizeof(float) + 1);
 }
@@ -23,7 +23,7 @@ SoilState::SoilState(const terrain::Grid3Shape& s) : shape(s) {
   for (auto* f : {&rho, &ux, &uy, &uz, &fx, &fy, &fz, &psi, &psi_static, &back.rho, &back.ux,
                   &back.uy, &back.uz, &back.fx, &back.fy, &back.fz, &back.moving})
     f->assign(n, 0.0f);
-  back.accept.assign(n, 0);
+  back.visited.assign(n, 0);
 }
 
 void SoilState::swap_back() {

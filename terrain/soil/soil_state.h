@@ -25,7 +25,8 @@ struct SoilState {
   // Back buffers the passes write before swapping, and per-voxel scratch.
   struct Back {
     std::vector<float> rho, ux, uy, uz, fx, fy, fz, moving;
-    std::vector<std::uint8_t> accept;
+    std::vector<std::uint8_t> visited;  // the settle's walks: voxels seen (cleared after each)
+    std::vector<std::size_t> walk;      // and their queue
   } back;
 
   // Allocates every field, zeroed. Checks the size against the memory

@@ -12,12 +12,18 @@ namespace drift::soil {
 
 namespace {
 
-// Reshapes one column's piles (see surface.h).
-void straighten_column(const HeightSpan* spans, int count, int nz, int ramp, const float* rho,
-                       float* out) {
+// Reshapes one column's piles (see surface.h). Only piles that hold soil: a
+// bare pile (ground, a body's top) would get a ramp of density at its top
+// and so a phantom sheet of soil over every body and terrain voxel. The one
+// exception is a pile's foot: bare floor beside soil on the floor keeps its
+// ramp (`foot`), which with the pad row under the floor lets the surface run
+// down into the ground at the pile's edge instead of ending in a step.
+void straighten_column(const HeightSpan* spans, int count, int nz, int ramp, bool foot,
+                       const float* rho, float* out) {
   for (int s = 0; s < count; ++s) {
     const HeightSpan& p = spans[s];
     if (p.type != SpanType::Piled) continue;
+    if (!holds_soil(p) && !(foot && s == 0 && p.bottom == 0.0f)) continue;
     const int floor = std::max(0, static_cast<int>(std::floor(p.bottom)));
     int ceiling = nz;  // first voxel of the next span
     if (s + 1 < count) ceiling = std::min(nz, static_cast<int>(std::floor(spans[s + 1].bottom)));
@@ -30,42 +36,18 @@ void straighten_column(const HeightSpan* spans, int count, int nz, int ramp, con
   }
 }
 
-}  // namespace
-
-std::vector<float> surface_density(const SoilState& s, const SurfaceOptions& o) {
-  std::vector<float> out = s.rho;
-  if (o.ridges == RidgeFix::Off) return out;
-  const terrain::Grid3Shape& g = s.shape;
-  const int ramp = std::clamp(o.ramp_voxels, 1, 16);
-  tbb::parallel_for(0, g.ny, [&](int y) {
-    HeightSpan spans[HeightSpans::kMaxSpans];
-    for (int x = 0; x < g.nx; ++x) {
-      const std::size_t c = g.column(x, y);
-      const int n = build_column_spans(s.rho.data() + c, s.psi.data() + c, g.nz, spans,
-                                       HeightSpans::kMaxSpans);
-      straighten_column(spans, n, g.nz, ramp, s.rho.data() + c, out.data() + c);
-    }
-  });
-  return out;
-}
-
-namespace {
-
 // Height (voxels) of the soil a column's floor pile holds; 0 for bare
-// ground, -1 where the column stands on a body (no floor pile).
+// ground (or a trace), -1 where the column stands on a body (no floor pile).
 float floor_pile_top(const float* rho, const float* psi, int nz) {
   HeightSpan spans[HeightSpans::kMaxSpans];
   const int n = build_column_spans(rho, psi, nz, spans, HeightSpans::kMaxSpans);
   if (n == 0 || psi[0] > 0 || spans[0].type != SpanType::Piled) return -1.0f;
-  return spans[0].bottom == 0.0f ? std::max(0.0f, spans[0].top) : -1.0f;
+  if (spans[0].bottom != 0.0f) return -1.0f;
+  return holds_soil(spans[0]) ? std::max(0.0f, spans[0].top) : 0.0f;
 }
 
-// The pad row under the floor: the ramp of surface.h carried on half a voxel
-// below the floor, for columns holding soil on the floor and for the bare
-// columns beside them (as if their top lay a quarter voxel under the floor,
-// so the soil's surface runs on down into the ground instead of ending in a
-// rim); 0 elsewhere.
-std::vector<float> floor_pads(const SoilState& s, int ramp) {
+// floor_pile_top of every column (y * nx + x).
+std::vector<float> floor_pile_tops(const SoilState& s) {
   const terrain::Grid3Shape& g = s.shape;
   std::vector<float> top(g.columns());
   tbb::parallel_for(0, g.ny, [&](int y) {
@@ -75,6 +57,49 @@ std::vector<float> floor_pads(const SoilState& s, int ramp) {
           floor_pile_top(s.rho.data() + c, s.psi.data() + c, g.nz);
     }
   });
+  return top;
+}
+
+// True if a column beside (x, y) holds soil on the floor (`top` > 0).
+bool beside_floor_soil(const std::vector<float>& top, const terrain::Grid3Shape& g, int x, int y) {
+  for (int ny = std::max(0, y - 1); ny <= std::min(g.ny - 1, y + 1); ++ny)
+    for (int nx = std::max(0, x - 1); nx <= std::min(g.nx - 1, x + 1); ++nx)
+      if (top[static_cast<std::size_t>(ny) * g.nx + nx] > 0) return true;
+  return false;
+}
+
+}  // namespace
+
+std::vector<float> surface_density(const SoilState& s, const SurfaceOptions& o) {
+  std::vector<float> out = s.rho;
+  if (o.ridges == RidgeFix::Off) return out;
+  const terrain::Grid3Shape& g = s.shape;
+  const int ramp = std::clamp(o.ramp_voxels, 1, 16);
+  const std::vector<float> top = floor_pile_tops(s);
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    HeightSpan spans[HeightSpans::kMaxSpans];
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t c = g.column(x, y);
+      const int n = build_column_spans(s.rho.data() + c, s.psi.data() + c, g.nz, spans,
+                                       HeightSpans::kMaxSpans);
+      const bool foot =
+          top[static_cast<std::size_t>(y) * g.nx + x] == 0.0f && beside_floor_soil(top, g, x, y);
+      straighten_column(spans, n, g.nz, ramp, foot, s.rho.data() + c, out.data() + c);
+    }
+  });
+  return out;
+}
+
+namespace {
+
+// The pad row under the floor: the ramp of surface.h carried on half a voxel
+// below the floor, for columns holding soil on the floor and for the bare
+// columns beside them (as if their top lay a quarter voxel under the floor,
+// so the soil's surface runs on down into the ground instead of ending in a
+// rim); 0 elsewhere.
+std::vector<float> floor_pads(const SoilState& s, int ramp) {
+  const terrain::Grid3Shape& g = s.shape;
+  const std::vector<float> top = floor_pile_tops(s);
   auto ramp_at = [ramp](float t) {
     return std::clamp(0.5f + (t + 0.5f) / (2.0f * ramp), 0.f, 1.f);
   };
@@ -84,10 +109,7 @@ std::vector<float> floor_pads(const SoilState& s, int ramp) {
       const float t = top[static_cast<std::size_t>(y) * g.nx + x];
       float& out = pad[static_cast<std::size_t>(y) * g.nx + x];
       if (t > 0) out = ramp_at(t);
-      if (t != 0) continue;  // soil, or a body on the floor
-      for (int ny = std::max(0, y - 1); ny <= std::min(g.ny - 1, y + 1); ++ny)
-        for (int nx = std::max(0, x - 1); nx <= std::min(g.nx - 1, x + 1); ++nx)
-          if (top[static_cast<std::size_t>(ny) * g.nx + nx] > 0) out = ramp_at(-0.25f);
+      if (t == 0 && beside_floor_soil(top, g, x, y)) out = ramp_at(-0.25f);
     }
   });
   return pad;

@@ -11,19 +11,29 @@
 // centres, R = ramp_voxels): linear in z with d = 0.5 exactly at T, and
 // linear between neighbouring columns at the same z, so the 0.5 crossings lie
 // on the straight line joining the column tops for slopes up to R voxels per
-// voxel. Only piles are reshaped (within their own voxels and the air up to
-// the next span); falling soil keeps its density.
+// voxel. Only piles that hold soil (kMinSurfaceSoil) are reshaped (within
+// their own voxels and the air up to the next span); falling soil keeps its
+// density, and bare ground and bare bodies stay without soil, so a scenario
+// without soil has no soil surface.
 #pragma once
 
 #include <filesystem>
 #include <vector>
 
 #include "terrain/mesh.h"
+#include "terrain/soil/height_spans.h"
 #include "terrain/soil/soil_state.h"
 
 namespace drift::soil {
 
 enum class RidgeFix { Off, StraightSlopes };
+
+// Soil (voxels, sum of rho) a pile must hold for the ridge fix to reshape it:
+// a trace left by soil running thin is below half a voxel in every voxel and
+// so has no surface without the fix; with it, it would become a sheet lying
+// on the ground (z-fighting flecks on bodies and terrain).
+inline constexpr float kMinSurfaceSoil = 0.05f;
+inline bool holds_soil(const HeightSpan& pile) { return pile.soil >= kMinSurfaceSoil; }
 
 struct SurfaceOptions {
   RidgeFix ridges = RidgeFix::StraightSlopes;
@@ -44,8 +54,11 @@ terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<fl
 terrain::Mesh soil_surface(const SoilState& state, const SurfaceOptions& options,
                            double moisture = 0.0);
 
-// Writes grids "density" (rho) and "collision" (psi) as fog volumes, voxel
-// size and origin in metres, atomically. Throws drift::Error naming the file.
-void write_density_vdb(const SoilState& state, const std::filesystem::path& path);
+// Writes grids "density" (rho), "collision" (psi) and "wetness" (`moisture`
+// where there is soil) as fog volumes and "velocity" (m/s, a vector grid),
+// voxel size and origin in metres, atomically; the same state gives the same
+// bytes. Throws drift::Error naming the file.
+void write_density_vdb(const SoilState& state, const std::filesystem::path& path,
+                       double moisture = 0.0);
 
 }  // namespace drift::soil

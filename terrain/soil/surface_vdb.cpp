@@ -3,7 +3,12 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <mutex>
+#include <string>
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
@@ -31,6 +36,39 @@ openvdb::FloatGrid::Ptr to_grid(const terrain::Grid3Shape& g, const std::vector<
         if (v != 0.0f) acc.setValue(openvdb::Coord(x, y, z), sign * v);
       }
   return grid;
+}
+
+// OpenVDB's header (io/Archive.cc, writeHeader): magic (8 bytes), file
+// version, library major and minor (4 each), the grid-offsets flag (1), then
+// the archive's UUID as 36 ASCII characters.
+constexpr std::size_t kUuidOffset = 21, kUuidLength = 36;
+
+// OpenVDB stamps every file with a random UUID (boost's random_generator), so
+// two identical runs wrote different bytes. The UUID only lets readers tell
+// files apart; replace it by one derived from the rest of the file (FNV-1a,
+// formatted as a UUID), so the same grids give the same bytes.
+void stamp_content_uuid(const std::filesystem::path& file, const std::string& shown) {
+  std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(io)), std::istreambuf_iterator<char>());
+  if (!io.good() && !io.eof()) throw Error("cannot read back '" + shown + "'");
+  if (bytes.size() < kUuidOffset + kUuidLength || bytes[kUuidOffset + 8] != '-')
+    throw Error("'" + shown + "': unexpected OpenVDB header (no UUID at byte 21)");
+  std::uint64_t h[2] = {1469598103934665603ull, 1099511628211ull * 31};
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (i >= kUuidOffset && i < kUuidOffset + kUuidLength) continue;
+    for (std::uint64_t& x : h) x = (x ^ static_cast<unsigned char>(bytes[i])) * 1099511628211ull;
+  }
+  char uuid[kUuidLength + 1];
+  std::snprintf(uuid, sizeof uuid, "%08x-%04x-%04x-%04x-%012llx", static_cast<unsigned>(h[0] >> 32),
+                static_cast<unsigned>((h[0] >> 16) & 0xffff),
+                static_cast<unsigned>(0x5000 | (h[0] & 0x0fff)),  // version 5 style: name-based
+                static_cast<unsigned>(0x8000 | ((h[1] >> 48) & 0x3fff)),
+                static_cast<unsigned long long>(h[1] & 0xffffffffffffull));
+  io.clear();
+  io.seekp(static_cast<std::streamoff>(kUuidOffset));
+  io.write(uuid, kUuidLength);
+  io.close();
+  if (!io) throw Error("cannot write '" + shown + "'");
 }
 
 }  // namespace
@@ -65,21 +103,45 @@ terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>
   return mesh;
 }
 
-void write_density_vdb(const SoilState& s, const std::filesystem::path& path) {
+void write_density_vdb(const SoilState& s, const std::filesystem::path& path, double moisture) {
   init_openvdb();
   const terrain::Grid3Shape& g = s.shape;
   auto transform = openvdb::math::Transform::createLinearTransform(g.voxel_size);
   transform->postTranslate(openvdb::Vec3d(g.origin.x() + 0.5 * g.voxel_size,
                                           g.origin.y() + 0.5 * g.voxel_size,
                                           g.origin.z() + 0.5 * g.voxel_size));
+  // The wetness of the soil (thesis 5.3.4, for a renderer's wet coat): the
+  // scenario's moisture wherever there is soil.
+  std::vector<float> wetness(s.size(), 0.0f);
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.rho[i] > 0) wetness[i] = static_cast<float>(moisture);
   openvdb::GridPtrVec grids;
-  for (auto [name, field] : {std::pair{"density", &s.rho}, std::pair{"collision", &s.psi}}) {
+  for (auto [name, field] :
+       {std::pair{"density", &s.rho}, std::pair{"collision", &s.psi},
+        std::pair{"wetness", static_cast<const std::vector<float>*>(&wetness)}}) {
     openvdb::FloatGrid::Ptr grid = to_grid(g, *field, 1.0f);
     grid->setName(name);
     grid->setGridClass(openvdb::GRID_FOG_VOLUME);
     grid->setTransform(transform);
     grids.push_back(grid);
   }
+  // Velocity (m/s) where there is soil: "velocity" is the name Blender and
+  // Houdini read for motion blur.
+  openvdb::Vec3SGrid::Ptr velocity = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  {
+    auto acc = velocity->getAccessor();
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x)
+        for (int z = 0; z < g.nz; ++z) {
+          const std::size_t i = g.index(x, y, z);
+          const openvdb::Vec3s v(s.ux[i], s.uy[i], s.uz[i]);
+          if (s.rho[i] > 0 && v != openvdb::Vec3s(0.0f)) acc.setValue(openvdb::Coord(x, y, z), v);
+        }
+  }
+  velocity->setName("velocity");
+  velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  velocity->setTransform(transform);
+  grids.push_back(velocity);
   AtomicFile out(path);
   try {
     openvdb::io::File file(out.temp_path().string());
@@ -88,6 +150,7 @@ void write_density_vdb(const SoilState& s, const std::filesystem::path& path) {
   } catch (const openvdb::Exception& e) {
     throw Error("cannot write '" + path.string() + "': " + e.what());
   }
+  stamp_content_uuid(out.temp_path(), path.string());
   out.commit();
 }
 

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
@@ -66,6 +68,37 @@ TEST(SoilCli, WritesMeshVdbSurfaceAndGround) {
   EXPECT_EQ(drift::terrain::read_raster(d / "ground.tif").width(), 24 + 64);
 }
 
+// --vdb-frames writes a numbered VDB sequence (a volume sequence in Blender
+// and Houdini), and two identical runs give the same bytes, frame for frame
+// and for --vdb (before, OpenVDB's random UUID made every file differ).
+TEST(SoilCli, VdbFramesAreASequenceAndRunsRepeatByteForByte) {
+  const fs::path d = dir();
+  std::ofstream(d / "s.toml") << kScenario;
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  std::string first[4];
+  for (int runs = 0; runs < 2; ++runs) {
+    fs::remove_all(d / "vdb");
+    fs::create_directories(d / "vdb");
+    ASSERT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.ply").string() + " --vdb " +
+                      (d / "soil.vdb").string() + " --vdb-frames " + (d / "vdb").string() +
+                      " --frame-every 20",
+                  d),
+              0)
+        << output(d);
+    const fs::path files[4] = {d / "vdb" / "soil_00020.vdb", d / "vdb" / "soil_00040.vdb",
+                               d / "vdb" / "soil_00060.vdb", d / "soil.vdb"};
+    for (int k = 0; k < 4; ++k) {
+      ASSERT_TRUE(fs::exists(files[k])) << files[k];
+      if (runs == 0) first[k] = bytes(files[k]);
+      EXPECT_TRUE(first[k] == bytes(files[k])) << files[k] << " differs between runs";
+    }
+  }
+  EXPECT_FALSE(first[0] == first[2]);  // the frames do change
+}
+
 TEST(SoilCli, DemGroundFollowsTheDemUpToTheWindowsEdges) {
   // A tilted plane of 10 m cells; a 6 x 4 window inside it split 4 x 4. The
   // ground under the grid is the DEM's bilinear surface, the plane itself, up
@@ -76,7 +109,10 @@ TEST(SoilCli, DemGroundFollowsTheDemUpToTheWindowsEdges) {
   drift::terrain::write_geotiff(drift::testing::dem_from(16, 10.0, 0.5, plane), d / "dem.tif");
   std::ofstream(d / "s.toml") << "[grid]\nsize = [0, 0, 40]\nvoxel = 2.5\n"
                                  "[terrain]\ndem = \"dem.tif\"\nwindow = [4, 5, 6, 4]\n"
-                                 "upsample = 4\ndepth = 5\n[simulation]\nsteps = 0\n";
+                                 "upsample = 4\ndepth = 5\n[simulation]\nsteps = 0\n"
+                                 // Some soil: a run without any is an error (no surface).
+                                 "[[soil_body]]\non_ground = true\nposition = [30, 20, 4]\n"
+                                 "[[soil_body.primitive]]\nshape = \"sphere\"\nradius = 6\n";
   ASSERT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.obj").string() + " --ground " +
                     (d / "ground.tif").string() + " --ground-margin 0",
                 d),
