@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -169,8 +170,8 @@ void add_soil_command(CLI::App& root) {
   sub->add_option("-o,--output", c->output, "soil surface mesh, .ply or .obj (metres)")->required();
   sub->add_option("--terrain", c->terrain,
                   "metric GeoTIFF replacing the dem the scenario's [terrain] names");
-  sub->add_option("--steps", c->steps, "time steps (overrides the scenario's)")
-      ->check(CLI::Range(0, soil::SoilScenario::kMaxSteps));
+  whole_in_range(sub->add_option("--steps", c->steps, "time steps (overrides the scenario's)"), 0,
+                 soil::SoilScenario::kMaxSteps);
   sub->add_option("--soil", c->soil_type, "soil type of the thesis's table 6")
       ->check(CLI::IsMember({"dry_sand", "sandy_loam", "loam"}));
   c->parameters.add_to(*sub);
@@ -178,7 +179,9 @@ void add_soil_command(CLI::App& root) {
   sub->add_option("--vdb-frames", c->vdb_frames,
                   "directory for an OpenVDB file (density, collision, wetness, velocity) every "
                   "--frame-every steps, soil_NNNNN.vdb: a volume sequence for Blender, Houdini");
-  sub->add_option("--frame-every", c->frame_every, "steps between frames")->capture_default_str();
+  whole_in_range(sub->add_option("--frame-every", c->frame_every, "steps between frames"), 1,
+                 std::numeric_limits<int>::max())
+      ->capture_default_str();
   sub->add_option("--vdb", c->vdb,
                   "OpenVDB file of the density, collision, wetness and velocity grids");
   sub->add_option("--surface", c->surface,
@@ -187,8 +190,9 @@ void add_soil_command(CLI::App& root) {
   sub->add_option("--ground", c->ground,
                   "GeoTIFF of the ground under the soil (terrain or the grid's floor), widened by "
                   "--ground-margin columns, in the meshes' frame: a terrain to render them on");
-  sub->add_option("--ground-margin", c->ground_margin, "columns added around the grid")
-      ->check(CLI::Range(0, 100000))
+  whole_in_range(
+      sub->add_option("--ground-margin", c->ground_margin, "columns added around the grid"), 0,
+      100000)
       ->capture_default_str();
   sub->add_flag("--no-ridge-fix", c->no_ridge_fix,
                 "extract the raw density (shows the thesis's vertical ridges)");

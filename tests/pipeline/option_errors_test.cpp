@@ -80,6 +80,8 @@ TEST(OptionErrors, NumbersAreReadAsWrittenOrRefusedSayingWhy) {
   const std::string render = "render " + scene + " -o " + (d / "a.png").string();
   EXPECT_EQ(run_drift(render + " --spp 1e3", d), 2);
   EXPECT_NE(drift_log(d).find("whole number"), std::string::npos) << drift_log(d);
+  EXPECT_EQ(run_drift("soil missing.toml -o " + (d / "s.ply").string() + " --steps 1e3", d), 2);
+  EXPECT_NE(drift_log(d).find("whole number"), std::string::npos) << drift_log(d);
   EXPECT_EQ(run_drift(dunes + " --threads 2.5", d), 2);
   EXPECT_NE(drift_log(d).find("whole number"), std::string::npos) << drift_log(d);
   EXPECT_EQ(run_drift(render + " --size 100000x100000", d), 2);
