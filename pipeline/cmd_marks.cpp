@@ -60,6 +60,26 @@ void make_frames_directory(const std::string& frames) {
   if (ec) throw Error("cannot create the --frames directory '" + frames + "': " + ec.message());
 }
 
+// Issue 32: an object that never touches the ground (a typo in a height) is
+// named with how near it came, instead of a silent run with no marks.
+void warn_about_misses(const marks::MarksReport& report) {
+  for (const marks::ObjectReport& o : report.objects) {
+    if (o.contact_steps > 0) continue;
+    if (!std::isfinite(o.clearance)) {
+      std::fprintf(stderr,
+                   "drift marks: warning: %s is never over the ground (its footprint misses the "
+                   "raster in all its %d steps); check its keyframes' x and y\n",
+                   o.name.c_str(), o.steps);
+      continue;
+    }
+    std::fprintf(stderr,
+                 "drift marks: warning: %s never touches the ground: its lowest point comes no "
+                 "nearer than %.4g m above the ground beneath it (bottom at %.6g m, ground at "
+                 "%.6g m); check its keyframes' z (absolute unless follow_ground = true)\n",
+                 o.name.c_str(), o.clearance, o.bottom, o.ground);
+  }
+}
+
 void run_marks(MarksCommand& c) {
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
   // Frames are each complete when written (they come one by one); the marked
@@ -107,8 +127,12 @@ void run_marks(MarksCommand& c) {
   outputs.commit();
   std::printf("marks: wrote %s\n", c.output.c_str());
   if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
-  std::printf("marks: %d steps; %.6g m3 under objects: %.6g displaced, %.6g compressed away\n",
-              r.report.steps, r.report.collided, r.report.displaced, r.report.compressed);
+  warn_about_misses(r.report);
+  std::printf(
+      "marks: %d steps, %d with contact; %.6g m3 under objects: %.6g displaced, %.6g compressed "
+      "away\n",
+      r.report.steps, r.report.contact_steps, r.report.collided, r.report.displaced,
+      r.report.compressed);
 }
 
 }  // namespace
@@ -153,6 +177,9 @@ void add_marks_command(CLI::App& root) {
       ->capture_default_str();
   sub->add_option("--margin", c->options.margin, "free cells kept around an object's footprint")
       ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  sub->add_option("--seed", c->options.seed,
+                  "seed of the roughness draws (sigma, paper 000, 3.5); same seed, same marks")
       ->capture_default_str();
   sub->add_option("--renderer", c->renderer,
                   "how the object's bottom is rendered: cpu (z-buffer, faster at these sizes) or "

@@ -19,9 +19,13 @@
 //   erosion_passes  -     100      [1, 1e5]   most relaxation passes per erosion
 //   margin          cells 4        [2, 1000]  free cells around a footprint for rims
 //   renderer        -     cpu      cpu|opengl how the object's bottom is rendered
+//   seed            -     0        any        roughness draws (erosion, Material::sigma)
 #pragma once
 
+#include <cmath>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -66,6 +70,7 @@ struct MarksOptions {
   int erosion_passes = 100;
   int margin = 4;
   BottomRenderer renderer = BottomRenderer::Cpu;
+  std::uint64_t seed = 0;
   std::optional<MarksCamera> camera;
   bool track_disturbed = true;  // keep the per-cell disturbance raster
   // Throws drift::Error naming the option.
@@ -76,6 +81,12 @@ struct StepReport {
   double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m3
   int contact_cells = 0;
   int substeps = 0;
+  // The object's lowest clearance above the ground at the step's end (m; <= 0:
+  // it touches), with its bottom and the ground there (m); +inf when it is
+  // not over the field.
+  double clearance = std::numeric_limits<double>::infinity();
+  double bottom = 0.0, ground = 0.0;
+  bool touched() const { return clearance <= 1e-9 * std::max(1.0, std::abs(ground)); }
 };
 
 // The state of a run, for callers that drive it step by step (benchmarks,
@@ -115,9 +126,21 @@ class MarksSimulation {
   friend struct Impl;
 };
 
+// Per object over the run: how many of its steps it touched the ground in, and
+// its lowest point against the ground beneath when it came nearest (for the
+// warning about objects that never touch: a typo in a height).
+struct ObjectReport {
+  std::string name;
+  int steps = 0, contact_steps = 0;
+  double clearance = std::numeric_limits<double>::infinity();  // m, +inf: never over the field
+  double bottom = 0.0, ground = 0.0;                           // m, where it came nearest
+};
+
 struct MarksReport {
   int steps = 0;
+  int contact_steps = 0;  // steps in which some object touched the ground
   double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m3 over the run
+  std::vector<ObjectReport> objects;                         // in the objects' order
 };
 
 struct MarksResult {

@@ -23,6 +23,7 @@ terrain::SlopeRule Material::slope_rule() const {
   r.tan_repose = theta_deg >= 90.0 ? std::numeric_limits<double>::infinity()
                                    : std::tan(theta_deg * std::numbers::pi / 180.0);
   r.fraction = sigma;
+  r.rough = true;  // paper 000, 3.5: sigma sets the slumped slope's roughness
   return r;
 }
 
