@@ -109,6 +109,7 @@ class SlopeRelaxer {
   // as run(): the Jacobi phases are the same functions of the same cells.
   SlopeRelaxReport run_cells(const std::vector<int>& seeds, std::vector<int>& moved) {
     SlopeRelaxReport report;
+    if (ws_.tan_.size() != ws_.active_.size()) ws_.tan_.assign(ws_.active_.size(), 0.0);
     std::vector<int> active;
     for (int c : seeds) add_once(active, static_cast<std::size_t>(c));
     for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 1;
@@ -133,6 +134,7 @@ class SlopeRelaxer {
       for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 1;
     }
     report.converged = active.empty();
+    cached_tan_ = false;
     for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 0;
     for (int c : moved) ws_.ever_[static_cast<std::size_t>(c)] = 0;
     std::sort(moved.begin(), moved.end());
@@ -215,6 +217,10 @@ class SlopeRelaxer {
   // from call to call.
   double tan_of(std::size_t i, const SlopeRule& r) const {
     if (!r.rough) return r.tan_repose;
+    if (cached_tan_) return ws_.tan_[i];
+    return rough_tan(i, r);
+  }
+  double rough_tan(std::size_t i, const SlopeRule& r) const {
     return r.tan_repose * (1.0 - r.fraction * unit_double(mix64(mix64(o_.seed) ^ i)));
   }
 
@@ -356,12 +362,19 @@ class SlopeRelaxer {
   // One Jacobi pass over the active cells and their neighbours; returns the
   // height moved.
   double pass_cells(const std::vector<int>& active) {
-    for_each_cell(active, [&](std::size_t i, int x, int y) {
-      if (giver(i)) ws_.give_[i] = give_factor(i, x, y);
-    });
     near_cells_.clear();
     for (int c : active) with_neighbour_cells(c, [&](std::size_t n) { add_once(near_cells_, n); });
     clear_marks(near_cells_);
+    // Rough cells' angles once a pass, not once a neighbour (a hash each).
+    cached_tan_ = false;
+    for_each_cell(near_cells_, [&](std::size_t i, int, int) {
+      const SlopeRule& r = rule_at(i);
+      ws_.tan_[i] = r.rough ? rough_tan(i, r) : r.tan_repose;
+    });
+    cached_tan_ = true;
+    for_each_cell(active, [&](std::size_t i, int x, int y) {
+      if (giver(i)) ws_.give_[i] = give_factor(i, x, y);
+    });
     for_each_cell(near_cells_,
                   [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
     gave_.assign(near_cells_.size(), 0.0);
@@ -444,6 +457,7 @@ class SlopeRelaxer {
   std::array<double, 8> distance_{};
   std::vector<int> near_;        // this pass: active tiles and their neighbours
   std::vector<int> near_cells_;  // run_cells: this pass's active cells and their neighbours
+  bool cached_tan_ = false;      // run_cells: ws_.tan_ holds the angles of near_cells_
   std::vector<double> gave_;     // per tile of near_
 };
 

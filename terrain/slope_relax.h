@@ -105,6 +105,7 @@ class SlopeRelaxWorkspace {
   std::vector<double> give_;  // per giver: its factor this pass (0: gives nothing)
   std::vector<double> take_;  // per taker: the share of its offers it takes
   std::vector<double> delta_;
+  std::vector<double> tan_;  // relax_slopes only: per cell, its angle's tangent this pass
   std::vector<std::uint8_t> active_, touched_, ever_, mark_;  // per cell
   std::vector<std::uint8_t> tile_active_, tile_touched_, tile_ever_, tile_mark_;
 };

@@ -155,7 +155,7 @@ struct MarksSimulation::Impl {
   }
   // Paper 000, 3.3-3.5 on the full-resolution field: collision, displacement, erosion.
   BottomMap deform(const CellTriangles& tris, const MarkObject& object,
-                   const std::optional<Eigen::Vector2d>& drag, StepReport& report) {
+                   const std::optional<Eigen::Vector2d>& drag, bool erode_now, StepReport& report) {
     BottomMap bottom;
     bottom.window =
         footprint_window(tris, sim.options_.margin, sim.heights_.width(), sim.heights_.height());
@@ -176,6 +176,11 @@ struct MarksSimulation::Impl {
     // Remember the contact and its rim even where the object holds them now:
     // they slide once it has gone (3.5).
     remember(seeds);
+    // The last sub-step's erosion is the step's: end_step relaxes every
+    // remembered cell, these among them, under the objects' last bottoms, so
+    // eroding here too would relax the same cells twice (paper 000, 3.5:
+    // erosion once a step, where needed).
+    if (!erode_now) return bottom;
     set_ceiling(bottom, true);
     erode(std::move(seeds));
     set_ceiling(bottom, false);
@@ -252,7 +257,7 @@ StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& obj
         sweep ? swept_triangles(shape, a.position, b, frame_) : posed_triangles(shape, b, frame_);
     const auto drag = first ? std::nullopt : drag_direction(contact_motion(shape, a, b), frame_);
     if (level == 1) {
-      last = impl_->deform(tris, object, drag, report);
+      last = impl_->deform(tris, object, drag, i < n, report);
     } else {
       if (object.material) {  // the fine cells the object will press into
         BottomMap fine;
