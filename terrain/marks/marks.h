@@ -16,7 +16,9 @@
 // Options (units, defaults, ranges):
 //   step            s     0.1      (0, 3600]  simulated time per step
 //   memory_steps    steps 20       [0, 1e6]   how long a cell that slid keeps relaxing
-//   erosion_passes  -     100      [1, 1e5]   most relaxation passes per erosion
+//                                             (a held cell: counted from the release)
+//   erosion_passes  -     100      [1, 1e5]   most relaxation passes per erosion (one a step,
+//                                             and one a sub-step before the last)
 //   margin          cells 4        [2, 1000]  free cells around a footprint for rims
 //   renderer        -     cpu      cpu|opengl how the object's bottom is rendered
 //   seed            -     0        any        roughness draws (erosion, Material::sigma)

@@ -48,6 +48,27 @@ inline terrain::Mesh box(double hx, double hy, double hz) {
   return m;
 }
 
+// An upturned cup: a square roof (half size `half`, 5 mm thick, its underside
+// at z = 0) on four walls 1 cm thick reaching down to z = -depth. Its contact
+// encloses a hole under the roof.
+inline terrain::Mesh cup(double half, double depth) {
+  terrain::Mesh m;
+  auto add = [&](double hx, double hy, double hz, double cx, double cy, double cz) {
+    const terrain::Mesh b = box(hx, hy, hz);
+    const int base = static_cast<int>(m.positions.size());
+    for (const auto& p : b.positions) m.positions.emplace_back(p.x() + cx, p.y() + cy, p.z() + cz);
+    for (const auto& t : b.triangles)
+      m.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  };
+  const double w = 0.005;  // half a wall
+  add(half, half, 0.0025, 0, 0, 0.0025);
+  add(w, half, depth / 2, -half + w, 0, -depth / 2);
+  add(w, half, depth / 2, half - w, 0, -depth / 2);
+  add(half, w, depth / 2, 0, -half + w, -depth / 2);
+  add(half, w, depth / 2, 0, half - w, -depth / 2);
+  return m;
+}
+
 // The object's bottom at `pose` over the whole field (kNone where it is not).
 inline BottomMap bottom_at(const ObjectShape& shape, const Pose& pose, const MarksSimulation& sim) {
   const CellTriangles t = posed_triangles(shape, pose, sim.frame());
