@@ -8,10 +8,12 @@
 
 #include "pipeline/cli.h"
 #include "pipeline/object_list.h"
+#include "pipeline/parameter_flags.h"
 #include "pipeline/progress_bar.h"
 #include "pipeline/track_file.h"
 #include "terrain/error.h"
 #include "terrain/marks/marks.h"
+#include "terrain/marks/marks_parameters.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
@@ -26,6 +28,8 @@ struct MarksCommand {
   double snow_min = 0.01;
   bool add_snow = false;
   marks::MarksOptions options;
+  // --memory-steps, --erosion-passes, --margin (terrain/marks/marks_parameters.h).
+  ParameterFlags<marks::MarksOptions> parameters{marks::marks_parameters()};
 };
 
 // The snow-depth raster, of the ground's size.
@@ -80,8 +84,9 @@ void warn_about_misses(const marks::MarksReport& report) {
   }
 }
 
-void run_marks(MarksCommand& c) {
+void run_marks(MarksCommand& c, const CLI::App& sub) {
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
+  c.parameters.apply(sub, c.options);
   // Frames are each complete when written (they come one by one); the marked
   // ground and the disturbed raster replace their files together at the end.
   std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth};
@@ -143,7 +148,7 @@ void add_marks_command(CLI::App& root) {
       root, "marks",
       "marks of objects in soft ground: footprints, tyre tracks, dragged objects in sand, mud "
       "and snow (paper 000)",
-      [c] { run_marks(*c); });
+      [c](const CLI::App& self) { run_marks(*c, self); });
   sub->add_option("ground", c->ground,
                   "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
       ->required();
@@ -167,17 +172,7 @@ void add_marks_command(CLI::App& root) {
                   "snow shallower than this (m) leaves the ground's material")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
-  sub->add_option("--memory-steps", c->options.memory_steps,
-                  "steps a cell that slid keeps relaxing (paper 000, 3.5)")
-      ->check(CLI::Range(0, 1000000))  // the ranges of MarksOptions::validate (marks.h)
-      ->capture_default_str();
-  sub->add_option("--erosion-passes", c->options.erosion_passes,
-                  "most relaxation passes per erosion")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  sub->add_option("--margin", c->options.margin, "free cells kept around an object's footprint")
-      ->check(CLI::Range(2, 1000))
-      ->capture_default_str();
+  c->parameters.add_to(*sub);
   sub->add_option("--seed", c->options.seed,
                   "seed of the roughness draws (sigma, paper 000, 3.5); same seed, same marks")
       ->capture_default_str();

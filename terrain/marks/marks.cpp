@@ -7,6 +7,7 @@
 #include "terrain/error.h"
 #include "terrain/hash.h"
 #include "terrain/marks/displacement.h"
+#include "terrain/marks/marks_parameters.h"
 #include "terrain/marks/multires.h"
 #include "terrain/memory.h"
 #include "terrain/slope_relax.h"
@@ -50,13 +51,7 @@ struct Clearance {
 }  // namespace
 
 void MarksOptions::validate() const {
-  if (!(step > 0.0 && step <= 3600.0))
-    throw Error("marks: step is " + std::to_string(step) + " s; it must lie in (0, 3600]");
-  if (memory_steps < 0 || memory_steps > 1000000)
-    throw Error("marks: memory_steps must lie in [0, 1000000]");
-  if (erosion_passes < 1 || erosion_passes > 100000)
-    throw Error("marks: erosion_passes must lie in [1, 100000]");
-  if (margin < 2 || margin > 1000) throw Error("marks: margin must lie in [2, 1000] cells");
+  for (const MarksParameter& p : marks_parameters()) p.require(*this);
   if (camera && (!camera->position.allFinite() || !(camera->fov_deg > 0 && camera->fov_deg < 180) ||
                  camera->width_px < 1))
     throw Error(
