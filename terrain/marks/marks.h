@@ -3,12 +3,16 @@
 // O'Brien & Hodgins 1999). One simulation step, per object and sub-step:
 //   1. collision by z-buffer: the object's bottom over the ground's cells,
 //      looking up from below (object_bottom.h; 3.3), swept when dragged;
-//   2. compression and displacement along a distance transform
-//      (displacement.h; 3.4);
+//   2. compression and displacement onto the contact's ring and outwards
+//      along a Euclidean distance transform, the object's bottom a hard
+//      ceiling (displacement.h; 3.4);
 //   3. erosion from the contact outwards where slopes exceed the material's
-//      angle, never above the object's bottom (terrain/slope_relax.h; 3.5);
-// and at the end of the step, erosion of the cells remembered from earlier
-// steps, so material goes on sliding after an object leaves (3.5).
+//      angle, never above the object's bottom (terrain/slope_relax.h; 3.5),
+//      for every sub-step but the last, whose erosion is the step's:
+// at the end of the step, erosion of the cells remembered from this and
+// earlier steps and of the cells objects hold (remembered while held), so
+// material goes on sliding after an object leaves, however long it stood
+// (3.5). The options' table is marks_parameters.h.
 // Objects far from a camera, or marked so by the user, work on a half or
 // quarter resolution copy of their window, written back by linear
 // interpolation (multires.h; 3.6).
