@@ -24,7 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct MarksCommand {
-  std::string ground, track, output, material, disturbed, frames, snow_depth, renderer = "cpu";
+  std::string ground, track, output, material, disturbed, frames, snow_depth, materials,
+      renderer = "cpu";
   double snow_min = 0.01;
   bool add_snow = false;
   marks::MarksOptions options;
@@ -44,8 +45,25 @@ terrain::HeightField read_snow_depth(const MarksCommand& c, const terrain::Heigh
   return depth;
 }
 
+// The --materials raster: per cell 0 sand, 1 mud, 2 snow (the presets' order).
+marks::MaterialField read_material_raster(const MarksCommand& c,
+                                          const terrain::HeightField& ground) {
+  const terrain::HeightField m = terrain::read_raster(c.materials);
+  if (m.width() != ground.width() || m.height() != ground.height()) {
+    throw Error("material raster '" + c.materials + "' is " + std::to_string(m.width()) + " x " +
+                std::to_string(m.height()) + " cells but the ground is " +
+                std::to_string(ground.width()) + " x " + std::to_string(ground.height()) +
+                "; give one value a cell of the ground");
+  }
+  std::vector<marks::Material> table;
+  for (const char* name : {"sand", "mud", "snow"}) table.push_back(*marks::material_preset(name));
+  return marks::materials_from_raster(m, table, "material raster '" + c.materials + "'");
+}
+
 marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
-                                      const terrain::HeightField& depth) {
+                                      const terrain::HeightField& depth,
+                                      const terrain::HeightField& ground) {
+  if (!c.materials.empty()) return read_material_raster(c, ground);
   marks::Material base = track.material.value_or(*marks::material_preset("sand"));
   if (!c.material.empty()) base = *marks::material_preset(c.material);
   if (depth.empty()) return marks::MaterialField{{base}, {}};
@@ -86,10 +104,12 @@ void warn_about_misses(const marks::MarksReport& report) {
 
 void run_marks(MarksCommand& c, const CLI::App& sub) {
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
+  if (!c.materials.empty() && (!c.snow_depth.empty() || !c.material.empty()))
+    usage_error("--materials gives every cell its material; drop --snow-depth and --material");
   c.parameters.apply(sub, c.options);
   // Frames are each complete when written (they come one by one); the marked
   // ground and the disturbed raster replace their files together at the end.
-  std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth};
+  std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth, c.materials};
   for (const fs::path& mesh : object_mesh_paths(c.track, "track file")) inputs.push_back(mesh);
   OutputSet outputs({c.output, c.disturbed}, inputs);
   TrackFile track = read_track_file(c.track);
@@ -110,7 +130,7 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
       if (std::isfinite(d)) ground.values()[i] += d;
     }
   }
-  marks::MaterialField materials = ground_materials(c, track, depth);
+  marks::MaterialField materials = ground_materials(c, track, depth, ground);
   if (!c.frames.empty()) make_frames_directory(c.frames);
   marks::StepFn on_step;
   if (!c.frames.empty()) {
@@ -165,6 +185,9 @@ void add_marks_command(CLI::App& root) {
   sub->add_option("--snow-depth", c->snow_depth,
                   "snow depth GeoTIFF (drift snow fall): snow where it lies, the ground's material "
                   "elsewhere");
+  sub->add_option("--materials", c->materials,
+                  "GeoTIFF of the ground's material per cell: 0 sand, 1 mud, 2 snow (painted or "
+                  "derived; objects' materials still apply where they walk)");
   sub->add_flag("--add-snow", c->add_snow,
                 "mark the snow surface: GROUND + the --snow-depth raster (the output is that "
                 "surface with the marks)");

@@ -3,6 +3,7 @@
 // write nothing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -128,6 +129,29 @@ TEST(MarksCli, AnObjectThatNeverTouchesTheGroundIsNamed) {
             0);
   EXPECT_EQ(output(d).find("warning"), std::string::npos) << output(d);
   EXPECT_NE(output(d).find("6 steps, 3 with contact"), std::string::npos) << output(d);
+}
+
+// --materials: the ground's material per cell (0 sand, 1 mud, 2 snow); a cell
+// holding anything else exits 1 naming the file, the cell and the value, and
+// writes nothing.
+TEST(MarksCli, AMaterialRasterSetsTheGroundsMaterialPerCell) {
+  const fs::path d = dir(), g = ground(d);
+  std::ofstream(d / "track.toml") << track();
+  auto painted = drift::testing::flat_utm_ground(64, 2.0f, 0.01);  // all snow
+  drift::terrain::write_geotiff(painted, d / "paint.tif");
+  const std::string args = g.string() + " --track " + (d / "track.toml").string() + " -o " +
+                           (d / "out.tif").string() + " --materials " + (d / "paint.tif").string();
+  ASSERT_EQ(run(args, d), 0) << output(d);
+  const auto out = drift::terrain::read_raster(d / "out.tif");
+  float top = -1e9f;
+  for (float v : out.values()) top = std::max(top, v);
+  EXPECT_LE(top, 2000.0f) << "snow: compressed, no rim";
+  painted(9, 4) = 7.0f;
+  drift::terrain::write_geotiff(painted, d / "paint.tif");
+  fs::remove(d / "out.tif");
+  EXPECT_EQ(run(args, d), 1) << output(d);
+  EXPECT_NE(output(d).find("paint.tif': cell (9, 4) holds 7"), std::string::npos) << output(d);
+  EXPECT_FALSE(fs::exists(d / "out.tif"));
 }
 
 }  // namespace
