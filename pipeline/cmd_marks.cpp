@@ -8,10 +8,12 @@
 
 #include "pipeline/cli.h"
 #include "pipeline/object_list.h"
+#include "pipeline/parameter_flags.h"
 #include "pipeline/progress_bar.h"
 #include "pipeline/track_file.h"
 #include "terrain/error.h"
 #include "terrain/marks/marks.h"
+#include "terrain/marks/marks_parameters.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
@@ -22,10 +24,13 @@ namespace {
 namespace fs = std::filesystem;
 
 struct MarksCommand {
-  std::string ground, track, output, material, disturbed, frames, snow_depth, renderer = "cpu";
+  std::string ground, track, output, material, disturbed, frames, snow_depth, materials,
+      renderer = "cpu";
   double snow_min = 0.01;
   bool add_snow = false;
   marks::MarksOptions options;
+  // --memory-steps, --erosion-passes, --margin (terrain/marks/marks_parameters.h).
+  ParameterFlags<marks::MarksOptions> parameters{marks::marks_parameters()};
 };
 
 // The snow-depth raster, of the ground's size.
@@ -40,8 +45,25 @@ terrain::HeightField read_snow_depth(const MarksCommand& c, const terrain::Heigh
   return depth;
 }
 
+// The --materials raster: per cell 0 sand, 1 mud, 2 snow (the presets' order).
+marks::MaterialField read_material_raster(const MarksCommand& c,
+                                          const terrain::HeightField& ground) {
+  const terrain::HeightField m = terrain::read_raster(c.materials);
+  if (m.width() != ground.width() || m.height() != ground.height()) {
+    throw Error("material raster '" + c.materials + "' is " + std::to_string(m.width()) + " x " +
+                std::to_string(m.height()) + " cells but the ground is " +
+                std::to_string(ground.width()) + " x " + std::to_string(ground.height()) +
+                "; give one value a cell of the ground");
+  }
+  std::vector<marks::Material> table;
+  for (const char* name : {"sand", "mud", "snow"}) table.push_back(*marks::material_preset(name));
+  return marks::materials_from_raster(m, table, "material raster '" + c.materials + "'");
+}
+
 marks::MaterialField ground_materials(const MarksCommand& c, const TrackFile& track,
-                                      const terrain::HeightField& depth) {
+                                      const terrain::HeightField& depth,
+                                      const terrain::HeightField& ground) {
+  if (!c.materials.empty()) return read_material_raster(c, ground);
   marks::Material base = track.material.value_or(*marks::material_preset("sand"));
   if (!c.material.empty()) base = *marks::material_preset(c.material);
   if (depth.empty()) return marks::MaterialField{{base}, {}};
@@ -60,11 +82,34 @@ void make_frames_directory(const std::string& frames) {
   if (ec) throw Error("cannot create the --frames directory '" + frames + "': " + ec.message());
 }
 
-void run_marks(MarksCommand& c) {
+// Issue 32: an object that never touches the ground (a typo in a height) is
+// named with how near it came, instead of a silent run with no marks.
+void warn_about_misses(const marks::MarksReport& report) {
+  for (const marks::ObjectReport& o : report.objects) {
+    if (o.contact_steps > 0) continue;
+    if (!std::isfinite(o.clearance)) {
+      std::fprintf(stderr,
+                   "drift marks: warning: %s is never over the ground (its footprint misses the "
+                   "raster in all its %d steps); check its keyframes' x and y\n",
+                   o.name.c_str(), o.steps);
+      continue;
+    }
+    std::fprintf(stderr,
+                 "drift marks: warning: %s never touches the ground: its lowest point comes no "
+                 "nearer than %.4g m above the ground beneath it (bottom at %.6g m, ground at "
+                 "%.6g m); check its keyframes' z (absolute unless follow_ground = true)\n",
+                 o.name.c_str(), o.clearance, o.bottom, o.ground);
+  }
+}
+
+void run_marks(MarksCommand& c, const CLI::App& sub) {
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
+  if (!c.materials.empty() && (!c.snow_depth.empty() || !c.material.empty()))
+    usage_error("--materials gives every cell its material; drop --snow-depth and --material");
+  c.parameters.apply(sub, c.options);
   // Frames are each complete when written (they come one by one); the marked
   // ground and the disturbed raster replace their files together at the end.
-  std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth};
+  std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth, c.materials};
   for (const fs::path& mesh : object_mesh_paths(c.track, "track file")) inputs.push_back(mesh);
   OutputSet outputs({c.output, c.disturbed}, inputs);
   TrackFile track = read_track_file(c.track);
@@ -85,7 +130,7 @@ void run_marks(MarksCommand& c) {
       if (std::isfinite(d)) ground.values()[i] += d;
     }
   }
-  marks::MaterialField materials = ground_materials(c, track, depth);
+  marks::MaterialField materials = ground_materials(c, track, depth, ground);
   if (!c.frames.empty()) make_frames_directory(c.frames);
   marks::StepFn on_step;
   if (!c.frames.empty()) {
@@ -107,8 +152,12 @@ void run_marks(MarksCommand& c) {
   outputs.commit();
   std::printf("marks: wrote %s\n", c.output.c_str());
   if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
-  std::printf("marks: %d steps; %.6g m3 under objects: %.6g displaced, %.6g compressed away\n",
-              r.report.steps, r.report.collided, r.report.displaced, r.report.compressed);
+  warn_about_misses(r.report);
+  std::printf(
+      "marks: %d steps, %d with contact; %.6g m3 under objects: %.6g displaced, %.6g compressed "
+      "away\n",
+      r.report.steps, r.report.contact_steps, r.report.collided, r.report.displaced,
+      r.report.compressed);
 }
 
 }  // namespace
@@ -119,7 +168,7 @@ void add_marks_command(CLI::App& root) {
       root, "marks",
       "marks of objects in soft ground: footprints, tyre tracks, dragged objects in sand, mud "
       "and snow (paper 000)",
-      [c] { run_marks(*c); });
+      [c](const CLI::App& self) { run_marks(*c, self); });
   sub->add_option("ground", c->ground,
                   "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
       ->required();
@@ -136,6 +185,9 @@ void add_marks_command(CLI::App& root) {
   sub->add_option("--snow-depth", c->snow_depth,
                   "snow depth GeoTIFF (drift snow fall): snow where it lies, the ground's material "
                   "elsewhere");
+  sub->add_option("--materials", c->materials,
+                  "GeoTIFF of the ground's material per cell: 0 sand, 1 mud, 2 snow (painted or "
+                  "derived; objects' materials still apply where they walk)");
   sub->add_flag("--add-snow", c->add_snow,
                 "mark the snow surface: GROUND + the --snow-depth raster (the output is that "
                 "surface with the marks)");
@@ -143,16 +195,9 @@ void add_marks_command(CLI::App& root) {
                   "snow shallower than this (m) leaves the ground's material")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
-  sub->add_option("--memory-steps", c->options.memory_steps,
-                  "steps a cell that slid keeps relaxing (paper 000, 3.5)")
-      ->check(CLI::Range(0, 1000000))  // the ranges of MarksOptions::validate (marks.h)
-      ->capture_default_str();
-  sub->add_option("--erosion-passes", c->options.erosion_passes,
-                  "most relaxation passes per erosion")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  sub->add_option("--margin", c->options.margin, "free cells kept around an object's footprint")
-      ->check(CLI::Range(2, 1000))
+  c->parameters.add_to(*sub);
+  sub->add_option("--seed", c->options.seed,
+                  "seed of the roughness draws (sigma, paper 000, 3.5); same seed, same marks")
       ->capture_default_str();
   sub->add_option("--renderer", c->renderer,
                   "how the object's bottom is rendered: cpu (z-buffer, faster at these sizes) or "

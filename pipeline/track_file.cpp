@@ -135,8 +135,10 @@ TrackFile read_track_file(const fs::path& path) {
   });
   if (placed.empty())
     throw Error(path.string() + ": a track file needs at least one [[objects]] entry");
+  const std::vector<fs::path> meshes = object_mesh_paths(path, "track file");
   for (std::size_t i = 0; i < placed.size(); ++i) {
     marks::MarkObject& o = extra[i];
+    if (i < meshes.size()) o.name += " (" + meshes[i].filename().string() + ")";
     o.mesh = placed[i].mesh;
     for (marks::Keyframe& k : o.trajectory.keys) k.position += placed[i].position;
     o.trajectory.validate(path.string() + ": " + o.name);

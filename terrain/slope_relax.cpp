@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 
+#include "terrain/hash.h"
+
 namespace drift::terrain {
 
 namespace {
@@ -33,13 +35,16 @@ void for_tiles(const std::vector<int>& tiles, const Fn& fn) {
 }
 
 template <class Fn>
-void for_each_index(std::size_t count, const Fn& fn) {
-  if (count < kParallelTiles) {
+void for_each_index(std::size_t count, const Fn& fn, std::size_t serial_below = kParallelTiles) {
+  if (count < serial_below) {
     for (std::size_t k = 0; k < count; ++k) fn(k);
     return;
   }
   tbb::parallel_for(std::size_t{0}, count, fn);
 }
+
+// Cells in a list below which a phase of run_cells runs on the calling thread.
+constexpr std::size_t kParallelCells = 8192;
 
 }  // namespace
 
@@ -51,6 +56,7 @@ void SlopeRelaxWorkspace::fit(int width, int height) {
   const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
   give_.assign(cells, 0.0), take_.assign(cells, 0.0), delta_.assign(cells, 0.0);
   active_.assign(cells, 0), touched_.assign(cells, 0), ever_.assign(cells, 0);
+  mark_.assign(cells, 0);
   tile_active_.assign(tiles, 0), tile_touched_.assign(tiles, 0);
   tile_ever_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
 }
@@ -93,6 +99,45 @@ class SlopeRelaxer {
     }
     report.converged = active.empty();
     for (int t : active) clear_active(t);  // stopped by max_passes
+    return report;
+  }
+
+  // The same passes over lists of cells instead of tiles (paper 000, 3.5: only
+  // the cells that need it, outward from the contact): a pass visits the
+  // active cells and their neighbours, nothing else, so a rim a few cells wide
+  // costs its own cells, not the 16 x 16 tiles about it. Same flows, same bits
+  // as run(): the Jacobi phases are the same functions of the same cells.
+  SlopeRelaxReport run_cells(const std::vector<int>& seeds, std::vector<int>& moved) {
+    SlopeRelaxReport report;
+    if (ws_.tan_.size() != ws_.active_.size()) ws_.tan_.assign(ws_.active_.size(), 0.0);
+    std::vector<int> active;
+    for (int c : seeds) add_once(active, static_cast<std::size_t>(c));
+    for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 1;
+    clear_marks(active);
+    moved.clear();
+    while (!active.empty() && report.passes < o_.max_passes) {
+      ++report.passes;
+      report.moved += pass_cells(active);
+      // After a pass: a cell is active if it or a neighbour gave or took.
+      for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 0;
+      std::vector<int> touched;
+      for (int c : near_cells_)
+        if (ws_.touched_[static_cast<std::size_t>(c)]) touched.push_back(c);
+      active.clear();
+      for (int c : touched) {
+        std::uint8_t& ever = ws_.ever_[static_cast<std::size_t>(c)];
+        if (!ever) ever = 1, moved.push_back(c);
+        with_neighbour_cells(c, [&](std::size_t n) { add_once(active, n); });
+      }
+      clear_marks(active);
+      for (int c : touched) ws_.touched_[static_cast<std::size_t>(c)] = 0;
+      for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 1;
+    }
+    report.converged = active.empty();
+    cached_tan_ = false;
+    for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 0;
+    for (int c : moved) ws_.ever_[static_cast<std::size_t>(c)] = 0;
+    std::sort(moved.begin(), moved.end());
     return report;
   }
 
@@ -160,11 +205,23 @@ class SlopeRelaxer {
   }
   // Excess of the slope from cell i (surface hi) to its neighbour n in direction k,
   // written once so that giver and taker get the same bits.
-  double excess(double hi, std::size_t n, const SlopeRule& r, int k) const {
-    return hi - surface(n) - r.tan_repose * distance_[k];
+  double excess(double hi, std::size_t n, double tan_repose, int k) const {
+    return hi - surface(n) - tan_repose * distance_[k];
   }
   std::size_t neighbour(int x, int y, int k) const {
     return static_cast<std::size_t>(y + kNeighbours[k].dy) * w_ + (x + kNeighbours[k].dx);
+  }
+
+  // The tangent cell i slides at (SlopeRule::rough): a pure function of the
+  // seed and the cell, so giver and taker agree and a cell keeps its angle
+  // from call to call.
+  double tan_of(std::size_t i, const SlopeRule& r) const {
+    if (!r.rough) return r.tan_repose;
+    if (cached_tan_) return ws_.tan_[i];
+    return rough_tan(i, r);
+  }
+  double rough_tan(std::size_t i, const SlopeRule& r) const {
+    return r.tan_repose * (1.0 - r.fraction * unit_double(mix64(mix64(o_.seed) ^ i)));
   }
 
   // Phase 1: a giver's factor. Fraction: the scale keeping its flows within half
@@ -173,11 +230,13 @@ class SlopeRelaxer {
     const SlopeRule& r = rule_at(i);
     const double hi = surface(i), room = std::max(h_[i] - floor(i), 0.0);
     double sum = 0.0, largest = 0.0;
+    const double share = r.share == SlopeShare::Fraction ? r.fraction : 1.0;
+    const double t = tan_of(i, r);
     for (int k = 0; k < 8; ++k) {
       if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
-      const double e = excess(hi, neighbour(x, y, k), r, k);
+      const double e = excess(hi, neighbour(x, y, k), t, k);
       if (e <= o_.tolerance) continue;
-      sum += r.share == SlopeShare::Fraction ? r.fraction * e : e;
+      sum += share * e;
       largest = std::max(largest, e);
     }
     if (sum <= 0.0) return 0.0;
@@ -205,7 +264,8 @@ class SlopeRelaxer {
       if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
       const std::size_t n = neighbour(x, y, k);
       if (!giver(n)) continue;
-      const double e = excess(surface(n), i, rule_at(n), 7 - k);
+      const SlopeRule& r = rule_at(n);
+      const double e = excess(surface(n), i, tan_of(n, r), 7 - k);
       if (e > o_.tolerance) fn(n, e);
     }
   }
@@ -228,11 +288,11 @@ class SlopeRelaxer {
     float* disturbed = disturbed_ ? &disturbed_->values()[i] : nullptr;
     if (ws_.give_[i] > 0.0 && giver(i)) {
       const SlopeRule& r = rule_at(i);
-      const double hi = surface(i);
+      const double hi = surface(i), t = tan_of(i, r);
       for (int k = 0; k < 8; ++k) {
         if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
         const std::size_t n = neighbour(x, y, k);
-        const double e = excess(hi, n, r, k);
+        const double e = excess(hi, n, t, k);
         if (e <= o_.tolerance) continue;
         const double f = flow(i, e, n);
         if (!(f > 0.0)) continue;
@@ -283,6 +343,65 @@ class SlopeRelaxer {
     double moved = 0.0;
     for (double g : gave_) moved += g;
     return moved;
+  }
+
+  // Cell lists (run_cells): `mark_` keeps a list free of duplicates.
+  void add_once(std::vector<int>& list, std::size_t i) {
+    if (!ws_.mark_[i]) ws_.mark_[i] = 1, list.push_back(static_cast<int>(i));
+  }
+  void clear_marks(const std::vector<int>& list) {
+    for (int c : list) ws_.mark_[static_cast<std::size_t>(c)] = 0;
+  }
+  template <class Fn>
+  void with_neighbour_cells(int c, const Fn& fn) const {
+    const int x = c % w_, y = c / w_;
+    fn(static_cast<std::size_t>(c));
+    for (int k = 0; k < 8; ++k)
+      if (inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) fn(neighbour(x, y, k));
+  }
+  // One Jacobi pass over the active cells and their neighbours; returns the
+  // height moved.
+  double pass_cells(const std::vector<int>& active) {
+    near_cells_.clear();
+    for (int c : active) with_neighbour_cells(c, [&](std::size_t n) { add_once(near_cells_, n); });
+    clear_marks(near_cells_);
+    // Rough cells' angles once a pass, not once a neighbour (a hash each).
+    cached_tan_ = false;
+    for_each_cell(near_cells_, [&](std::size_t i, int, int) {
+      const SlopeRule& r = rule_at(i);
+      ws_.tan_[i] = r.rough ? rough_tan(i, r) : r.tan_repose;
+    });
+    cached_tan_ = true;
+    for_each_cell(active, [&](std::size_t i, int x, int y) {
+      if (giver(i)) ws_.give_[i] = give_factor(i, x, y);
+    });
+    for_each_cell(near_cells_,
+                  [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
+    gave_.assign(near_cells_.size(), 0.0);
+    for_each_index(
+        near_cells_.size(),
+        [&](std::size_t k) {
+          const int c = near_cells_[k];
+          gave_[k] = change(static_cast<std::size_t>(c), c % w_, c / w_);
+        },
+        kParallelCells);
+    for_each_cell(near_cells_, [&](std::size_t i, int, int) {
+      h_[i] += ws_.delta_[i];
+      ws_.give_[i] = ws_.take_[i] = ws_.delta_[i] = 0.0;
+    });
+    double moved = 0.0;
+    for (double g : gave_) moved += g;
+    return moved;
+  }
+  template <class Fn>
+  void for_each_cell(const std::vector<int>& cells, const Fn& fn) const {
+    for_each_index(
+        cells.size(),
+        [&](std::size_t k) {
+          const int c = cells[k];
+          fn(static_cast<std::size_t>(c), c % w_, c / w_);
+        },
+        kParallelCells);
   }
 
   void clear_active(int t) {
@@ -336,8 +455,10 @@ class SlopeRelaxer {
   const SlopePassFn& on_pass_;
   int w_, hgt_;
   std::array<double, 8> distance_{};
-  std::vector<int> near_;     // this pass: active tiles and their neighbours
-  std::vector<double> gave_;  // per tile of near_
+  std::vector<int> near_;        // this pass: active tiles and their neighbours
+  std::vector<int> near_cells_;  // run_cells: this pass's active cells and their neighbours
+  bool cached_tan_ = false;      // run_cells: ws_.tan_ holds the angles of near_cells_
+  std::vector<double> gave_;     // per tile of near_
 };
 
 SlopeRelaxReport relax_slopes(Grid<double>& heights, const std::vector<int>& active,
@@ -349,10 +470,7 @@ SlopeRelaxReport relax_slopes(Grid<double>& heights, const std::vector<int>& act
   ws.fit(heights.width(), heights.height());
   const SlopePassFn none;
   SlopeRelaxer relaxer(heights, cells, options, ws, disturbed, none);
-  for (int c : active) relaxer.seed(c);
-  const SlopeRelaxReport report = relaxer.run();
-  relaxer.collect_moved(moved_cells);
-  return report;
+  return relaxer.run_cells(active, moved_cells);
 }
 
 SlopeRelaxReport relax_slopes_everywhere(Grid<double>& heights, const SlopeCells& cells,

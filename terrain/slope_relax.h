@@ -26,8 +26,11 @@
 // Only active cells may give: the seeds at first, then every cell next to one
 // that gave or took, so the work stays around the disturbance. The grid is cut
 // into 16 x 16 tiles; passes visit only the tiles with active cells and their
-// neighbours, in parallel (TBB) when there are many. Storage: three doubles and
-// two bytes a cell in the workspace, none per flow.
+// neighbours, in parallel (TBB) when there are many (relax_slopes_everywhere);
+// relax_slopes keeps lists of the active cells instead and visits only them
+// and their neighbours (paper 000, 3.5: only where needed), with the same
+// flows and bits. Storage: three doubles and four bytes a cell in the
+// workspace, none per flow.
 #pragma once
 
 #include <cstdint>
@@ -50,12 +53,21 @@ struct SlopeRule {
   double tan_repose = 0.577;  // tan of the steepest stable slope; +inf never slides
   double fraction = 0.2;      // sigma (SlopeShare::Fraction): share of the excess a pass, (0, 0.5]
   SlopeShare share = SlopeShare::Fraction;
+  // Roughness (paper 000, 3.5: sigma "sets the roughness of the slumped slope,
+  // smaller being smoother"; Sumner et al. 1999). Each cell slides at its own
+  // angle, tan_repose (1 - fraction u), u uniform in [0, 1) drawn from the
+  // options' seed and the cell (terrain/hash.h: any thread count, the same
+  // angle in every call), so slumped slopes stand between (1 - sigma) and 1
+  // times tan theta, never steeper: a small sigma gives a smooth slope, a large
+  // one a lumpy, grainy one. The share moved a pass stays sigma x excess.
+  bool rough = false;
 };
 
 struct SlopeRelaxOptions {
   double dx = 1.0, dy = 1.0;  // cell sizes (m)
   double tolerance = 1e-6;    // m: a pair steeper than repose by less than this is stable
   int max_passes = 200;
+  std::uint64_t seed = 0;  // for rules with `rough`: which cells stand steeper
 };
 
 // Called after each pass with the passes so far and the share of the tiles still
@@ -93,7 +105,8 @@ class SlopeRelaxWorkspace {
   std::vector<double> give_;  // per giver: its factor this pass (0: gives nothing)
   std::vector<double> take_;  // per taker: the share of its offers it takes
   std::vector<double> delta_;
-  std::vector<std::uint8_t> active_, touched_, ever_;  // per cell
+  std::vector<double> tan_;  // relax_slopes only: per cell, its angle's tangent this pass
+  std::vector<std::uint8_t> active_, touched_, ever_, mark_;  // per cell
   std::vector<std::uint8_t> tile_active_, tile_touched_, tile_ever_, tile_mark_;
 };
 
@@ -113,6 +126,7 @@ SlopeRelaxReport relax_slopes_everywhere(Grid<double>& heights, const SlopeCells
                                          const SlopePassFn& on_pass = {});
 
 // Largest excess of a neighbour slope over its rule, in metres of height, among
+// against the rule's tan_repose (not a rough cell's own, which is lower),
 // the pairs whose higher cell is in `cells` (flat indices; empty: the whole grid)
 // and holds more than `min_room` above its floor, and whose lower cell is not
 // capped by a ceiling (for tests and reports).

@@ -3,11 +3,14 @@
 // bottom b below the ground g) the ground drops to b; of the h' = g - b it
 // loses, delta h = alpha h' is displaced and the rest is compressed away.
 //
-// Pressing (the object not dragged): the displaced material moves from the
-// inside of the contact region outwards along a distance transform (chessboard
-// distance to the nearest free cell): each contact cell, deepest first, hands
-// its material in equal shares to its neighbours nearer the boundary, and the
-// contour hands it to the ring of free cells just outside.
+// Pressing (the object not dragged): paper 000 routes the displaced material
+// from the inside of the contact outwards along a distance transform to the
+// ring of free cells just outside. Here each connected contact region hands
+// its volume to its ring evenly, in proportion to each ring cell's border with
+// the region (issue 32: nearest-edge routing gives a square's edge a rim
+// shaped like the sector behind it; real prints have even rims). Excess that
+// does not fit under the object moves outwards along a Euclidean distance
+// transform from the contact (distance_transform.h), so rims are round.
 //
 // Dragging (paper 000, 3.4, second paragraph): the contact cells are taken from
 // the side opposite the motion forwards, and each hands its material to its
@@ -16,7 +19,9 @@
 //
 // In both, a free cell that the object overhangs takes no more than reaches
 // the object's bottom and pushes its excess on to the free cells farther from
-// the contact (never backwards when dragging).
+// the contact (backwards when dragging only if nothing else can take it). The
+// bottom is a hard ceiling: material with nowhere to go under the object (a
+// hole the contact encloses, the field's edge) is compressed, not stacked.
 #pragma once
 
 #include <Eigen/Core>
@@ -39,10 +44,11 @@ struct DisplacementReport {
 
 // heights: the whole field (m), updated in the bottom map's window.
 // drag: the horizontal motion in cell space (any length), or none when pressing.
-// disturbed (optional): accumulates |change| per cell.
+// disturbed (optional): accumulates |change| per cell. dx, dy: cell sizes (m).
 DisplacementReport compress_and_displace(terrain::Grid<double>& heights, const BottomMap& bottom,
                                          const MaterialField& materials,
                                          const std::optional<Eigen::Vector2d>& drag,
-                                         terrain::Grid<float>* disturbed = nullptr);
+                                         terrain::Grid<float>* disturbed = nullptr, double dx = 1.0,
+                                         double dy = 1.0);
 
 }  // namespace drift::marks

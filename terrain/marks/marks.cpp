@@ -5,7 +5,9 @@
 #include <numbers>
 
 #include "terrain/error.h"
+#include "terrain/hash.h"
 #include "terrain/marks/displacement.h"
+#include "terrain/marks/marks_parameters.h"
 #include "terrain/marks/multires.h"
 #include "terrain/memory.h"
 #include "terrain/slope_relax.h"
@@ -40,16 +42,16 @@ Eigen::Vector3d contact_motion(const ObjectShape& shape, const Pose& a, const Po
   return (b.position + rb * p) - (a.position + ra * p);
 }
 
+// How near an object comes to the ground: its lowest gap (m) over the cells
+// beneath it, with its bottom and the ground's height there.
+struct Clearance {
+  double gap = kInf, bottom = 0.0, ground = 0.0;
+};
+
 }  // namespace
 
 void MarksOptions::validate() const {
-  if (!(step > 0.0 && step <= 3600.0))
-    throw Error("marks: step is " + std::to_string(step) + " s; it must lie in (0, 3600]");
-  if (memory_steps < 0 || memory_steps > 1000000)
-    throw Error("marks: memory_steps must lie in [0, 1000000]");
-  if (erosion_passes < 1 || erosion_passes > 100000)
-    throw Error("marks: erosion_passes must lie in [1, 100000]");
-  if (margin < 2 || margin > 1000) throw Error("marks: margin must lie in [2, 1000] cells");
+  for (const MarksParameter& p : marks_parameters()) p.require(*this);
   if (camera && (!camera->position.allFinite() || !(camera->fov_deg > 0 && camera->fov_deg < 180) ||
                  camera->width_px < 1))
     throw Error(
@@ -84,6 +86,9 @@ struct MarksSimulation::Impl {
         v = on ? std::min(v, z) : kInf;
       }
   }
+  // The seed of the erosion's roughness: the run's, so that a cell keeps its
+  // own angle from step to step (terrain/slope_relax.h, SlopeRule::rough).
+  std::uint64_t erosion_seed() const { return terrain::mix64(sim.options_.seed); }
   void erode(std::vector<int> seeds) {
     std::vector<terrain::SlopeRule> rules;
     for (const Material& m : sim.materials_.table) rules.push_back(m.slope_rule());
@@ -91,33 +96,71 @@ struct MarksSimulation::Impl {
                               &ceiling, nullptr};
     terrain::SlopeRelaxOptions o{sim.frame_.dx, sim.frame_.dy,
                                  1e-4 * std::min(sim.frame_.dx, sim.frame_.dy),
-                                 sim.options_.erosion_passes};
+                                 sim.options_.erosion_passes, erosion_seed()};
     std::vector<int> moved;
     terrain::relax_slopes(sim.heights_, std::move(seeds), cells, o, moved,
                           sim.options_.track_disturbed ? &sim.disturbed_ : nullptr, &workspace);
     remember(moved);
   }
-  void claim_material(const CellWindow& w, const MarkObject& object) {
-    if (!object.material) return;
+  // Issue 32: an object's material is recorded per cell it disturbs (its
+  // contact and the cells its displaced material reaches), never over its
+  // window, so it does not leak onto ground it never touched.
+  void claim_material(const std::vector<int>& cells, const MarkObject& object) {
+    if (!object.material || cells.empty()) return;
     MaterialField& m = sim.materials_;
     const std::uint8_t id = m.add(*object.material);
     if (m.index.empty())
       m.index = terrain::Grid<std::uint8_t>(sim.heights_.width(), sim.heights_.height(), 0);
-    for (int r = w.row0; r < w.row0 + w.height; ++r)
-      for (int c = w.col0; c < w.col0 + w.width; ++c) m.index(c, r) = id;
+    for (int c : cells) m.index.values()[static_cast<std::size_t>(c)] = id;
+  }
+  // The cells where the bottom is below the ground (the contact to come).
+  std::vector<int> below(const BottomMap& b) const {
+    std::vector<int> out;
+    const CellWindow& w = b.window;
+    for (int r = 0; r < w.height; ++r)
+      for (int c = 0; c < w.width; ++c)
+        if (b.z[static_cast<std::size_t>(r) * w.width + c] < sim.heights_(w.col0 + c, w.row0 + r))
+          out.push_back((w.row0 + r) * sim.heights_.width() + w.col0 + c);
+    return out;
+  }
+  // Paper 000, 3.5: the cells the object holds (its bottom at or below the
+  // ground) and their neighbours (the tops of the walls) stay remembered while
+  // it holds them, so the memory counts from the release and a print held for
+  // any time slumps once the object has left. Returns the object's lowest
+  // clearance above the ground (m; <= 0: touching) for the run's report.
+  Clearance hold(const BottomMap& b) {
+    Clearance out;
+    const CellWindow& w = b.window;
+    const int gw = sim.heights_.width(), gh = sim.heights_.height();
+    std::vector<int> held;
+    for (int r = 0; r < w.height; ++r)
+      for (int c = 0; c < w.width; ++c) {
+        const double z = b.z[static_cast<std::size_t>(r) * w.width + c];
+        if (!std::isfinite(z)) continue;
+        const int col = w.col0 + c, row = w.row0 + r;
+        const double g = sim.heights_(col, row), gap = z - g;
+        if (gap < out.gap) out = {gap, z, g};
+        if (gap > 1e-9 * std::max(1.0, std::abs(g))) continue;
+        for (int y = std::max(row - 1, 0); y <= std::min(row + 1, gh - 1); ++y)
+          for (int x = std::max(col - 1, 0); x <= std::min(col + 1, gw - 1); ++x)
+            held.push_back(y * gw + x);
+      }
+    remember(held);
+    return out;
   }
   // Paper 000, 3.3-3.5 on the full-resolution field: collision, displacement, erosion.
   BottomMap deform(const CellTriangles& tris, const MarkObject& object,
-                   const std::optional<Eigen::Vector2d>& drag, StepReport& report) {
+                   const std::optional<Eigen::Vector2d>& drag, bool erode_now, StepReport& report) {
     BottomMap bottom;
     bottom.window =
         footprint_window(tris, sim.options_.margin, sim.heights_.width(), sim.heights_.height());
     if (bottom.window.empty()) return bottom;
     rasteriser->render(tris, bottom);
-    claim_material(bottom.window, object);
-    const DisplacementReport d =
-        compress_and_displace(sim.heights_, bottom, sim.materials_, drag,
-                              sim.options_.track_disturbed ? &sim.disturbed_ : nullptr);
+    if (object.material) claim_material(below(bottom), object);
+    const DisplacementReport d = compress_and_displace(
+        sim.heights_, bottom, sim.materials_, drag,
+        sim.options_.track_disturbed ? &sim.disturbed_ : nullptr, sim.frame_.dx, sim.frame_.dy);
+    claim_material(d.received, object);
     const double area = sim.frame_.dx * sim.frame_.dy;
     report.collided += d.collided * area, report.displaced += d.displaced * area;
     report.compressed += d.compressed * area;
@@ -128,6 +171,11 @@ struct MarksSimulation::Impl {
     // Remember the contact and its rim even where the object holds them now:
     // they slide once it has gone (3.5).
     remember(seeds);
+    // The last sub-step's erosion is the step's: end_step relaxes every
+    // remembered cell, these among them, under the objects' last bottoms, so
+    // eroding here too would relax the same cells twice (paper 000, 3.5:
+    // erosion once a step, where needed).
+    if (!erode_now) return bottom;
     set_ceiling(bottom, true);
     erode(std::move(seeds));
     set_ceiling(bottom, false);
@@ -140,7 +188,10 @@ MarksSimulation::MarksSimulation(const terrain::HeightField& ground, MaterialFie
     : materials_(std::move(materials)), frame_(GridFrame::of(ground.geo())), options_(options) {
   options_.validate();
   const std::uint64_t cells = static_cast<std::uint64_t>(ground.width()) * ground.height();
-  require_memory(cells * (8 + 8 + 4 + 4 + 1) + cells * 4,
+  // Heights, ceiling (double), disturbance, expiry (4 bytes), material (1), the
+  // float copy written out (4), and the erosion's workspace (terrain/slope_relax:
+  // give, take, delta, angle, 8 bytes each; 4 bytes of flags).
+  require_memory(cells * (8 + 8 + 4 + 4 + 1) + cells * 4 + cells * (4 * 8 + 4),
                  "marks state for a " + std::to_string(ground.width()) + " x " +
                      std::to_string(ground.height()) + " ground",
                  "crop the ground (drift import --crop) or coarsen it (drift import --resample)");
@@ -204,14 +255,18 @@ StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& obj
         sweep ? swept_triangles(shape, a.position, b, frame_) : posed_triangles(shape, b, frame_);
     const auto drag = first ? std::nullopt : drag_direction(contact_motion(shape, a, b), frame_);
     if (level == 1) {
-      last = impl_->deform(tris, object, drag, report);
+      last = impl_->deform(tris, object, drag, i < n, report);
     } else {
-      impl_->claim_material(
-          footprint_window(tris, options_.margin * level, heights_.width(), heights_.height()),
-          object);
-      CoarseResult c = deform_coarse(heights_, materials_, tris, level, frame_.dx, frame_.dy,
-                                     options_.margin, options_.erosion_passes, *impl_->rasteriser,
-                                     drag, options_.track_disturbed ? &disturbed_ : nullptr);
+      if (object.material) {  // the fine cells the object will press into
+        BottomMap fine;
+        fine.window = footprint_window(tris, 0, heights_.width(), heights_.height());
+        impl_->rasteriser->render(tris, fine);
+        impl_->claim_material(impl_->below(fine), object);
+      }
+      CoarseResult c =
+          deform_coarse(heights_, materials_, tris, level, frame_.dx, frame_.dy, options_.margin,
+                        options_.erosion_passes, *impl_->rasteriser, drag,
+                        options_.track_disturbed ? &disturbed_ : nullptr, impl_->erosion_seed());
       const double area = frame_.dx * frame_.dy * level * level;
       report.collided += c.collided * area, report.displaced += c.displaced * area;
       report.compressed += c.compressed * area;
@@ -221,7 +276,11 @@ StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& obj
     }
     ++report.substeps;
   }
-  if (!last.window.empty()) impl_->last.push_back(std::move(last));
+  if (!last.window.empty()) {
+    const Clearance c = impl_->hold(last);
+    report.clearance = c.gap, report.bottom = c.bottom, report.ground = c.ground;
+    impl_->last.push_back(std::move(last));
+  }
   return report;
 }
 

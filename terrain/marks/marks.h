@@ -3,12 +3,16 @@
 // O'Brien & Hodgins 1999). One simulation step, per object and sub-step:
 //   1. collision by z-buffer: the object's bottom over the ground's cells,
 //      looking up from below (object_bottom.h; 3.3), swept when dragged;
-//   2. compression and displacement along a distance transform
-//      (displacement.h; 3.4);
+//   2. compression and displacement onto the contact's ring and outwards
+//      along a Euclidean distance transform, the object's bottom a hard
+//      ceiling (displacement.h; 3.4);
 //   3. erosion from the contact outwards where slopes exceed the material's
-//      angle, never above the object's bottom (terrain/slope_relax.h; 3.5);
-// and at the end of the step, erosion of the cells remembered from earlier
-// steps, so material goes on sliding after an object leaves (3.5).
+//      angle, never above the object's bottom (terrain/slope_relax.h; 3.5),
+//      for every sub-step but the last, whose erosion is the step's:
+// at the end of the step, erosion of the cells remembered from this and
+// earlier steps and of the cells objects hold (remembered while held), so
+// material goes on sliding after an object leaves, however long it stood
+// (3.5). The options' table is marks_parameters.h.
 // Objects far from a camera, or marked so by the user, work on a half or
 // quarter resolution copy of their window, written back by linear
 // interpolation (multires.h; 3.6).
@@ -16,12 +20,18 @@
 // Options (units, defaults, ranges):
 //   step            s     0.1      (0, 3600]  simulated time per step
 //   memory_steps    steps 20       [0, 1e6]   how long a cell that slid keeps relaxing
-//   erosion_passes  -     100      [1, 1e5]   most relaxation passes per erosion
+//                                             (a held cell: counted from the release)
+//   erosion_passes  -     100      [1, 1e5]   most relaxation passes per erosion (one a step,
+//                                             and one a sub-step before the last)
 //   margin          cells 4        [2, 1000]  free cells around a footprint for rims
 //   renderer        -     cpu      cpu|opengl how the object's bottom is rendered
+//   seed            -     0        any        roughness draws (erosion, Material::sigma)
 #pragma once
 
+#include <cmath>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -66,6 +76,7 @@ struct MarksOptions {
   int erosion_passes = 100;
   int margin = 4;
   BottomRenderer renderer = BottomRenderer::Cpu;
+  std::uint64_t seed = 0;
   std::optional<MarksCamera> camera;
   bool track_disturbed = true;  // keep the per-cell disturbance raster
   // Throws drift::Error naming the option.
@@ -76,6 +87,12 @@ struct StepReport {
   double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m3
   int contact_cells = 0;
   int substeps = 0;
+  // The object's lowest clearance above the ground at the step's end (m; <= 0:
+  // it touches), with its bottom and the ground there (m); +inf when it is
+  // not over the field.
+  double clearance = std::numeric_limits<double>::infinity();
+  double bottom = 0.0, ground = 0.0;
+  bool touched() const { return clearance <= 1e-9 * std::max(1.0, std::abs(ground)); }
 };
 
 // The state of a run, for callers that drive it step by step (benchmarks,
@@ -115,9 +132,21 @@ class MarksSimulation {
   friend struct Impl;
 };
 
+// Per object over the run: how many of its steps it touched the ground in, and
+// its lowest point against the ground beneath when it came nearest (for the
+// warning about objects that never touch: a typo in a height).
+struct ObjectReport {
+  std::string name;
+  int steps = 0, contact_steps = 0;
+  double clearance = std::numeric_limits<double>::infinity();  // m, +inf: never over the field
+  double bottom = 0.0, ground = 0.0;                           // m, where it came nearest
+};
+
 struct MarksReport {
   int steps = 0;
+  int contact_steps = 0;  // steps in which some object touched the ground
   double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m3 over the run
+  std::vector<ObjectReport> objects;                         // in the objects' order
 };
 
 struct MarksResult {

@@ -23,6 +23,7 @@ terrain::SlopeRule Material::slope_rule() const {
   r.tan_repose = theta_deg >= 90.0 ? std::numeric_limits<double>::infinity()
                                    : std::tan(theta_deg * std::numbers::pi / 180.0);
   r.fraction = sigma;
+  r.rough = true;  // paper 000, 3.5: sigma sets the slumped slope's roughness
   return r;
 }
 
@@ -45,6 +46,28 @@ std::uint8_t MaterialField::add(const Material& m) {
   if (table.size() >= 255) throw Error("more than 255 different ground materials");
   table.push_back(m);
   return static_cast<std::uint8_t>(table.size() - 1);
+}
+
+MaterialField materials_from_raster(const terrain::Grid<float>& indices,
+                                    const std::vector<Material>& table, const std::string& what) {
+  if (table.empty() || table.size() > 255)
+    throw Error(what + ": a material raster needs 1 to 255 materials");
+  MaterialField f;
+  f.table = table;
+  f.index = terrain::Grid<std::uint8_t>(indices.width(), indices.height(), 0);
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const float v = indices.values()[i];
+    if (!(v >= 0.0f && v < static_cast<float>(table.size()) && v == std::floor(v))) {
+      const int col = static_cast<int>(i % static_cast<std::size_t>(indices.width()));
+      const int row = static_cast<int>(i / static_cast<std::size_t>(indices.width()));
+      throw Error(
+          what + ": cell (" + std::to_string(col) + ", " + std::to_string(row) + ") holds " +
+          std::to_string(v) + "; each cell must hold a whole number from 0 to " +
+          std::to_string(table.size() - 1) + " (" + material_preset_names() + ", in that order)");
+    }
+    f.index.values()[i] = static_cast<std::uint8_t>(v);
+  }
+  return f;
 }
 
 MaterialField materials_from_snow_depth(const terrain::Grid<float>& snow_depth, double min_depth,

@@ -49,6 +49,13 @@ struct MaterialField {
   }
 };
 
+// Per-region materials from a raster a user paints or derives (issue 32: the
+// material belongs to the ground): each cell holds the index of its material
+// in `table` (0, 1, ...; whole numbers). Throws drift::Error naming `what`,
+// the cell and the value for anything else (NaN, a fraction, out of range).
+MaterialField materials_from_raster(const terrain::Grid<float>& indices,
+                                    const std::vector<Material>& table, const std::string& what);
+
 // Per-region materials from a snow-depth raster (drift snow fall): `snow` where
 // the snow is deeper than `min_depth` (m), `ground` elsewhere. The raster must
 // match the ground's size.

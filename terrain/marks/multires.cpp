@@ -78,7 +78,7 @@ CoarseResult deform_coarse(terrain::Grid<double>& heights, const MaterialField& 
                            const CellTriangles& tris, int level, double dx, double dy, int margin,
                            int erosion_passes, BottomRasteriser& rasteriser,
                            const std::optional<Eigen::Vector2d>& drag,
-                           terrain::Grid<float>* disturbed) {
+                           terrain::Grid<float>* disturbed, std::uint64_t seed) {
   CoarseResult r;
   const CellWindow w = block_window(tris, level, margin, heights.width(), heights.height());
   if (w.empty()) return r;
@@ -92,7 +92,8 @@ CoarseResult deform_coarse(terrain::Grid<double>& heights, const MaterialField& 
   cb.window = {0, 0, c.heights.width(), c.heights.height()};
   rasteriser.render(coarse_tris, cb);
   const terrain::Grid<double> before = c.heights;
-  const DisplacementReport d = compress_and_displace(c.heights, cb, c.materials, drag);
+  const DisplacementReport d =
+      compress_and_displace(c.heights, cb, c.materials, drag, nullptr, dx * level, dy * level);
   r.collided = d.collided, r.displaced = d.displaced, r.compressed = d.compressed;
   r.contact_cells = static_cast<int>(d.contact.size());
   if (!d.contact.empty()) {
@@ -105,7 +106,8 @@ CoarseResult deform_coarse(terrain::Grid<double>& heights, const MaterialField& 
     std::vector<int> seeds = d.received, moved;
     seeds.insert(seeds.end(), d.contact.begin(), d.contact.end());
     terrain::relax_slopes(c.heights, seeds, cells,
-                          {dx * level, dy * level, 1e-4 * std::min(dx, dy), erosion_passes}, moved);
+                          {dx * level, dy * level, 1e-4 * std::min(dx, dy), erosion_passes, seed},
+                          moved);
   }
   terrain::Grid<double> delta(c.heights.width(), c.heights.height());
   for (std::size_t i = 0; i < delta.size(); ++i)

@@ -7,6 +7,7 @@
 // them and the next steps' erosion smooths them at full resolution.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -24,10 +25,11 @@ struct CoarseResult {
 };
 
 // tris: in the fine grid's cell space. level: 2 or 4. dx, dy: fine cell sizes (m).
+// seed: the erosion's roughness draws (terrain/slope_relax.h).
 CoarseResult deform_coarse(terrain::Grid<double>& heights, const MaterialField& materials,
                            const CellTriangles& tris, int level, double dx, double dy, int margin,
                            int erosion_passes, BottomRasteriser& rasteriser,
                            const std::optional<Eigen::Vector2d>& drag,
-                           terrain::Grid<float>* disturbed);
+                           terrain::Grid<float>* disturbed, std::uint64_t seed = 0);
 
 }  // namespace drift::marks

@@ -59,9 +59,11 @@ MarksResult simulate_marks(const terrain::HeightField& ground,
     return p;
   };
   MarksResult result;
+  for (const MarkObject& o : objects) result.report.objects.push_back({o.name});
   if (progress && !progress(0.0, "marks")) throw Cancelled();
   for (int k = 0; k <= steps; ++k) {
     const double t = std::min(t0 + k * options.step, t1), t_prev = t0 + (k - 1) * options.step;
+    bool contact = false;
     for (std::size_t i = 0; i < objects.size(); ++i) {
       const MarkObject& o = objects[i];
       if (!o.trajectory.active_at(t)) continue;
@@ -70,7 +72,13 @@ MarksResult simulate_marks(const terrain::HeightField& ground,
       const StepReport r = sim.move(shapes[i], o, from, to, first);
       result.report.collided += r.collided, result.report.displaced += r.displaced;
       result.report.compressed += r.compressed;
+      ObjectReport& each = result.report.objects[i];
+      ++each.steps;
+      if (r.touched() || r.contact_cells > 0) ++each.contact_steps, contact = true;
+      if (r.clearance < each.clearance)
+        each.clearance = r.clearance, each.bottom = r.bottom, each.ground = r.ground;
     }
+    if (contact) ++result.report.contact_steps;
     sim.end_step();
     if (on_step && !on_step(k, sim)) throw Cancelled();
     if (progress && !progress(static_cast<double>(k + 1) / (steps + 1), "marks")) throw Cancelled();

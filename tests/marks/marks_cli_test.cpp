@@ -3,6 +3,7 @@
 // write nothing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -95,6 +96,62 @@ TEST(MarksCli, AnOutputThatIsAnInputIsRefused) {
   std::ofstream(d / "track.toml") << track();
   EXPECT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " + g.string(), d), 1)
       << output(d);
+}
+
+// Issue 32 item 6: a track whose object never touches the ground (a typo in a
+// height: 1 m too high) warns, naming the object and its lowest point against
+// the ground beneath, and the run says how many steps had contact.
+TEST(MarksCli, AnObjectThatNeverTouchesTheGroundIsNamed) {
+  const fs::path d = dir(), g = ground(d);
+  std::string text = track();
+  for (const char* z : {"2000.08", "2000.02", "2000.1"}) {
+    const std::string high = std::to_string(std::stod(z) + 1.0).substr(0, 7);
+    text.replace(text.find(z), std::string(z).size(), high);
+  }
+  std::ofstream(d / "track.toml") << text;
+  ASSERT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " +
+                    (d / "out.tif").string(),
+                d),
+            0)
+      << output(d);
+  const std::string log = output(d);
+  EXPECT_NE(log.find("warning: object 1 (ball.obj) never touches the ground"), std::string::npos)
+      << log;
+  // The ball's lowest vertex against the ground (tessellation: 0.97 to 0.971).
+  EXPECT_NE(log.find("no nearer than 0.97"), std::string::npos) << log;
+  EXPECT_NE(log.find("m above the ground beneath it"), std::string::npos) << log;
+  EXPECT_NE(log.find("6 steps, 0 with contact"), std::string::npos) << log;
+  // A track that presses says so, without a warning.
+  std::ofstream(d / "track.toml") << track();
+  ASSERT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " +
+                    (d / "out.tif").string(),
+                d),
+            0);
+  EXPECT_EQ(output(d).find("warning"), std::string::npos) << output(d);
+  EXPECT_NE(output(d).find("6 steps, 3 with contact"), std::string::npos) << output(d);
+}
+
+// --materials: the ground's material per cell (0 sand, 1 mud, 2 snow); a cell
+// holding anything else exits 1 naming the file, the cell and the value, and
+// writes nothing.
+TEST(MarksCli, AMaterialRasterSetsTheGroundsMaterialPerCell) {
+  const fs::path d = dir(), g = ground(d);
+  std::ofstream(d / "track.toml") << track();
+  auto painted = drift::testing::flat_utm_ground(64, 2.0f, 0.01);  // all snow
+  drift::terrain::write_geotiff(painted, d / "paint.tif");
+  const std::string args = g.string() + " --track " + (d / "track.toml").string() + " -o " +
+                           (d / "out.tif").string() + " --materials " + (d / "paint.tif").string();
+  ASSERT_EQ(run(args, d), 0) << output(d);
+  const auto out = drift::terrain::read_raster(d / "out.tif");
+  float top = -1e9f;
+  for (float v : out.values()) top = std::max(top, v);
+  EXPECT_LE(top, 2000.0f) << "snow: compressed, no rim";
+  painted(9, 4) = 7.0f;
+  drift::terrain::write_geotiff(painted, d / "paint.tif");
+  fs::remove(d / "out.tif");
+  EXPECT_EQ(run(args, d), 1) << output(d);
+  EXPECT_NE(output(d).find("paint.tif': cell (9, 4) holds 7"), std::string::npos) << output(d);
+  EXPECT_FALSE(fs::exists(d / "out.tif"));
 }
 
 }  // namespace

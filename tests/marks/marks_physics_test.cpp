@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "terrain/error.h"
 #include "terrain/marks/marks.h"
 #include "tests/marks/shapes.h"
 
@@ -130,8 +131,13 @@ TEST(MarksErosion, SandRimsSlumpMudWallsStandSnowHasNoRim) {
   EXPECT_LE(rim(snow.sim), 0.0);           // alpha 0: compressed, no rim
 }
 
+// Compression and displacement are symmetric (a material that does not slip:
+// erosion's roughness, sigma, gives each cell its own angle and so breaks the
+// symmetry on purpose, paper 000, 3.5).
 TEST(MarksSymmetry, ABallPressedStraightDownLeavesASymmetricMark) {
-  Press p(only("sand"), 32, 32, 65);
+  MaterialField stiff;
+  stiff.table = {Material{"stiff", 90.0, 1.0, 0.2}};
+  Press p(stiff, 32, 32, 65);
   const auto& h = p.sim.heights();
   const int n = h.width();
   double worst = 0;
@@ -168,6 +174,44 @@ TEST(MarksMaterials, PerRegionMaterialsFromASnowDepthRaster) {
   EXPECT_LE(snow_top, 1.0) << "snow: compressed, no rim";
   EXPECT_GT(sand_top, 1.001) << "sand: displaced into a rim";
   EXPECT_LT(sim.heights()(24, 24), 1.0 - 0.9 * kDepth);
+}
+
+// Issue 32 item 4: the ground's materials from a raster a user paints (0 sand,
+// 1 mud, ...): a ball pressed into each half slumps by that half's material;
+// a cell that holds no material's index is refused, naming it.
+TEST(MarksMaterials, PerRegionMaterialsFromAPaintedRaster) {
+  terrain::Grid<float> painted(96, 48, 0.0f);
+  for (int r = 0; r < 48; ++r)
+    for (int c = 0; c < 48; ++c) painted(c, r) = 1.0f;  // the west half mud
+  const MaterialField m = materials_from_raster(
+      painted, {*material_preset("sand"), *material_preset("mud")}, "paint.tif");
+  MarksSimulation sim(terrain::HeightField(96, 48, 1.0f, terrain::local_georeference(kCell)), m,
+                      {});
+  const ObjectShape shape = ObjectShape::of(sphere(kRadius));
+  MarkObject object;
+  for (double col : {24.0, 72.0}) {
+    const Pose pose{at_cell(sim, col, 24, 1.0 + kRadius - kDepth), Eigen::Quaterniond::Identity()};
+    sim.move(shape, object, pose, pose, true);
+  }
+  settle(sim, 10);
+  auto steepest = [&](int c0, int c1) {
+    double worst = 0;
+    for (int r = 0; r < 47; ++r)
+      for (int c = c0; c < c1; ++c)
+        worst = std::max(worst, std::abs(sim.heights()(c + 1, r) - sim.heights()(c, r)));
+    return std::atan(worst / kCell) * 180 / std::numbers::pi;
+  };
+  EXPECT_GT(steepest(4, 44), 40.0) << "mud's walls stand";
+  EXPECT_LE(steepest(52, 92), 30.5) << "sand's slump to 30 degrees";
+  painted(5, 7) = 0.5f;
+  try {
+    materials_from_raster(painted, {*material_preset("sand"), *material_preset("mud")},
+                          "paint.tif");
+    ADD_FAILURE() << "a fraction passed";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("paint.tif: cell (5, 7) holds 0.5"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(MarksMaterials, PresetsAreThePapers) {
