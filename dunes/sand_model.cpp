@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -15,6 +14,7 @@
 #include "dunes/sand_parameters.h"
 #include "dunes/sweep_tiles.h"
 #include "dunes/wind_frame.h"
+#include "terrain/angles.h"
 #include "terrain/error.h"
 #include "terrain/hash.h"
 #include "terrain/memory.h"
@@ -47,41 +47,18 @@ DRIFT_SIMD_KERNEL float fast_tanh(float x) {
 
 // The largest edge drop avalanching allows, in model height units.
 double max_drop(const SandOptions& o) {
-  return std::tan(o.repose_deg * std::numbers::pi / 180.0) * o.cell_m / o.height_unit;
+  return terrain::tan_degrees(o.repose_deg) * o.cell_m / o.height_unit;
 }
 
 // The shadow line's fall per cell along the wind, in model height units.
 double shadow_drop(const SandOptions& o) {
-  return std::tan(o.shadow_deg * std::numbers::pi / 180.0) * o.cell_m / o.height_unit;
+  return terrain::tan_degrees(o.shadow_deg) * o.cell_m / o.height_unit;
 }
 
 }  // namespace
 
-SandOptions default_options(Model model) {
-  SandOptions o;
-  o.model = model;
-  if (model == Model::Dunes) {
-    // Large scale: flights shorten and lift grows on windward slopes.
-    o.cell_m = 1.0;
-    o.height_unit = 0.25;
-    o.L0 = 20.0;
-    o.b = 1.0;
-    o.q = 0.2;
-    o.b_prime = 0.02;
-    o.creep = 0.25;
-    o.initial_amplitude = 2.0;
-    o.steps = 3000;
-    o.shadow_deg = 15.0;
-    o.reattach = 1.0;
-  }
-  return o;
-}
-
 void validate(const SandOptions& o) {
-  for (const SandParameter& p : sand_parameters()) {
-    const double v = p.get(o);
-    terrain::require_field(std::isfinite(v) && v >= p.lo && v <= p.hi, p.field, v, range_text(p));
-  }
+  for (const terrain::Parameter<SandOptions>& p : sand_parameters()) p.require(o);
   if (o.model == Model::Dunes) {
     if (o.L0 <= o.b)
       throw terrain::ParameterError("L0",

@@ -10,6 +10,8 @@
 
 #include "dunes/lattice.h"
 
+#include "terrain/angles.h"
+
 namespace drift::dunes {
 
 WindFrame wind_frame(double wind_from_deg) {
@@ -29,7 +31,7 @@ WindFrame wind_frame(double wind_from_deg) {
     return f;
   }
   // Clockwise in map view with rows running south: +rows is clockwise of +x.
-  const double a = residual_deg * std::numbers::pi / 180.0;
+  const double a = terrain::radians(residual_deg);
   f.cos_a = std::cos(a);
   f.sin_a = std::sin(a);
   return f;
@@ -118,7 +120,7 @@ double lattice_wind_from(double wind_from_deg, int n) {
   // difference.
   const double shift =
       std::atan2(rounded.sin_a, rounded.cos_a) - std::atan2(exact.sin_a, exact.cos_a);
-  return wind_from_deg + shift * 180.0 / std::numbers::pi;
+  return wind_from_deg + terrain::degrees(shift);
 }
 
 terrain::HeightField lattice_to_grid(const terrain::HeightField& s, const WindLattice& l, int n) {

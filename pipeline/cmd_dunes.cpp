@@ -11,6 +11,7 @@
 #include "dunes/sand_parameters.h"
 #include "dunes/wind_frame.h"
 #include "pipeline/cli.h"
+#include "pipeline/parameter_flags.h"
 #include "pipeline/progress_bar.h"
 #include "terrain/output_set.h"
 #include "terrain/parameter.h"
@@ -20,24 +21,24 @@ namespace drift::pipeline {
 
 namespace {
 
+// A flag's help: its meaning, range and both models' defaults, from the table.
+std::string parameter_help(const terrain::Parameter<dunes::SandOptions>& p) {
+  const auto ripples = dunes::default_options(dunes::Model::Ripples);
+  const auto dunes_defaults = dunes::default_options(dunes::Model::Dunes);
+  return std::string(p.meaning) + " " + p.range() + " (default: ripples " +
+         (dunes::dunes_only(p) ? std::string("-") : terrain::format_value(p.get(ripples))) +
+         ", dunes " + terrain::format_value(p.get(dunes_defaults)) + ")";
+}
+
 struct DunesCommand {
   std::string model = "ripples";
   std::string output;
   unsigned long long seed = 1;
   int snapshot_every = 0;
-  // The table's flags as parsed (dunes/sand_parameters.h); only those given
-  // override the model's defaults.
-  std::vector<double> values = std::vector<double>(dunes::sand_parameters().size(), 0.0);
+  // The table's flags (dunes/sand_parameters.h); only those given override
+  // the model's defaults.
+  ParameterFlags<dunes::SandOptions> parameters{dunes::sand_parameters(), &parameter_help};
 };
-
-// A flag's help: its meaning, range and both models' defaults, from the table.
-std::string parameter_help(const dunes::SandParameter& p) {
-  const auto ripples = dunes::default_options(dunes::Model::Ripples);
-  const auto dunes_defaults = dunes::default_options(dunes::Model::Dunes);
-  return std::string(p.meaning) + " " + dunes::range_text(p) + " (default: ripples " +
-         (p.dunes_only ? std::string("-") : terrain::format_value(p.get(ripples))) + ", dunes " +
-         terrain::format_value(p.get(dunes_defaults)) + ")";
-}
 
 // OUT.tif -> OUT_00040.tif
 std::filesystem::path snapshot_path(const std::filesystem::path& out, int step) {
@@ -49,14 +50,9 @@ std::filesystem::path snapshot_path(const std::filesystem::path& out, int step) 
 void run_dunes(const DunesCommand& c, const CLI::App& sub) {
   const dunes::Model model = c.model == "dunes" ? dunes::Model::Dunes : dunes::Model::Ripples;
   dunes::SandOptions o = dunes::default_options(model);
-  FlagNames flags;
-  for (std::size_t i = 0; i < dunes::sand_parameters().size(); ++i) {
-    const dunes::SandParameter& p = dunes::sand_parameters()[i];
-    if (sub.count(p.flag)) p.set(o, c.values[i]);
-    flags.emplace_back(p.field, p.flag);
-  }
+  c.parameters.apply(sub, o);
   o.seed = c.seed;
-  validate_flags([&o] { dunes::validate(o); }, flags, false);
+  validate_flags([&o] { dunes::validate(o); }, c.parameters.flag_names());
   const double simulated_from = dunes::lattice_wind_from(o.wind_from_deg, o.size);
   if (std::fabs(simulated_from - o.wind_from_deg) > 1e-9) {
     std::fprintf(stderr,
@@ -98,11 +94,7 @@ void add_dunes_command(CLI::App& root) {
       ->check(CLI::IsMember({"ripples", "dunes"}))
       ->capture_default_str();
   sub->add_option("-o,--output", c->output, "output GeoTIFF (heights in metres)")->required();
-  for (std::size_t i = 0; i < dunes::sand_parameters().size(); ++i) {
-    const dunes::SandParameter& p = dunes::sand_parameters()[i];
-    CLI::Option* opt = sub->add_option(p.flag, c->values[i], parameter_help(p));
-    if (p.integer) opt->check(CLI::Validator(whole_number, "WHOLE"));
-  }
+  c->parameters.add_to(*sub);
   whole_in_range(sub->add_option("--snapshot-every", c->snapshot_every,
                                  "also write OUT_<step>.tif every K steps (for animations)"),
                  1, 10000000);

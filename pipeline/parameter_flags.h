@@ -22,14 +22,19 @@ class ParameterFlags {
  public:
   using Table = std::vector<terrain::Parameter<Options>>;
 
-  explicit ParameterFlags(const Table& table) : table_(table), values_(table.size(), 0.0) {}
+  using HelpFn = std::string (*)(const terrain::Parameter<Options>&);
+
+  // `help_of` makes a flag's help from its row; by default help() below (a
+  // stage whose defaults depend on a mode, as dunes' on the model, gives its own).
+  explicit ParameterFlags(const Table& table, HelpFn help_of = &ParameterFlags::help)
+      : table_(table), help_of_(help_of), values_(table.size(), 0.0) {}
 
   // Adds one option per row with a flag of its own to `sub`.
   void add_to(CLI::App& sub) {
     for (std::size_t i = 0; i < table_.size(); ++i) {
       const terrain::Parameter<Options>& p = table_[i];
       if (!p.has_own_flag()) continue;
-      CLI::Option* opt = sub.add_option(p.flag, values_[i], help(p));
+      CLI::Option* opt = sub.add_option(p.flag, values_[i], help_of_(p));
       if (p.integer) opt->check(CLI::Validator(whole_number, "WHOLE"));
     }
   }
@@ -64,6 +69,7 @@ class ParameterFlags {
 
  private:
   const Table& table_;
+  HelpFn help_of_;
   std::vector<double> values_;
 };
 

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+
+#include "terrain/angles.h"
 
 namespace drift::snow {
 
@@ -12,7 +13,7 @@ double thin_coverage(double depth, const CoverageOptions& o) {
 
 double adhesion_coverage(const Eigen::Vector3d& n, double facing, double amount,
                          const CoverageOptions& o) {
-  const double phi = std::acos(std::clamp(n.z(), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  const double phi = terrain::degrees(std::acos(std::clamp(n.z(), -1.0, 1.0)));
   const double steep =
       std::clamp((phi - o.adhesion_min_slope) / (90.0 - o.adhesion_min_slope), 0.0, 1.0);
   const double saturation = 1.0 - std::exp(-amount / o.adhesion_depth);

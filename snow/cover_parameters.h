@@ -8,7 +8,7 @@
 
 #include <vector>
 
-#include "snow/snow_cover.h"
+#include "snow/cover_options.h"
 #include "terrain/parameter.h"
 
 namespace drift::snow {

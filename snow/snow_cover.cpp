@@ -8,10 +8,10 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <vector>
 
 #include "snow/cover_parameters.h"
+#include "terrain/angles.h"
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
@@ -263,7 +263,7 @@ float sun_corrected(float t, const HeightField& smoothed, int x, int row, float 
 HeightField apply_sun(const HeightField& t, const HeightField& smoothed, const CoverOptions& o,
                       bool southern) {
   const float sun_y = southern ? 1.0f : -1.0f;
-  const float theta1 = static_cast<float>(o.sun_range_deg * std::numbers::pi / 180.0);
+  const float theta1 = static_cast<float>(terrain::radians(o.sun_range_deg));
   HeightField corrected = t;
   for_rows(t.height(), [&](int row) {
     for (int x = 0; x < t.width(); ++x)

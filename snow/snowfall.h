@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "snow/adhesion_coverage.h"
+#include "snow/snowfall_options.h"
 #include "snow/snowfall_probability.h"
 #include "snow/snowfall_scene.h"
 #include "terrain/grid.h"
@@ -40,31 +41,6 @@
 #include "terrain/progress.h"
 
 namespace drift::snow {
-
-struct SnowfallOptions {
-  double azimuth_deg = 0.0;
-  double elevation_deg = 90.0;
-  double spread_deg = 5.0;
-  int maps = 16;
-  double rate_m_per_h = 0.02;
-  double hours = 10.0;
-  double repose_deg = 40.0;
-  std::uint64_t seed = 1;
-  double mesh_max_edge = 0.25;
-  ProbabilityOptions occlusion;
-  CoverageOptions coverage;
-  double tolerance = 1e-6;  // m: object stabilisation stops when nothing moves more per pass
-  // m: on the ground a pair steeper than repose by less than this, or a film
-  // thinner, is stable (stabilise_grid.h)
-  double ground_tolerance = 1e-3;
-  int max_iterations = 100000;
-  // The coarse-to-fine start of the ground's stabilisation (stabilise_grid.h
-  // StabiliseOptions::coarse_levels); 0: the passes on the grid alone.
-  int coarse_levels = 0;
-
-  // Throws drift::Error naming the parameter, its value and the valid range.
-  void validate() const;
-};
 
 struct SnowfallResult {
   terrain::HeightField depth;     // m of snow (vertical), georeference of the ground

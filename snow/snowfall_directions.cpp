@@ -5,6 +5,7 @@
 #include <numbers>
 #include <string>
 
+#include "terrain/angles.h"
 #include "terrain/direction.h"
 #include "terrain/error.h"
 #include "terrain/hash.h"
@@ -12,7 +13,6 @@
 namespace drift::snow {
 
 namespace {
-constexpr double kDeg = terrain::kRadiansPerDegree;
 
 double uniform(std::uint64_t seed, std::uint64_t index) {
   return terrain::unit_double(terrain::mix64(terrain::mix64(seed) ^ index));
@@ -32,7 +32,7 @@ std::vector<FallDirection> jittered_directions(double azimuth_deg, double elevat
     const Eigen::Vector3d helper =
         std::abs(mean.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
     const Eigen::Vector3d e1 = helper.cross(mean).normalized(), e2 = mean.cross(e1);
-    const double sigma = spread_deg * kDeg, cone = 2.5 * sigma;
+    const double sigma = terrain::radians(spread_deg), cone = 2.5 * sigma;
     const double golden = (3.0 - std::sqrt(5.0)) * std::numbers::pi;  // golden angle
     const double rotation = 2.0 * std::numbers::pi * uniform(seed, 0);
     std::vector<double> raw(out.size());
@@ -52,7 +52,7 @@ std::vector<FallDirection> jittered_directions(double azimuth_deg, double elevat
     for (int k = 0; k < maps; ++k) out[k].weight = static_cast<float>(raw[k] / total);
   }
   for (const auto& d : out) {
-    if (d.toward_source.z() < std::sin(1.0 * kDeg)) {
+    if (d.toward_source.z() < std::sin(terrain::radians(1.0))) {
       throw Error("snowfall elevation " + std::to_string(elevation_deg) + " with spread " +
                   std::to_string(spread_deg) +
                   " gives directions less than 1 degree above the horizon; raise the elevation "

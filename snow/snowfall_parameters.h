@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "snow/snowfall.h"
+#include "snow/snowfall_options.h"
 #include "terrain/parameter.h"
 
 namespace drift::snow {

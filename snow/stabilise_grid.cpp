@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <numbers>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -16,7 +15,9 @@
 #include "snow/stabilise_cells.h"
 #include "snow/stabilise_levels.h"
 #include "snow/stabilise_settle.h"
+#include "terrain/angles.h"
 #include "terrain/error.h"
+#include "terrain/neighbours.h"
 #include "terrain/memory.h"
 #include "terrain/slope_relax.h"
 
@@ -48,12 +49,7 @@ constexpr int kTailPasses = 200;
 constexpr double kTailShare = 0.1;
 // The coarse-to-fine start stops before a level of fewer cells a side.
 constexpr int kCoarsestCells = 32;
-// Neighbour k and neighbour 7 - k are opposite (the order of terrain/slope_relax,
-// so that sums are formed in the same order and give the same bits).
-constexpr std::array<int, 8> kDx{-1, 0, 1, -1, 1, -1, 0, 1};
-constexpr std::array<int, 8> kDy{-1, -1, -1, 0, 0, 1, 1, 1};
-
-double tan_deg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
+using terrain::kNeighbours8;
 
 template <class Fn>
 void for_list(const std::vector<int>& items, const Fn& fn) {
@@ -127,8 +123,8 @@ class SnowPasses {
           {},
           tolerance};
     for (int k = 0; k < 8; ++k) {
-      c_.drop[k] = tan_repose * std::hypot(kDx[k] * dx, kDy[k] * dy);
-      c_.offset[k] = static_cast<std::ptrdiff_t>(kDy[k]) * w_ + kDx[k];
+      c_.drop[k] = tan_repose * std::hypot(kNeighbours8[k].dx * dx, kNeighbours8[k].dy * dy);
+      c_.offset[k] = static_cast<std::ptrdiff_t>(kNeighbours8[k].dy) * w_ + kNeighbours8[k].dx;
     }
     const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
     tile_active_.assign(tiles, 1), tile_touched_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
@@ -186,7 +182,7 @@ class SnowPasses {
   unsigned inside_bits(int x, int y) const {
     unsigned bits = 0;
     for (int k = 0; k < 8; ++k) {
-      const int nx = x + kDx[k], ny = y + kDy[k];
+      const int nx = x + kNeighbours8[k].dx, ny = y + kNeighbours8[k].dy;
       bits |= static_cast<unsigned>(nx >= 0 && ny >= 0 && nx < w_ && ny < hgt_) << k;
     }
     return bits;
@@ -447,7 +443,7 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
   const std::uint64_t coarse_bytes = options.coarse_levels > 0 ? 10 : 0;
   require_memory(snow.size() * (SnowPasses::bytes_per_cell() + shortcut_bytes + coarse_bytes),
                  "snow stabilisation's workspace", "use a smaller or coarser ground raster");
-  const SettleGeometry geo{dx, dy, tan_deg(options.repose_deg), options.tolerance};
+  const SettleGeometry geo{dx, dy, terrain::tan_degrees(options.repose_deg), options.tolerance};
   if (options.coarse_levels < 0)
     throw Error("stabilise_grid: the number of coarse levels must be 0 or more");
   StabiliseReport report =
@@ -460,7 +456,7 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
 
 double max_repose_excess(const terrain::Grid<float>& ground, const terrain::Grid<double>& snow,
                          double dx, double dy, double repose_deg, double min_snow) {
-  const terrain::SlopeRule rule{tan_deg(repose_deg), 0.5, terrain::SlopeShare::HalfSteepest};
+  const terrain::SlopeRule rule{terrain::tan_degrees(repose_deg), 0.5, terrain::SlopeShare::HalfSteepest};
   terrain::SlopeCells cells{{&rule, 1}};
   cells.base = &ground;
   cells.min_value = 0.0;

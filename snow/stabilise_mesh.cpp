@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numbers>
 
+#include "terrain/angles.h"
 #include "terrain/error.h"
 
 namespace drift::snow {
@@ -114,7 +114,7 @@ MeshStabiliseReport stabilise_mesh(const terrain::Mesh& mesh, const std::vector<
   if (!(options.repose_deg > 0.0 && options.repose_deg < 90.0))
     throw Error("the angle of repose of snow must lie in (0, 90) degrees");
   const std::size_t n = mesh.vertex_count();
-  const double tan_r = std::tan(options.repose_deg * std::numbers::pi / 180.0);
+  const double tan_r = terrain::tan_degrees(options.repose_deg);
   // Slivers hold nothing: a footprint a million times below the mean would make
   // tiny volumes tall and keep them moving for ever.
   double mean = 0.0;

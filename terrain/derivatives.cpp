@@ -1,17 +1,17 @@
+#include "terrain/angles.h"
 #include "terrain/derivatives.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include "terrain/error.h"
 
 namespace drift::terrain {
 namespace {
 
-constexpr float kDegrees = static_cast<float>(180.0 / std::numbers::pi);
+constexpr float kDegrees = static_cast<float>(degrees(1.0));  // float per radian
 
 void require_metric_cells(const HeightField& dem) {
   const auto& g = dem.geo();

@@ -5,17 +5,16 @@
 
 #include <Eigen/Core>
 #include <cmath>
-#include <numbers>
+
+#include "terrain/angles.h"
 
 namespace drift::terrain {
-
-constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
 
 // Unit vector (x east, y north, z up) pointing towards azimuth `azimuth_deg`
 // (clockwise from north) at `elevation_deg` above the horizon; (any, 90) is
 // straight up.
 inline Eigen::Vector3d direction_from_az_el(double azimuth_deg, double elevation_deg) {
-  const double az = azimuth_deg * kRadiansPerDegree, el = elevation_deg * kRadiansPerDegree;
+  const double az = radians(azimuth_deg), el = radians(elevation_deg);
   return {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
 }
 

@@ -14,7 +14,6 @@
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
 #include "terrain/parameter.h"
-#include "terrain/raster_dataset.h"
 #include "terrain/raster_io.h"
 
 namespace drift::terrain {

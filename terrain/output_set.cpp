@@ -1,6 +1,11 @@
 #include "terrain/output_set.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 
 #include <mutex>
 #include <string>
@@ -34,6 +39,47 @@ fs::path keep_old(const fs::path& target, const fs::path& temp) {
   old += ".old";
   return link(target.c_str(), old.c_str()) == 0 ? old : fs::path();
 }
+
+// Exclusive advisory locks (flock) on the folders of a set's outputs, taken in
+// sorted order so that two runs never wait on each other crosswise. Runs whose
+// outputs share a folder replace their outputs one set after the other, so two
+// runs writing the same files at once leave one run's outputs, never a mix
+// (issue 34, class 7). Held only while renaming, so `make -j` over one folder
+// keeps its parallelism. Best effort: a file system without flock (some network
+// mounts) commits unlocked, as before.
+class FolderLocks {
+ public:
+  explicit FolderLocks(const std::vector<OutputSet::Staged>& outputs) {
+    std::vector<fs::path> folders;
+    for (const OutputSet::Staged& s : outputs) {
+      std::error_code ec;
+      const fs::path folder = fs::canonical(normal(s.target).parent_path(), ec);
+      if (!ec) folders.push_back(folder);
+    }
+    std::sort(folders.begin(), folders.end());
+    folders.erase(std::unique(folders.begin(), folders.end()), folders.end());
+    for (const fs::path& folder : folders) {
+      const int fd = open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+      if (fd < 0) continue;
+      int status;
+      while ((status = flock(fd, LOCK_EX)) != 0 && errno == EINTR) {
+      }
+      if (status != 0) {
+        close(fd);
+        continue;
+      }
+      fds_.push_back(fd);
+    }
+  }
+  ~FolderLocks() {
+    for (const int fd : fds_) close(fd);  // closing the last descriptor releases the lock
+  }
+  FolderLocks(const FolderLocks&) = delete;
+  FolderLocks& operator=(const FolderLocks&) = delete;
+
+ private:
+  std::vector<int> fds_;
+};
 
 }  // namespace
 
@@ -99,6 +145,8 @@ void OutputSet::commit() {
     if (!s.written) throw Error("internal: output '" + s.target.string() + "' was not written");
   }
   for (const Staged& s : outputs_) match_permissions(s.temp, s.target);
+  // Taken before signals are deferred: a run waiting here can still be stopped.
+  const FolderLocks locks(outputs_);
   DeferSignals defer(true);
   std::vector<fs::path> old(outputs_.size());
   for (std::size_t i = 0; i < outputs_.size(); ++i) {

@@ -19,7 +19,6 @@
 #include "terrain/error.h"
 #include "terrain/input_path.h"
 #include "terrain/memory.h"
-#include "terrain/raster_dataset.h"
 
 namespace drift::terrain {
 

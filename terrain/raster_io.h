@@ -12,6 +12,8 @@
 
 #include "terrain/grid.h"
 
+class GDALDataset;  // GDAL stays private to terrain: only its own sources hold one
+
 namespace drift::terrain {
 
 // Registers GDAL's drivers once and routes GDAL's messages into our errors
@@ -52,6 +54,12 @@ void require_row_across_bands_memory(std::uint64_t width, int bands, int bytes_p
 // read as a raster, a band that does not exist, a read failure (truncated or
 // corrupt data), or a raster larger than the memory available.
 HeightField read_raster(const std::filesystem::path& path, const ReadOptions& options = {});
+
+// For terrain's own sources that hold a GDAL dataset already (the warped grid
+// of an import, kept in memory): read it as read_raster reads a file. `name`
+// is what errors call the data (the file it came from).
+HeightField read_dataset(GDALDataset& dataset, const std::filesystem::path& name,
+                         const ReadOptions& options = {});
 
 struct WriteOptions {
   std::string description;  // stored as the band description (e.g. "snow depth (m)")

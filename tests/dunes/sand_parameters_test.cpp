@@ -4,6 +4,8 @@
 // must hold every range at both of its ends.
 #include "dunes/sand_parameters.h"
 
+#include "dunes/sand_model.h"
+
 #include <gtest/gtest.h>
 
 #include <map>
@@ -37,11 +39,11 @@ TEST(SandParameters, DocsAgreeWithTheTable) {
   const SandOptions ripples = default_options(Model::Ripples);
   const SandOptions dunes = default_options(Model::Dunes);
   ASSERT_EQ(rows.size(), sand_parameters().size()) << "docs/dunes.md lists other flags";
-  for (const SandParameter& p : sand_parameters()) {
+  for (const drift::terrain::Parameter<SandOptions>& p : sand_parameters()) {
     const auto it = rows.find(p.flag);
     ASSERT_NE(it, rows.end()) << p.flag << " is not in docs/dunes.md";
     const std::vector<std::string>& d = it->second;
-    EXPECT_EQ(d[0], p.dunes_only ? "-" : format_value(p.get(ripples))) << p.flag;
+    EXPECT_EQ(d[0], dunes_only(p) ? "-" : format_value(p.get(ripples))) << p.flag;
     EXPECT_EQ(d[1], format_value(p.get(dunes))) << p.flag;
     EXPECT_EQ(d[2], format_value(p.lo) + " - " + format_value(p.hi)) << p.flag;
     EXPECT_EQ(d[3], p.unit) << p.flag;
@@ -51,7 +53,7 @@ TEST(SandParameters, DocsAgreeWithTheTable) {
 
 TEST(SandParameters, ValidateHoldsEveryRangeAndNamesTheField) {
   for (const Model model : {Model::Ripples, Model::Dunes}) {
-    for (const SandParameter& p : sand_parameters()) {
+    for (const drift::terrain::Parameter<SandOptions>& p : sand_parameters()) {
       SandOptions o = default_options(model);
       EXPECT_NO_THROW(validate(o));
       if (p.field == std::string("b_prime") && model == Model::Dunes) continue;  // below q

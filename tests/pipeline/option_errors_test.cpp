@@ -53,7 +53,7 @@ TEST(OptionErrors, CommandLineSpeaksOfFlags) {
   EXPECT_NE(drift_log(d).find("--spread is 40"), std::string::npos) << drift_log(d);
   EXPECT_EQ(run_drift("import missing.tif -o " + out + " --exaggerate 0", d), 1);
   EXPECT_NE(drift_log(d).find("--exaggerate is 0"), std::string::npos) << drift_log(d);
-  EXPECT_EQ(run_drift("dunes --size 32 --L0 100 -o " + out, d), 1);
+  EXPECT_EQ(run_drift("dunes --size 32 --L0 100 -o " + out, d), 2);
   EXPECT_NE(drift_log(d).find("--L0 is 100"), std::string::npos) << drift_log(d);
   EXPECT_FALSE(fs::exists(out));
 }

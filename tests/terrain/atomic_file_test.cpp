@@ -2,7 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <fstream>
+#include <thread>
 
 #include "terrain/error.h"
 #include "terrain/output_set.h"
@@ -125,6 +132,49 @@ TEST(OutputSet, ReplacesNothingUnlessEveryOutputIsWritten) {
   EXPECT_EQ(read_all(a), "new");
   EXPECT_EQ(read_all(b), "new");
   EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator()), 2);
+}
+
+// Two runs writing the same outputs at once leave one run's set, never a mix
+// (issue 34, class 7): a set replaces its outputs under an exclusive lock on
+// their folder. Here the test holds that lock; a child process's set, written
+// and committing, must wait for it and replace nothing meanwhile.
+TEST(OutputSet, RunsWritingOneFolderReplaceTheirOutputsOneSetAtATime) {
+  const fs::path d = fresh_dir("locked"), a = d / "a.txt", b = d / "b.txt";
+  const int folder = open(d.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  ASSERT_GE(folder, 0);
+  ASSERT_EQ(flock(folder, LOCK_EX), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    try {
+      drift::OutputSet set({a, b});
+      for (const fs::path& p : {a, b}) {
+        drift::AtomicFile f(p);
+        std::ofstream(f.temp_path()) << "child";
+        f.commit();
+      }
+      set.commit();
+      _exit(0);
+    } catch (...) {
+      _exit(1);
+    }
+  }
+  // Both temporary files written: the child is at its commit.
+  const auto entries = [&] {
+    return std::distance(fs::directory_iterator(d), fs::directory_iterator());
+  };
+  for (int i = 0; i < 1000 && entries() < 2; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_FALSE(fs::exists(a));
+  EXPECT_FALSE(fs::exists(b));
+  ASSERT_EQ(flock(folder, LOCK_UN), 0);
+  close(folder);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_EQ(read_all(a), "child");
+  EXPECT_EQ(read_all(b), "child");
 }
 
 TEST(OutputSet, RefusesInputsAndTwiceNamedOutputsBeforeCreatingAnything) {

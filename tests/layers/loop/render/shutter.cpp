@@ -1,0 +1,3 @@
+// See lens.h.
+#include "render/shutter.h"
+#include "render/lens.h"

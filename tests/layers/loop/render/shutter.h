@@ -1,0 +1,2 @@
+// See lens.h.
+#pragma once
