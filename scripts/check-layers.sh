@@ -16,7 +16,7 @@ set -euo pipefail
 root="${1:-$(cd "$(dirname "$0")/.." && pwd)}"
 cd "$root"
 
-# The module of a path inside the tree ("terrain/marks/x.h" -> marks).
+# The module of a path inside the tree ("terrain/marks/marks.h" -> marks).
 module_of() {
   case "$1" in
     terrain/marks/*) echo marks ;;
