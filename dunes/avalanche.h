@@ -1,6 +1,6 @@
 // Avalanching of dry granular material on a periodic height field: sand moves
 // downhill across every cell edge steeper than the angle of repose until none
-// is (beyond paper 002, required by SPEC 2 so that slip faces form).
+// is (beyond paper 002, so that slip faces form: docs/dunes.md, The model, 3).
 #pragma once
 
 #include <vector>

@@ -1,6 +1,7 @@
 // Nishimori-Ouchi sand transport on a periodic height field (paper 002, sec. 2,
 // after Nishimori & Ouchi 1993, PRL 71:197): wind ripples and dunes from
-// saltation and creep, plus avalanching to the angle of repose (SPEC 2).
+// saltation and creep, plus avalanching to the angle of repose (beyond the
+// paper; docs/dunes.md, The model, 3).
 //
 // Frames and units. The model runs in the wind's frame (dunes/wind_frame.h):
 // the ground grid turned by whole quarter turns so that the wind blows within

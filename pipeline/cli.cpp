@@ -31,8 +31,9 @@ void require_finite_numbers(const CLI::App& sub) {
 }
 
 // An empty value (`--cover ""`, say from an unset shell variable in a batch
-// job) was taken as the option not given: the output it asked for was not
-// written, the input it named not read, with exit 0. Free text may be empty.
+// job) is refused: taken as the option not given, the output it asks for would
+// silently not be written and the input it names not read, with exit 0. Free
+// text may be empty.
 void require_nonempty_values(const CLI::App& sub) {
   for (const CLI::Option* option : sub.get_options()) {
     const std::string name = option->get_name();

@@ -32,8 +32,9 @@ struct SnowfallCommand {
   ParameterFlags<snow::SnowfallOptions> parameters{snow::snowfall_parameters()};
 };
 
-// SPEC 3a's third output: the height of the snow's top, for stages that press
-// into it (marks). NaN where the ground has no data.
+// The snow surface (docs/snowfall.md, `--surface`): the height of the snow's
+// top, ground + depth, for stages that press into it (marks). NaN where the
+// ground has no data.
 terrain::HeightField snow_surface(const terrain::HeightField& ground,
                                   const terrain::HeightField& depth) {
   terrain::HeightField top = depth;

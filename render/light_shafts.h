@@ -1,8 +1,9 @@
-// Light shafts: the terrain's shadow on the air (SPEC 6, issue 7's optional
-// item). Aerial perspective (PhysicalSky::from_camera) lets the sun light all
-// the air between the camera and what it sees; where a ridge hides the sun,
-// that air scatters only the sky's light, and at a low sun dark shafts fall
-// from the peaks through the haze.
+// Light shafts: the terrain's shadow on the air (docs/rendering.md, Sky, sun
+// and air; issue 7's optional item). Aerial perspective
+// (PhysicalSky::from_camera) lets the sun light all the air between the camera
+// and what it sees; where a ridge hides the sun, that air scatters only the
+// sky's light, and at a low sun dark shafts fall from the peaks through the
+// haze.
 //
 // The camera ray is cut into `steps` equal strata within the heights where a
 // shadow can be (between the scene's lowest and highest geometry); one point

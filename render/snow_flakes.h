@@ -1,8 +1,9 @@
 // Snow that covers part of a surface, shown as flakes (paper 003, 2.1(4)
-// and 2.3(5); SPEC 3a): the start of a snowfall and the flakes stuck to steep
-// faces are "a texture of sparsely attached flakes", not a pale film. The
-// snow stages give a coverage c in [0, 1] (snow/adhesion_coverage.h); here c
-// becomes a deterministic world-space pattern whose covered area fraction is c.
+// and 2.3(5); docs/snowfall.md, Thin snow and stuck flakes): the start of a
+// snowfall and the flakes stuck to steep faces are "a texture of sparsely
+// attached flakes", not a pale film. The snow stages give a coverage c in
+// [0, 1] (snow/adhesion_coverage.h); here c becomes a deterministic world-space
+// pattern whose covered area fraction is c.
 //
 // The pattern is a Boolean model (Chiu, Stoyan, Kendall & Mecke 2013,
 // "Stochastic Geometry and its Applications", ch. 3: discs of a Poisson

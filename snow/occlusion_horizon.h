@@ -1,6 +1,7 @@
 // The height-field path of the occlusion test: instead of rasterising the DEM's
-// triangles into a depth map (OSMesa, occlusion_osmesa.h), sweep the grid line by
-// line from the side the snow comes from, carrying the "shadow surface"
+// triangles into a depth map (OSMesa, terrain/offscreen/osmesa_depth_renderer.h),
+// sweep the grid line by line from the side the snow comes from, carrying the
+// "shadow surface"
 //   S(p) = max(h(p), S(p + s * horizontal) - s * tan(elevation)),
 // the highest the terrain upstream reaches along the ray through p; S at the
 // upstream point is interpolated linearly between the two cells the ray crosses.

@@ -189,7 +189,8 @@ bool in_southern_hemisphere(const HeightField& dem, Hemisphere hemisphere) {
   return terrain::centre_lonlat(dem.geo(), dem.width(), dem.height())[1] < 0.0;
 }
 
-// Altitude factor a(z) (SPEC 3b.4): (z / z_max)^2, or a smooth step across a snow line.
+// Altitude factor a(z) (docs/snow.md, Steps, 4): (z / z_max)^2, or a smooth step
+// across a snow line.
 struct Altitude {
   float z_max;
   const CoverOptions& o;
@@ -296,7 +297,8 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
   // 2. TSA of the smoothed surface (lines 4-5).
   result.accessibility = tangent_sphere_accessibility(smoothed);
   if (!progress(0.7, "accessibility")) throw Cancelled();
-  // 3-4. Transfer and altitude (lines 6-7, SPEC 3b.4); 5. smooth t once (line 9).
+  // 3-4. Transfer and altitude (lines 6-7; docs/snow.md, Steps, 4); 5. smooth t
+  // once (line 9).
   HeightField t = smooth(descriptor_from_accessibility(dem, result.accessibility, o), 1);
   // 6. Sun (lines 10-15).
   if (o.sun_range_deg > 0.0) t = apply_sun(t, smoothed, o, result.southern);

@@ -1,7 +1,7 @@
 // The snow-cover descriptor of paper 001 (Nakatani, Fujishiro and Ohno, "Design
 // of Surface Descriptor for Rendering Snow-Covered Terrain", after Miller 1994's
-// Tangent Sphere Accessibility), with the decisions of SPEC 3b: per grid point a
-// value t in [0, 1], 0 = snow, 1 = bare rock.
+// Tangent Sphere Accessibility), with the decisions docs/snow.md records: per
+// grid point a value t in [0, 1], 0 = snow, 1 = bare rock.
 //
 //   1. smooth the DEM k times over the diamond of region n;
 //   2. TSA of the smoothed surface at each point (paper eq. 3);
@@ -12,10 +12,11 @@
 //      within theta1 of the sun's side updates t = t phi + (1 - phi), phi its
 //      normalised angle, one triangle after the other.
 //
-// Lengths are metric by default (SPEC 3b.3): the probe radius in metres and the
-// smoothing region in units of the paper's 50 m grid spacing, widened to as many
-// cells as that is on a finer DEM, so that a DEM and the same ground sampled
-// finer give the same descriptor. Cells can be asked for explicitly.
+// Lengths are metric by default (docs/snow.md, Steps 1 and 3, and "Metric
+// defaults on finer DEMs"): the probe radius in metres and the smoothing region
+// in units of the paper's 50 m grid spacing, widened to as many cells as that is
+// on a finer DEM, so that a DEM and the same ground sampled finer give the same
+// descriptor. Cells can be asked for explicitly.
 #pragma once
 
 #include <Eigen/Core>

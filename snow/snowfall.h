@@ -1,6 +1,7 @@
 // Snowfall with occlusion, irregular motion and stabilisation (paper 003:
 // Moriki & Tokoi, "Real-time simulation of the fallen snow with consideration to
-// the irregular motion of the snow"; SPEC section 3a).
+// the irregular motion of the snow"; docs/snowfall.md records the decisions
+// the paper leaves open).
 //
 // Stages: depth maps along jittered directions -> probability per ground cell
 // and object face (snowfall_probability.h) -> amount = probability x rate x

@@ -4,14 +4,14 @@
 //   (2) one neighbour lower: snow moves to it;
 //   (3) two or more lower: the snow is shared among them, in proportion to how
 //       much lower each is.
-// The paper does not say how much moves. Here (SPEC 3a) a neighbour counts as
-// lower only where the snow surface slope to it exceeds the angle of repose, by
-// the excess e = (H_i - H_j) - tan(repose) * L, L the distance between the cell
-// centres; the cell gives min(snow held, e_max / 2) (half the steepest excess
-// brings that pair exactly to repose, never past it), so a cell never gives more
-// snow than it holds and bare ground never moves. No over-relaxation: snow
-// thrown past the point where a pair is at repose never comes back, so piles
-// would end flatter than the repose angle.
+// The paper does not say how much moves. Here (docs/snowfall.md, Stabilisation)
+// a neighbour counts as lower only where the snow surface slope to it exceeds
+// the angle of repose, by the excess e = (H_i - H_j) - tan(repose) * L, L the
+// distance between the cell centres; the cell gives min(snow held, e_max / 2)
+// (half the steepest excess brings that pair exactly to repose, never past it),
+// so a cell never gives more snow than it holds and bare ground never moves. No
+// over-relaxation: snow thrown past the point where a pair is at repose never
+// comes back, so piles would end flatter than the repose angle.
 //
 // Departure from the paper: 8 neighbours (the diagonals at their distance), not
 // the paper's 4, which let diagonal slopes stand at up to 50 degrees when the

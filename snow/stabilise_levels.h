@@ -38,8 +38,8 @@
 // surface rises (the steeper of the one-sided differences of the change that
 // rise that way), so the block keeps snow on its uphill side and what that
 // leaves steeper than repose the grid's passes take down within the block.
-// The earlier limited slope (minmod) stood the 2 x 2 apex blocks of a pile flat
-// and left the pile flatter than repose (an 8 x 8 tower: apex 4 % lower,
+// A limited slope (minmod) instead would stand the 2 x 2 apex blocks of a pile
+// flat and leave the pile flatter than repose (an 8 x 8 tower: apex 4 % lower,
 // diagonal flanks 1.4 degrees below). The four offsets cancel, so the block's
 // volume is its coarse cell's; they are scaled down where a cell would go
 // negative, and a block losing more than a cell holds (a pile's edge whose

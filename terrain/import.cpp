@@ -64,10 +64,10 @@ int utm_epsg(double lon, double lat) {
 
 // Ring by ring as a breadth-first walk from the valid cells: each ring's cells
 // take the mean of their neighbours of earlier rings, in the same order and
-// arithmetic as a pass over the whole grid per ring did, so the same bits. That
-// pass was quadratic in a gap's width: a 1 x 17667 strip of nodata (found by
-// fuzz_raster) ran over a minute, a DEM with a sea of nodata thousands of
-// cells wide would never have finished.
+// arithmetic as a pass over the whole grid per ring, so the same bits, in time
+// linear in the grid. A pass per ring is quadratic in a gap's width: a 1 x
+// 17667 strip of nodata (found by fuzz_raster) takes over a minute so, and a
+// DEM with a sea of nodata thousands of cells wide would never finish.
 std::size_t fill_nodata(HeightField& g, const std::string& what) {
   const int w = g.width(), h = g.height();
   std::vector<std::uint8_t> known(g.size()), queued(g.size());

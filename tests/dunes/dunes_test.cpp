@@ -265,9 +265,9 @@ TEST(Sand, DunesGrowSlipFacesAtObliqueWindsAsAlongTheGrid) {
   // The share of the area that is lee face over 25 degrees (falling along
   // the wind) after 6000 steps at 128^2, creep 0.5, seed 1, at winds off the
   // grid against one along it. Measured: 17 % along the grid; 18, 15 and
-  // 10.5 % at 15, 30 and 45 degrees off it. On the sheared lattice of the
-  // previous version a slip face across an oblique wind was a staircase that
-  // creep and avalanching wore down: 2.1, 1.4 and 0 % (measured on it).
+  // 10.5 % at 15, 30 and 45 degrees off it. On a lattice sheared to the wind
+  // instead of turned to it (docs/dunes.md) a slip face across an oblique wind
+  // is a staircase that creep and avalanching wear down: 2.1, 1.4 and 0 %.
   auto lee_share = [](double wind) {
     SandOptions o = small(Model::Dunes, 128, 6000);
     o.creep = 0.5;

@@ -8,8 +8,8 @@
 // Checked allocations stay well below libFuzzer's -malloc_limit_mb (512 in
 // scripts/fuzz.sh): a larger single allocation is unchecked, a finding. 64M
 // (DRIFT_MEMORY_LIMIT overrides it) also keeps each input quick: a 35-byte
-// image declaring 10000^2 pixels was decoded into 400 MB (0.4-0.8 s an input,
-// 108 inputs in round 3) where it is now refused by the check it exercises.
+// image declaring 10000^2 pixels is refused by the check it exercises instead
+// of being decoded into 400 MB (0.4-0.8 s an input, 108 such inputs in round 3).
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   setenv("DRIFT_MEMORY_LIMIT", "64M", 0);
   drift::fuzz::bound_work_per_input();

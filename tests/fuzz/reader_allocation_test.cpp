@@ -72,7 +72,7 @@ std::string image_refusal(const fs::path& file, std::size_t& largest) {
 
 // An "int" attribute declaring 24 bytes: OpenEXR's C++ reader reads 4 and
 // parses on from there, where a hidden string attribute declares 1.8 GB; a
-// walk of the declared sizes (drift's check until now) skipped over it.
+// walk of the declared sizes alone would skip over it.
 TEST(ReaderAllocation, ValueShorterThanItsDeclaredSizeCannotHideAHugeAttribute) {
   const fs::path file = regression("image", "exr_int_declared_24_bytes_hides_1.8GB_string.exr");
   std::size_t largest = 0;
@@ -108,9 +108,9 @@ TEST(ReaderAllocation, OneRowImageIsReadWithoutARowBuffer256High) {
   EXPECT_EQ(back.at(99999, 0, 2), back.at(0, 0, 2));
 }
 
-// A PLY header of 889,850,951 vertices and no properties: 0 bytes a row, so
-// the check of the declared rows against the file passed, and 3.6 GB were
-// allocated for a column (fuzz_ply, 2026-11-25).
+// A PLY header of 889,850,951 vertices and no properties: 0 bytes a row, so a
+// check of the declared rows against the file's size passes it, and a reader
+// trusting it would allocate 3.6 GB for a column (fuzz_ply, 2026-11-25).
 TEST(ReaderAllocation, PlyVerticesWithoutCoordinatesAreRefusedBeforeAllocating) {
   const fs::path file = regression("ply", "889850951_vertices_no_properties.ply");
   std::size_t largest = 0;

@@ -133,9 +133,9 @@ TEST(RefusalsCli, FifosAsInputsFailAtOnce) {
   }
 }
 
-// Files named inside inputs are inputs too: a VRT's sources (a FIFO had
-// blocked info and import for ever) and an OBJ's mtllib (/dev/zero had been read
-// without end, a FIFO had blocked marks and snow fall).
+// Files named inside inputs are inputs too: a VRT's sources (a FIFO would
+// block info and import for ever) and an OBJ's mtllib (/dev/zero would be read
+// without end, a FIFO would block marks and snow fall).
 TEST(RefusalsCli, FilesNamedInsideInputsObeyTheInputRules) {
   const fs::path d = test_dir(), fifo = d / "pipe.tif";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
@@ -369,7 +369,8 @@ TEST(RefusalsCli, SoilRefusesValuesOutOfRangeAndGridsLargerThanMemory) {
   EXPECT_REFUSED(drift(ground + " --ground-margin 50000", d, "DRIFT_MEMORY_LIMIT=256M"), 1,
                  "--ground raster of 100016 x 100016 cells");
   EXPECT_REFUSED(drift(ground + " --ground-margin -5", d), 2, "--ground-margin");
-  // --frames must name a directory: a file is not one (it was "does not exist").
+  // --frames must name a directory: a file is not one, and the message says so
+  // (not "does not exist").
   put(d / "afile", "keep");
   EXPECT_REFUSED(drift(run + " --frames " + (d / "afile").string(), d), 1, "is not a directory");
   EXPECT_REFUSED(drift(run + " --frames " + (d / "none").string(), d), 1, "does not exist");
@@ -458,10 +459,10 @@ TEST(RefusalsCli, TilesOfDifferentScenesDoNotMerge) {
       0);
 }
 
-// compare --region X,Y,W,H: numbers an int cannot hold are usage errors (they
-// were read modulo 2^32, so 4294967296 compared column 0), and a rectangle
-// whose far edge overflows an int is outside the image (it wrapped past the
-// check and read beyond the pixels).
+// compare --region X,Y,W,H: numbers an int cannot hold are usage errors (read
+// modulo 2^32, 4294967296 would compare column 0), and a rectangle whose far
+// edge overflows an int is outside the image (wrapped past the check, it would
+// read beyond the pixels).
 TEST(RefusalsCli, CompareRegionsBeyondAnIntOrTheImageAreRefused) {
   const fs::path d = test_dir();
   const std::string png = (d / "a.png").string(), diff = (d / "diff.png").string();

@@ -177,7 +177,7 @@ TEST(SceneFile, SeedTakesTheCommandLinesSixtyFourBitRange) {
     return drift::pipeline::read_scene_file(p).settings.seed;
   };
   EXPECT_EQ(seed_of("0"), 0u);
-  EXPECT_EQ(seed_of("4294967296"), 4294967296u);  // beyond the old 2^31 - 1
+  EXPECT_EQ(seed_of("4294967296"), 4294967296u);  // beyond 2^31 - 1: seeds are 64-bit
   EXPECT_EQ(seed_of("9223372036854775807"), 9223372036854775807u);
   EXPECT_EQ(seed_of("\"18446744073709551615\""), 18446744073709551615u);
   for (const char* bad : {"-1", "\"18446744073709551616\"", "\"12a\"", "1.5"}) {

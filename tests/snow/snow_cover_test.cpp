@@ -1,4 +1,4 @@
-// The snow-cover descriptor (paper 001, SPEC 3b): TSA against analytic
+// The snow-cover descriptor (paper 001; docs/snow.md): TSA against analytic
 // surfaces and its invariances, the smoothing diamond, the transfer, the sun's
 // side in both hemispheres, and the command line keeping the georeference.
 #include "snow/snow_cover.h"

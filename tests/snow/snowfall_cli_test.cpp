@@ -46,7 +46,8 @@ TEST(SnowfallCli, WritesDepthCoverSurfaceAndMesh) {
   EXPECT_EQ(depth.geo().geotransform[0], 600000.0);
   EXPECT_EQ(depth(2, 2), 0.2f);  // open flat ground: rate x hours
   EXPECT_TRUE(fs::exists(d / "cover.tif"));
-  // The snow surface (SPEC 3a): ground + depth, same georeference.
+  // The snow surface (docs/snowfall.md, `--surface`): ground + depth, same
+  // georeference.
   const auto surface = drift::terrain::read_raster(d / "surface.tif");
   EXPECT_EQ(surface.geo().geotransform, depth.geo().geotransform);
   for (int row = 0; row < depth.height(); ++row)

@@ -1,9 +1,9 @@
-// Stabilisation (paper 003, 2.1(3); SPEC 3a): the paper's three cases one by one,
-// a column settling into a cone whose flanks stand at the repose angle along all
-// 8 grid directions (diagonals included) and as high as the repose angle allows,
-// no snow-surface slope above repose where snow lies, mass conserved to double
-// rounding, symmetric, thread-count independent, the same bits as the shared
-// slope relaxation it specialises.
+// Stabilisation (paper 003, 2.1(3); docs/snowfall.md, Stabilisation): the
+// paper's three cases one by one, a column settling into a cone whose flanks
+// stand at the repose angle along all 8 grid directions (diagonals included)
+// and as high as the repose angle allows, no snow-surface slope above repose
+// where snow lies, mass conserved to double rounding, symmetric, thread-count
+// independent, the same bits as the shared slope relaxation it specialises.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 

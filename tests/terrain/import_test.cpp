@@ -126,8 +126,8 @@ TEST(Import, FillNodataIsLocalAndComplete) {
 
 namespace {
 
-// The pass-per-ring fill as it was before the walk (quadratic in a gap's
-// width), kept as the reference for the bits.
+// The fill by a pass over the whole grid per ring (quadratic in a gap's
+// width): the reference for the bits of the walk in terrain/import.cpp.
 void fill_by_passes(HeightField& g) {
   std::size_t missing = 0;
   for (float v : g.values()) missing += std::isnan(v);
