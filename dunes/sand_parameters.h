@@ -1,7 +1,7 @@
 // The sand model's parameters in one table (Mitsuba's parameter tables are
 // the model): each row names the SandOptions field, the `drift dunes` flag,
-// the unit, the valid range and what it means, as every stage's table does. validate(), the command line's
-// flags and help, and docs/dunes.md's table all come from it: the defaults are
+// the unit, the valid range and what it means, as every stage's table does. validate(), the command
+// line's flags and help, and docs/dunes.md's table all come from it: the defaults are
 // default_options(model)'s, and tests/dunes/sand_parameters_test.cpp fails
 // when docs/dunes.md disagrees with the table.
 #pragma once

@@ -12,6 +12,7 @@
 #include "pipeline/progress_bar.h"
 #include "pipeline/scene_file.h"
 #include "pipeline/scene_products.h"
+#include "pipeline/scene_variables.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
 #include "render/tiles.h"
@@ -24,6 +25,7 @@ namespace {
 
 struct RenderOptions {
   std::string scene;
+  std::vector<std::string> variables;  // --set NAME=VALUE
   int spp = 0;
   double noise_target = -1.0;  // < 0: the scene's
   std::string size;
@@ -193,8 +195,22 @@ void print_summary(const SceneFile& scene, const render::Image& image,
   std::printf("\n");
 }
 
+// --set NAME=VALUE, each a usage error unless NAME can name a variable.
+SceneVariables scene_variables(const std::vector<std::string>& settings) {
+  SceneVariables variables;
+  for (const std::string& setting : settings) {
+    const std::size_t equals = setting.find('=');
+    const std::string name = setting.substr(0, equals);
+    if (equals == std::string::npos || !is_variable_name(name))
+      usage_error("--set '" + setting +
+                  "' must be NAME=VALUE with NAME of letters, digits and '_' (e.g. OUT=out)");
+    variables[name] = setting.substr(equals + 1);
+  }
+  return variables;
+}
+
 void run_render(const RenderOptions& o, const CLI::App& sub) {
-  SceneFile scene = read_scene_file(o.scene);
+  SceneFile scene = read_scene_file(o.scene, scene_variables(o.variables));
   apply_overrides(o, sub, scene);
   check_outputs(o, scene);
   std::vector<std::filesystem::path> inputs = scene_inputs(scene);
@@ -247,6 +263,9 @@ void add_render_command(CLI::App& root) {
   CLI::App* sub = add_subcommand(root, "render", "path-trace a scene file (TOML) to EXR and/or PNG",
                                  [o](const CLI::App& self) { run_render(*o, self); });
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
+  sub->add_option("--set", o->variables,
+                  "NAME=VALUE: ${NAME} in the scene file's strings becomes VALUE (overrides its "
+                  "[variables]; e.g. --set OUT=build/out for the products it reads)");
   whole_in_range(sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)"), 1,
                  render::RenderSettings::kMaxSamplesPerPixel);
   sub->add_option("--noise-target", o->noise_target,

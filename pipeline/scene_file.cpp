@@ -12,6 +12,7 @@
 
 #include "pipeline/object_list.h"
 #include "pipeline/scene_products.h"
+#include "pipeline/scene_variables.h"
 #include "pipeline/toml_section.h"
 #include "render/atmosphere.h"
 #include "render/land_form.h"
@@ -457,8 +458,9 @@ std::vector<terrain::PlacedMesh> read_objects_with_materials(const toml::table& 
 
 }  // namespace
 
-SceneFile read_scene_file(const fs::path& path) {
-  const toml::table root = parse_toml_file(path, "scene");
+SceneFile read_scene_file(const fs::path& path, const SceneVariables& variables) {
+  toml::table root = parse_toml_file(path, "scene");
+  expand_scene_variables(root, path, variables);
   check_sections(root, path);
   SceneFile scene;
   const std::optional<fs::path> objects_file = read_terrain(root, path, scene);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/scene_variables.h"
 #include "render/render_settings.h"
 #include "render/solar_position.h"
 #include "render/tonemap.h"
@@ -62,7 +63,9 @@ struct SceneFile {
 std::vector<std::string> scene_sections();
 
 // Parses and validates; meshes are loaded, the terrain raster is not.
-SceneFile read_scene_file(const std::filesystem::path& path);
+// `variables` replace the defaults of the file's [variables] table
+// (pipeline/scene_variables.h).
+SceneFile read_scene_file(const std::filesystem::path& path, const SceneVariables& variables = {});
 
 // Every file the scene reads (rasters, masks, product files), for refusing
 // them as outputs.

@@ -74,7 +74,7 @@ for file in "${files[@]}"; do
       echo "$file:$line: $from includes \"$include\" ($to is above or beside it; $from may include:${allowed_of[$from]% }; see docs/architecture.md)"
       status=1
     elif [[ $to == "$from" && ${target%.*} != "${file%.*}" ]]; then
-      edges+=("${file%.*} ${target%.*}") # a file pair (x.h, x.cpp) is one component
+      edges+=("${file%.*} ${target%.*}") # a header and its source are one component
     fi
   done < <(grep -n -oE '^[[:space:]]*#[[:space:]]*include[[:space:]]+"[^"]+"' "$file" |
            sed -E 's/^([0-9]+):.*"([^"]+)"/\1:\2/')

@@ -17,8 +17,8 @@
 #include "snow/stabilise_settle.h"
 #include "terrain/angles.h"
 #include "terrain/error.h"
-#include "terrain/neighbours.h"
 #include "terrain/memory.h"
+#include "terrain/neighbours.h"
 #include "terrain/slope_relax.h"
 
 namespace drift::snow {
@@ -456,7 +456,8 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
 
 double max_repose_excess(const terrain::Grid<float>& ground, const terrain::Grid<double>& snow,
                          double dx, double dy, double repose_deg, double min_snow) {
-  const terrain::SlopeRule rule{terrain::tan_degrees(repose_deg), 0.5, terrain::SlopeShare::HalfSteepest};
+  const terrain::SlopeRule rule{terrain::tan_degrees(repose_deg), 0.5,
+                                terrain::SlopeShare::HalfSteepest};
   terrain::SlopeCells cells{{&rule, 1}};
   cells.base = &ground;
   cells.min_value = 0.0;

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cerrno>
-
 #include <mutex>
 #include <string>
 #include <system_error>

@@ -733,7 +733,7 @@ TEST(DunesCommand, WritesStartSnapshotsAndRefusesNonsense) {
   EXPECT_TRUE(fs::exists(dir / "r.tif"));
 
   EXPECT_EQ(run_cli("--model sand -o " + (dir / "x.tif").string()), 2 << 8);
-  EXPECT_EQ(run_cli("--size 32 --L0 100 -o " + (dir / "x.tif").string()), 1 << 8);
+  EXPECT_EQ(run_cli("--size 32 --L0 100 -o " + (dir / "x.tif").string()), 2 << 8);
   EXPECT_FALSE(fs::exists(dir / "x.tif"));
   fs::remove_all(dir);
 }

@@ -4,14 +4,13 @@
 // must hold every range at both of its ends.
 #include "dunes/sand_parameters.h"
 
-#include "dunes/sand_model.h"
-
 #include <gtest/gtest.h>
 
 #include <map>
 #include <string>
 #include <vector>
 
+#include "dunes/sand_model.h"
 #include "terrain/parameter.h"
 #include "tests/markdown_table.h"
 

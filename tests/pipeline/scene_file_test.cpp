@@ -562,3 +562,36 @@ TEST(SceneFile, CloudsAreReadAndChecked) {
       error_of(std::string(kTerrain) + "[sky]\nmodel = \"simple\"\n[clouds]\ncoverage = 0.5\n");
   EXPECT_NE(simple.find("physical sky"), std::string::npos) << simple;
 }
+
+// ${NAME} in a scene's strings: the file's [variables] give defaults, the
+// caller's values (drift render --set) replace them, and a name neither gives
+// is an error naming the key, the line and the way to give it.
+TEST(SceneFile, VariablesNameProductsRelativeToAFolderTheCallerChooses) {
+  const fs::path p = write_scene("vars.toml",
+                                 "[variables]\nOUT = \"products\"\n"
+                                 "[terrain]\nraster = \"${OUT}/dem.tif\"\n"
+                                 "[output]\nfiles = [\"${OUT}/a.png\", \"b_${OUT}.exr\"]\n");
+  const auto defaults = drift::pipeline::read_scene_file(p);
+  EXPECT_EQ(defaults.terrain_raster, p.parent_path() / "products/dem.tif");
+  ASSERT_EQ(defaults.outputs.size(), 2u);
+  EXPECT_EQ(defaults.outputs[0], p.parent_path() / "products/a.png");
+  EXPECT_EQ(defaults.outputs[1], p.parent_path() / "b_products.exr");
+  const auto given = drift::pipeline::read_scene_file(p, {{"OUT", "/data/run 1"}});
+  EXPECT_EQ(given.terrain_raster, fs::path("/data/run 1/dem.tif"));
+  EXPECT_EQ(given.outputs[0], fs::path("/data/run 1/a.png"));
+}
+
+TEST(SceneFile, UnknownOrMalformedVariablesAreRefusedSayingHowToGiveThem) {
+  const std::string unknown = error_of("[terrain]\nraster = \"${OUTT}/dem.tif\"\n");
+  EXPECT_NE(unknown.find("s.toml:2: terrain.raster: unknown variable ${OUTT}"), std::string::npos)
+      << unknown;
+  EXPECT_NE(unknown.find("--set OUTT=VALUE"), std::string::npos) << unknown;
+  const std::string open = error_of("[terrain]\nraster = \"${OUT/dem.tif\"\n");
+  EXPECT_NE(open.find("without its closing"), std::string::npos) << open;
+  const std::string number = error_of("[variables]\nOUT = 3\n" + std::string(kTerrain));
+  EXPECT_NE(number.find("[variables] OUT: give a string"), std::string::npos) << number;
+  const std::string empty_name = error_of("[terrain]\nraster = \"${}/dem.tif\"\n");
+  EXPECT_NE(empty_name.find("unknown variable ${}"), std::string::npos) << empty_name;
+  // A lone '$' is no variable.
+  EXPECT_EQ(error_of("[terrain]\nraster = \"$dem.tif\"\n"), "");
+}
