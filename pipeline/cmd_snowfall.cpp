@@ -12,6 +12,7 @@
 #include "snow/snowfall.h"
 #include "snow/snowfall_parameters.h"
 #include "terrain/error.h"
+#include "terrain/height_change.h"
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
 #include "terrain/products.h"
@@ -31,17 +32,6 @@ struct SnowfallCommand {
   // SnowfallOptions{}'s defaults.
   ParameterFlags<snow::SnowfallOptions> parameters{snow::snowfall_parameters()};
 };
-
-// The snow surface (docs/snowfall.md, `--surface`): the height of the snow's
-// top, ground + depth, for stages that press into it (marks). NaN where the
-// ground has no data.
-terrain::HeightField snow_surface(const terrain::HeightField& ground,
-                                  const terrain::HeightField& depth) {
-  terrain::HeightField top = depth;
-  for (std::size_t i = 0; i < top.size(); ++i)
-    top.values()[i] = ground.values()[i] + depth.values()[i];
-  return top;
-}
 
 // --mesh-out's help from the declared form it writes (terrain/products.h).
 std::string mesh_out_help() {
@@ -89,7 +79,7 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   terrain::write_geotiff(r.depth, c.output, {"snow depth (m)", "m"});
   if (!c.cover.empty()) terrain::write_geotiff(r.coverage, c.cover, {"snow coverage (0..1)", ""});
   if (!c.surface.empty())
-    terrain::write_geotiff(snow_surface(ground, r.depth), c.surface,
+    terrain::write_geotiff(terrain::lay_on_ground(ground, r.depth, "the snow depth"), c.surface,
                            {"snow surface height, ground + depth (m)", "m"});
   if (!c.mesh_out.empty()) terrain::write_ply(r.objects, c.mesh_out);
   outputs.commit();

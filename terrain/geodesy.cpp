@@ -2,8 +2,10 @@
 
 #include <ogr_spatialref.h>
 
+#include <cmath>
 #include <memory>
 
+#include "terrain/angles.h"
 #include "terrain/error.h"
 
 namespace drift::terrain {
@@ -51,6 +53,14 @@ bool is_geographic(const std::string& crs_wkt) {
 std::array<double, 2> centre_lonlat(const GeoReference& geo, int width, int height) {
   const auto c = geo.cell_center((width - 1) / 2.0, (height - 1) / 2.0);
   return to_lonlat(geo.crs_wkt, c[0], c[1]);
+}
+
+double grid_convergence_deg(const GeoReference& geo, int width, int height) {
+  const auto lonlat = centre_lonlat(geo, width, height);
+  // The grid direction of a step of 1e-3 degrees north from the centre.
+  const auto centre = geo.cell_center((width - 1) / 2.0, (height - 1) / 2.0);
+  const auto north = from_lonlat(geo.crs_wkt, lonlat[0], lonlat[1] + 1e-3);
+  return degrees(std::atan2(north[0] - centre[0], north[1] - centre[1]));
 }
 
 }  // namespace drift::terrain

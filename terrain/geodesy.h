@@ -23,4 +23,10 @@ bool is_geographic(const std::string& crs_wkt);
 // lon/lat of the centre of a raster with this georeference and size.
 std::array<double, 2> centre_lonlat(const GeoReference& geo, int width, int height);
 
+// Meridian convergence at the centre of a raster with this georeference and
+// size: the angle from the grid's north (+y) to true north, in degrees,
+// clockwise (east of grid north is positive). A true azimuth plus this is the
+// grid azimuth. Throws as to_lonlat does for a raster without a CRS.
+double grid_convergence_deg(const GeoReference& geo, int width, int height);
+
 }  // namespace drift::terrain

@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "terrain/grid.h"
+#include "terrain/marks/marks_options.h"
 #include "terrain/marks/material.h"
 #include "terrain/marks/object_bottom.h"
 #include "terrain/marks/object_geometry.h"
@@ -60,27 +61,6 @@ struct MarkObject {
   std::optional<Material> material;  // the ground's material where it walks
   Motion motion = Motion::Sweep;
   int resolution = 1;  // 1 full, 2 half, 4 quarter; 0: chosen from the camera
-};
-
-// A camera to choose resolutions by (paper 000, 3.6 A): a cell projects to
-// about cell x focal / distance pixels.
-struct MarksCamera {
-  Eigen::Vector3d position{0, 0, 0};
-  double fov_deg = 40.0;  // horizontal
-  int width_px = 1280;
-};
-
-struct MarksOptions {
-  double step = 0.1;
-  int memory_steps = 20;
-  int erosion_passes = 100;
-  int margin = 4;
-  BottomRenderer renderer = BottomRenderer::Cpu;
-  std::uint64_t seed = 0;
-  std::optional<MarksCamera> camera;
-  bool track_disturbed = true;  // keep the per-cell disturbance raster
-  // Throws drift::Error naming the option.
-  void validate() const;
 };
 
 struct StepReport {

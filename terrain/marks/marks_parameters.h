@@ -8,7 +8,7 @@
 
 #include <vector>
 
-#include "terrain/marks/marks.h"
+#include "terrain/marks/marks_options.h"
 #include "terrain/parameter.h"
 
 namespace drift::marks {

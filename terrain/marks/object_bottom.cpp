@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "terrain/marks/object_bottom_osmesa.h"
 
 namespace drift::marks {
 

@@ -60,4 +60,10 @@ class BottomRasteriser {
 // Throws drift::Error if OSMesa cannot make a context (OpenGL only).
 std::unique_ptr<BottomRasteriser> make_bottom_rasteriser(BottomRenderer kind);
 
+// The object's bottom rendered by OSMesa (paper 000, 3.3: OpenGL looking up
+// from below the ground, orthographic, one pixel per cell), through the depth
+// renderer shared with snowfall (terrain/offscreen; object_bottom_osmesa.cpp).
+// Throws drift::Error if OSMesa cannot make a context. Use on one thread.
+std::unique_ptr<BottomRasteriser> make_osmesa_bottom_rasteriser();
+
 }  // namespace drift::marks

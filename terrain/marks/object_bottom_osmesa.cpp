@@ -1,4 +1,9 @@
-#include "terrain/marks/object_bottom_osmesa.h"
+// The object's bottom rendered by OSMesa (paper 000, 3.3: OpenGL looking up
+// from below the ground, orthographic, one pixel per cell), through the depth
+// renderer shared with snowfall (terrain/offscreen). Depths are 32-bit floats
+// measured from the object's lowest point, so they keep sub-millimetre
+// precision whatever the ground's altitude.
+#include "terrain/marks/object_bottom.h"
 
 #include <algorithm>
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "terrain/parameter.h"
-#include "terrain/soil/simulation.h"
+#include "terrain/soil/soil_options.h"
 
 namespace drift::soil {
 

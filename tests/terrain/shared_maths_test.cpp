@@ -1,17 +1,23 @@
 // The small shared ideas every module draws on (terrain/bilinear.h,
-// terrain/direction.h, terrain/hash.h, terrain/local_frame.h and the central
-// differences of terrain/derivatives.h), against closed forms.
+// terrain/direction.h, terrain/hash.h, terrain/local_frame.h, terrain/angles.h,
+// terrain/neighbours.h, terrain/height_change.h, the meridian convergence of
+// terrain/geodesy.h and the central differences of terrain/derivatives.h),
+// against closed forms.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <set>
 
+#include "terrain/angles.h"
 #include "terrain/bilinear.h"
 #include "terrain/derivatives.h"
 #include "terrain/direction.h"
 #include "terrain/error.h"
+#include "terrain/geodesy.h"
 #include "terrain/hash.h"
+#include "terrain/height_change.h"
 #include "terrain/local_frame.h"
+#include "terrain/neighbours.h"
 
 using namespace drift::terrain;
 
@@ -125,4 +131,59 @@ TEST(CentralGradient, ExactOnPlanesInsideAndAtTheBorder) {
   EXPECT_NEAR(n.norm(), 1.0, 1e-15);
   EXPECT_NEAR(n.dot(Eigen::Vector3d(1, 0, 0.5)), 0.0, 1e-15);  // perpendicular to the slope
   EXPECT_GT(n.z(), 0);
+}
+
+TEST(Angles, DegreesAndRadiansRoundTripAndMatchTheClosedForms) {
+  EXPECT_DOUBLE_EQ(radians(180.0), std::acos(-1.0));
+  EXPECT_DOUBLE_EQ(degrees(std::acos(-1.0) / 2.0), 90.0);
+  EXPECT_FLOAT_EQ(radians(90.0f), static_cast<float>(std::acos(-1.0) / 2.0));
+  EXPECT_NEAR(tan_degrees(45.0), 1.0, 1e-15);
+  for (double d : {-720.0, -33.3, 0.0, 12.5, 359.0}) EXPECT_NEAR(degrees(radians(d)), d, 1e-12);
+}
+
+TEST(Neighbours, EightOffsetsEachOppositeItsMirror) {
+  std::set<std::pair<int, int>> seen;
+  for (int k = 0; k < 8; ++k) {
+    const NeighbourOffset o = kNeighbours8[k], m = kNeighbours8[opposite_neighbour(k)];
+    EXPECT_EQ(o.dx, -m.dx);
+    EXPECT_EQ(o.dy, -m.dy);
+    EXPECT_TRUE(o.dx != 0 || o.dy != 0);
+    seen.insert({o.dx, o.dy});
+  }
+  EXPECT_EQ(seen.size(), 8u);
+}
+
+// One nodata rule: a NaN ground stays NaN; a change with no data leaves the
+// ground as it is; sizes must agree.
+TEST(HeightChange, LaysAChangeOnTheGroundWithOneNodataRule) {
+  HeightField ground(3, 1, 100.0f), change(3, 1, 0.5f);
+  ground(0, 0) = NAN;
+  change(1, 0) = NAN;
+  change(2, 0) = INFINITY;
+  const HeightField top = lay_on_ground(ground, change);
+  EXPECT_TRUE(std::isnan(top(0, 0)));
+  EXPECT_EQ(top(1, 0), 100.0f);
+  EXPECT_EQ(top(2, 0), 100.0f);
+  change(2, 0) = 0.25f;
+  EXPECT_EQ(lay_on_ground(ground, change)(2, 0), 100.25f);
+  EXPECT_THROW(lay_on_ground(ground, HeightField(2, 1, 0.0f)), drift::Error);
+}
+
+// UTM zone 54N (central meridian 141 E) at 137.5 E, 36.3 N: west of the
+// central meridian the meridians lean east going north, so true north lies
+// clockwise of grid north by about (lon0 - lon) sin(lat) = 3.5 x 0.592 degrees.
+TEST(Geodesy, MeridianConvergenceOfAUtmGridMatchesTheClosedForm) {
+  GeoReference geo;
+  const std::string utm54 =
+      "PROJCS[\"WGS 84 / UTM zone 54N\",GEOGCS[\"WGS 84\",DATUM[\"WGS_1984\","
+      "SPHEROID[\"WGS 84\",6378137,298.257223563]],PRIMEM[\"Greenwich\",0],"
+      "UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Transverse_Mercator\"],"
+      "PARAMETER[\"latitude_of_origin\",0],PARAMETER[\"central_meridian\",141],"
+      "PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],"
+      "PARAMETER[\"false_northing\",0],UNIT[\"metre\",1]]";
+  geo.crs_wkt = utm54;
+  const auto centre = from_lonlat(utm54, 137.5, 36.3);
+  geo.geotransform = {centre[0] - 5.0, 10.0, 0.0, centre[1] + 5.0, 0.0, -10.0};
+  const double expected = (141.0 - 137.5) * std::sin(radians(36.3));
+  EXPECT_NEAR(grid_convergence_deg(geo, 1, 1), expected, 0.02);
 }
