@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "pipeline/cli.h"
 #include "pipeline/object_list.h"
@@ -14,6 +15,7 @@
 #include "terrain/error.h"
 #include "terrain/marks/marks.h"
 #include "terrain/marks/marks_parameters.h"
+#include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
@@ -24,9 +26,10 @@ namespace {
 namespace fs = std::filesystem;
 
 struct MarksCommand {
-  std::string ground, track, output, material, disturbed, frames, snow_depth, materials,
+  std::string ground, track, output, material, disturbed, frames, snow_depth, materials, posed,
       renderer = "cpu";
   double snow_min = 0.01;
+  std::optional<double> posed_at;
   bool add_snow = false;
   marks::MarksOptions options;
   // --memory-steps, --erosion-passes, --margin (terrain/marks/marks_parameters.h).
@@ -111,7 +114,7 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
   // ground and the disturbed raster replace their files together at the end.
   std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth, c.materials};
   for (const fs::path& mesh : object_mesh_paths(c.track, "track file")) inputs.push_back(mesh);
-  OutputSet outputs({c.output, c.disturbed}, inputs);
+  OutputSet outputs({c.output, c.disturbed, c.posed}, inputs);
   TrackFile track = read_track_file(c.track);
   marks::MarksOptions o = c.options;
   o.step = track.step;
@@ -149,9 +152,14 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
     terrain::write_geotiff(r.disturbed, c.disturbed,
                            {"ground disturbed by marks (m compressed, displaced or slid)", "m"});
   }
+  if (!c.posed.empty()) {  // issue 32 item 7: the objects where they stand at --posed-at
+    const double t = c.posed_at.value_or(marks::run_end(track.objects));
+    terrain::write_obj(marks::posed_objects(track.objects, ground, t), c.posed);
+  }
   outputs.commit();
   std::printf("marks: wrote %s\n", c.output.c_str());
   if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
+  if (!c.posed.empty()) std::printf("marks: wrote %s\n", c.posed.c_str());
   warn_about_misses(r.report);
   std::printf(
       "marks: %d steps, %d with contact; %.6g m3 under objects: %.6g displaced, %.6g compressed "
@@ -195,6 +203,13 @@ void add_marks_command(CLI::App& root) {
                   "snow shallower than this (m) leaves the ground's material")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
+  sub->add_option("--posed", c->posed,
+                  "OBJ of the objects at their pose at --posed-at (same keyframes as the marks), "
+                  "in the ground's CRS from the raster's north-west corner: a scene's [[objects]] "
+                  "mesh, at position = that corner ([0, 0, 0] on a local grid)");
+  sub->add_option("--posed-at", c->posed_at,
+                  "time (s) of the --posed objects; default: the run's last keyframe")
+      ->check(CLI::Range(-1e9, 1e9));
   c->parameters.add_to(*sub);
   sub->add_option("--seed", c->options.seed,
                   "seed of the roughness draws (sigma, paper 000, 3.5); same seed, same marks")

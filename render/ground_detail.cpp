@@ -334,9 +334,14 @@ void triplanar_detail(const GroundDetail& d, const Planes& planes, double x, dou
 
 }  // namespace
 
+float relief_scale(const GroundDetail& detail, double cell) {
+  return cell > 0.0 ? std::min(detail.scale, static_cast<float>(cell)) : detail.scale;
+}
+
 DetailedGround ground_detail(const Material& material, double x, double y, double z,
-                             const Eigen::Vector3f& normal, double footprint) {
-  const GroundDetail& d = material.detail;
+                             const Eigen::Vector3f& normal, double footprint, double cell) {
+  GroundDetail d = material.detail;
+  d.scale = relief_scale(d, cell);
   DetailedGround out{material.albedo, normal, material.roughness};
   const Planes planes = plane_weights(normal);
   float f = 1.0f, joints = 1.0f;

@@ -43,8 +43,18 @@ struct DetailedGround {
 // wide. Faces steeper than ~24-34 degrees read their detail triplanar (from
 // the vertical planes too, see ground_detail.cpp), so it is not stretched
 // down their fall line; gentler ground reads the map's plane alone.
+// `cell`: the DEM's cell (m; 0: not known). The relief is what the DEM does
+// not resolve, so its largest wavelength is the smaller of the preset's scale
+// and the cell (relief_scale): a 10 m mountain DEM keeps its presets' metres
+// of relief, a 1 cm grid of a footprint gets only sub-centimetre grain, not a
+// mountainside's bumps at the size of a print. The albedo's mottle is stated
+// in metres (128 m to 0.5 m) and stays so at any cell.
 DetailedGround ground_detail(const Material& material, double x, double y, double z,
-                             const Eigen::Vector3f& normal, double footprint);
+                             const Eigen::Vector3f& normal, double footprint, double cell = 0.0);
+
+// The largest wavelength of the relief (m) on a DEM of cells `cell` m (0: not
+// known, the preset's scale).
+float relief_scale(const GroundDetail& detail, double cell);
 
 // The relief's slope (dh/dx, dh/dy) and the slope variance the footprint
 // filtered away (for tests and the shading above).

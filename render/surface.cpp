@@ -198,7 +198,7 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
     for (const NormalDetail& tile : surface.normal_details)
       apply_normal_detail(tile, x, y, normal, footprint, p);
   const DetailedGround detail =
-      ground_detail(p.material, x, y, relief.altitude, p.normal, footprint);
+      ground_detail(p.material, x, y, relief.altitude, p.normal, footprint, surface.cell);
   p.material.albedo = detail.albedo;
   p.material.roughness = detail.roughness;
   p.normal = detail.normal;

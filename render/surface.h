@@ -97,6 +97,9 @@ struct TerrainSurface {
   // `position`, in the DEM's CRS; made from the DEM when the scene is loaded.
   std::optional<terrain::HeightField> position;
   std::vector<ObjectLayer> object_layers;
+  // The DEM's cell (m; 0: not known): ground detail below it only
+  // (render/ground_detail.h), set by the scene from its terrain.
+  double cell = 0.0;
 };
 
 // Reads a draped albedo image (GeoTIFF or any GDAL raster): 3 bands (or 1,

@@ -82,6 +82,7 @@ TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<E
   const terrain::HeightField& dem = raised ? *raised : input.terrain;
   check_terrain(dem);
   surface_ = input.surface;
+  surface_.cell = std::min(std::abs(dem.geo().cell_size_x()), std::abs(dem.geo().cell_size_y()));
   coverage_ = coverage_channels(surface_);
   fill_vertices(dem, static_cast<float>(input.vertical_exaggeration));
 
@@ -362,8 +363,8 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
     // normal turned back after, as intersect() faces it to the ray anyway.
     const Eigen::Vector3d world = origin_ + hit.position.cast<double>();
     const float side = n.z() < 0.0f ? -1.0f : 1.0f;
-    const DetailedGround g =
-        ground_detail(hit.material, world.x(), world.y(), world.z(), side * n, footprint);
+    const DetailedGround g = ground_detail(hit.material, world.x(), world.y(), world.z(), side * n,
+                                           footprint, surface_.cell);
     hit.material.albedo = g.albedo;
     hit.material.roughness = g.roughness;
     n = side * g.normal;

@@ -54,9 +54,10 @@ void SlopeRelaxWorkspace::fit(int width, int height) {
   tiles_x_ = (width + kTile - 1) / kTile, tiles_y_ = (height + kTile - 1) / kTile;
   const std::size_t cells = static_cast<std::size_t>(width) * height;
   const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
-  give_.assign(cells, 0.0), take_.assign(cells, 0.0), delta_.assign(cells, 0.0);
+  take_.assign(cells, 0.0);
+  slot_.assign(cells, -1);
   active_.assign(cells, 0), touched_.assign(cells, 0), ever_.assign(cells, 0);
-  mark_.assign(cells, 0);
+  stamp_.assign(cells, 0), stamp_now_ = 0;
   tile_active_.assign(tiles, 0), tile_touched_.assign(tiles, 0);
   tile_ever_.assign(tiles, 0), tile_mark_.assign(tiles, 0);
 }
@@ -74,8 +75,10 @@ class SlopeRelaxer {
         on_pass_(on_pass),
         w_(heights.width()),
         hgt_(heights.height()) {
-    for (int k = 0; k < 8; ++k)
+    for (int k = 0; k < 8; ++k) {
       distance_[k] = std::hypot(kNeighbours[k].dx * o_.dx, kNeighbours[k].dy * o_.dy);
+      offset_[k] = static_cast<std::ptrdiff_t>(kNeighbours[k].dy) * w_ + kNeighbours[k].dx;
+    }
   }
 
   void seed(int index) {
@@ -87,12 +90,29 @@ class SlopeRelaxer {
     std::fill(ws_.tile_active_.begin(), ws_.tile_active_.end(), 1);
   }
 
+  // Passes over 16 x 16 tiles (relax_slopes_everywhere): a pass works on the
+  // active cells of the active tiles and on every cell of those tiles and their
+  // neighbours.
   SlopeRelaxReport run() {
     SlopeRelaxReport report;
     std::vector<int> active = tiles_where(ws_.tile_active_);
     while (!active.empty() && report.passes < o_.max_passes) {
       ++report.passes;
-      report.moved += pass(active);
+      givers_.clear();
+      for (int t : active)
+        for_cells(t, [&](std::size_t i, int, int) {
+          if (ws_.active_[i]) givers_.push_back(static_cast<int>(i));
+        });
+      near_ = with_neighbours(active);
+      near_cells_.clear();
+      for (int t : near_)
+        for_cells(t, [&](std::size_t i, int, int) { near_cells_.push_back(static_cast<int>(i)); });
+      report.moved += pass(givers_, near_cells_);
+      for_tiles(near_, [&](int t) {
+        bool any = false;
+        for_cells(t, [&](std::size_t i, int, int) { any = any || ws_.touched_[i]; });
+        ws_.tile_touched_[static_cast<std::size_t>(t)] = any;
+      });
       active = next_active(active);
       if (on_pass_)
         on_pass_(report.passes, static_cast<double>(active.size()) / ws_.tile_active_.size());
@@ -106,36 +126,39 @@ class SlopeRelaxer {
   // the cells that need it, outward from the contact): a pass visits the
   // active cells and their neighbours, nothing else, so a rim a few cells wide
   // costs its own cells, not the 16 x 16 tiles about it. Same flows, same bits
-  // as run(): the Jacobi phases are the same functions of the same cells.
+  // as run(): both call pass().
   SlopeRelaxReport run_cells(const std::vector<int>& seeds, std::vector<int>& moved) {
     SlopeRelaxReport report;
-    if (ws_.tan_.size() != ws_.active_.size()) ws_.tan_.assign(ws_.active_.size(), 0.0);
     std::vector<int> active;
+    new_list();
     for (int c : seeds) add_once(active, static_cast<std::size_t>(c));
-    for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 1;
-    clear_marks(active);
     moved.clear();
+    std::vector<int> touched, was_touched;
+    bool same = false;  // the active cells are those of the last pass
     while (!active.empty() && report.passes < o_.max_passes) {
       ++report.passes;
-      report.moved += pass_cells(active);
+      if (!same) {
+        dilate(active, near_cells_);
+      }
+      report.moved += pass(active, near_cells_);
       // After a pass: a cell is active if it or a neighbour gave or took.
-      for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 0;
-      std::vector<int> touched;
+      touched.clear();
       for (int c : near_cells_)
         if (ws_.touched_[static_cast<std::size_t>(c)]) touched.push_back(c);
-      active.clear();
-      for (int c : touched) {
-        std::uint8_t& ever = ws_.ever_[static_cast<std::size_t>(c)];
-        if (!ever) ever = 1, moved.push_back(c);
-        with_neighbour_cells(c, [&](std::size_t n) { add_once(active, n); });
-      }
-      clear_marks(active);
       for (int c : touched) ws_.touched_[static_cast<std::size_t>(c)] = 0;
-      for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 1;
+      // The slow tail of a slump moves the same cells pass after pass: then the
+      // lists built from them are the same too (the same cells in the same
+      // order, since each list is built from the one before).
+      same = touched == was_touched;
+      if (same) continue;
+      for (int c : touched) {
+        const std::size_t i = static_cast<std::size_t>(c);
+        if (!ws_.ever_[i]) ws_.ever_[i] = 1, moved.push_back(c);
+      }
+      dilate(touched, active);
+      std::swap(touched, was_touched);
     }
     report.converged = active.empty();
-    cached_tan_ = false;
-    for (int c : active) ws_.active_[static_cast<std::size_t>(c)] = 0;
     for (int c : moved) ws_.ever_[static_cast<std::size_t>(c)] = 0;
     std::sort(moved.begin(), moved.end());
     return report;
@@ -187,6 +210,10 @@ class SlopeRelaxer {
   }
 
   bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < w_ && y < hgt_; }
+  // Neighbour k of cell (x, y) lies in the grid.
+  bool has(int x, int y, int k) const {
+    return inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy);
+  }
   const SlopeRule& rule_at(std::size_t i) const {
     return cells_.rule_of_cell ? cells_.rules[cells_.rule_of_cell->values()[i]] : cells_.rules[0];
   }
@@ -199,102 +226,105 @@ class SlopeRelaxer {
   double surface(std::size_t i) const {
     return cells_.base ? static_cast<double>(cells_.base->values()[i]) + h_[i] : h_[i];
   }
-  // Whether cell i may give this pass (its rule, its ceiling, active).
+  // Whether an active cell i may give this pass (its rule, its ceiling).
   bool giver(std::size_t i) const {
-    return ws_.active_[i] && std::isfinite(rule_at(i).tan_repose) && h_[i] < ceiling(i);
-  }
-  // Excess of the slope from cell i (surface hi) to its neighbour n in direction k,
-  // written once so that giver and taker get the same bits.
-  double excess(double hi, std::size_t n, double tan_repose, int k) const {
-    return hi - surface(n) - tan_repose * distance_[k];
-  }
-  std::size_t neighbour(int x, int y, int k) const {
-    return static_cast<std::size_t>(y + kNeighbours[k].dy) * w_ + (x + kNeighbours[k].dx);
+    return std::isfinite(rule_at(i).tan_repose) && h_[i] < ceiling(i);
   }
 
   // The tangent cell i slides at (SlopeRule::rough): a pure function of the
-  // seed and the cell, so giver and taker agree and a cell keeps its angle
-  // from call to call.
+  // seed and the cell, so a cell keeps its angle from pass to pass and call to
+  // call.
   double tan_of(std::size_t i, const SlopeRule& r) const {
     if (!r.rough) return r.tan_repose;
-    if (cached_tan_) return ws_.tan_[i];
-    return rough_tan(i, r);
-  }
-  double rough_tan(std::size_t i, const SlopeRule& r) const {
-    return r.tan_repose * (1.0 - r.fraction * unit_double(mix64(mix64(o_.seed) ^ i)));
+    return r.tan_repose * (1.0 - r.fraction * unit_double(mix64(seed_ ^ i)));
   }
 
-  // Phase 1: a giver's factor. Fraction: the scale keeping its flows within half
-  // its largest excess and its floor; HalfSteepest: min(room, e_max / 2) / sum e.
-  double give_factor(std::size_t i, int x, int y) const {
+  // The per-pair rule, written once for both loops (tiles and cell lists) and
+  // worked out once a pass per pair: the excess of the slope from giver i
+  // (surface hi, its angle's tangent t) to its neighbour in direction k,
+  // e = (H_i - H_n) - tan(theta) d_k. A pair counts when e > tolerance. Givers
+  // keep their eight excesses for the pass (excess_, -inf outside the grid), so
+  // the taker's share and both ends of every flow read the very same bits.
+  double pair_excess(double hi, std::size_t n, double t, int k) const {
+    return hi - surface(n) - t * distance_[k];
+  }
+  // What giver slot s offers for excess e (SlopeShare::Fraction: sigma e;
+  // HalfSteepest: its factor times e) and what flows of it to a taker that
+  // takes `take` of its offers: the offer times the giver's factor (Fraction;
+  // HalfSteepest's post_ is 1, exact) times `take`.
+  double offer(std::size_t s, double e) const { return ws_.mult_[s] * e; }
+  double flow(std::size_t s, double e, double take) const {
+    return offer(s, e) * ws_.post_[s] * take;
+  }
+
+  // Phase 1: giver i (slot s) works out its excesses and its factor: Fraction:
+  // the scale keeping its flows within half its largest excess and its floor;
+  // HalfSteepest: min(room, e_max / 2) / sum e.
+  void give(std::size_t s, std::size_t i) {
+    const int x = static_cast<int>(i % w_), y = static_cast<int>(i / w_);
     const SlopeRule& r = rule_at(i);
-    const double hi = surface(i), room = std::max(h_[i] - floor(i), 0.0);
+    const double hi = surface(i), t = tan_of(i, r);
+    double* e = &ws_.excess_[8 * s];
+    for (int k = 0; k < 8; ++k) e[k] = has(x, y, k) ? pair_excess(hi, i + offset_[k], t, k) : -kInf;
+    const double room = std::max(h_[i] - floor(i), 0.0);
     double sum = 0.0, largest = 0.0;
     const double share = r.share == SlopeShare::Fraction ? r.fraction : 1.0;
-    const double t = tan_of(i, r);
     for (int k = 0; k < 8; ++k) {
-      if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
-      const double e = excess(hi, neighbour(x, y, k), t, k);
-      if (e <= o_.tolerance) continue;
-      sum += share * e;
-      largest = std::max(largest, e);
+      if (e[k] <= o_.tolerance) continue;
+      sum += share * e[k];
+      largest = std::max(largest, e[k]);
     }
-    if (sum <= 0.0) return 0.0;
-    // Paper 003: a film thinner than the tolerance is as good as bare (it would
-    // trickle on for ever in amounts nobody can see).
-    if (r.share == SlopeShare::HalfSteepest)
-      return room > o_.tolerance ? std::min(room, 0.5 * largest) / sum : 0.0;
-    return std::min({1.0, 0.5 * largest / sum, room / sum});
+    double factor = 0.0;
+    if (sum > 0.0) {
+      // Paper 003: a film thinner than the tolerance is as good as bare (it
+      // would trickle on for ever in amounts nobody can see).
+      if (r.share == SlopeShare::HalfSteepest)
+        factor = room > o_.tolerance ? std::min(room, 0.5 * largest) / sum : 0.0;
+      else
+        factor = std::min({1.0, 0.5 * largest / sum, room / sum});
+    }
+    ws_.factor_[s] = factor;
+    ws_.mult_[s] = r.share == SlopeShare::Fraction ? r.fraction : factor;
+    ws_.post_[s] = r.share == SlopeShare::Fraction ? factor : 1.0;
+    ws_.slot_[i] = static_cast<int>(s);
   }
-  // What giver n offers for excess e before its scaling, and what flows.
-  double offer(std::size_t n, double e) const {
-    const SlopeRule& r = rule_at(n);
-    return r.share == SlopeShare::Fraction ? r.fraction * e : ws_.give_[n] * e;
-  }
-  double flow(std::size_t n, double e, std::size_t to) const {
-    const SlopeRule& r = rule_at(n);
-    const double given =
-        r.share == SlopeShare::Fraction ? r.fraction * e * ws_.give_[n] : ws_.give_[n] * e;
-    return given * ws_.take_[to];
-  }
-  // Calls fn(n, e) for every giver next to cell i with excess e towards it.
+  // Calls fn(s, e) for every giver (slot s) next to cell i with excess e
+  // towards it.
   template <class Fn>
   void for_offers(std::size_t i, int x, int y, const Fn& fn) const {
     for (int k = 0; k < 8; ++k) {
-      if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
-      const std::size_t n = neighbour(x, y, k);
-      if (!giver(n)) continue;
-      const SlopeRule& r = rule_at(n);
-      const double e = excess(surface(n), i, tan_of(n, r), 7 - k);
-      if (e > o_.tolerance) fn(n, e);
+      if (!has(x, y, k)) continue;
+      const int s = ws_.slot_[i + offset_[k]];
+      if (s < 0) continue;
+      const double e = ws_.excess_[8 * static_cast<std::size_t>(s) + (7 - k)];
+      if (e > o_.tolerance) fn(static_cast<std::size_t>(s), e);
     }
   }
   // Phase 2: the share of its offers a taker takes (half the largest excess it is
   // offered from, its ceiling).
   double take_share(std::size_t i, int x, int y) const {
     double in = 0.0, largest = 0.0;
-    for_offers(i, x, y, [&](std::size_t n, double e) {
-      in += offer(n, e);
+    for_offers(i, x, y, [&](std::size_t s, double e) {
+      in += offer(s, e);
       largest = std::max(largest, e);
     });
     if (!(in > 0.0)) return 0.0;
     const double room = ceiling(i) - h_[i];
     return std::min({1.0, 0.5 * largest / in, std::max(room, 0.0) / in});
   }
-  // Phase 3: the change of cell i (taken - given); returns what it gave.
+  // Phase 3: the change of cell i (taken - given), applied at once: nothing
+  // in this phase reads a height (the excesses and shares are the pass's), so
+  // the pass stays Jacobi. Returns what it gave.
   double change(std::size_t i, int x, int y) {
     double out = 0.0, in = 0.0;
     bool moved = false;
     float* disturbed = disturbed_ ? &disturbed_->values()[i] : nullptr;
-    if (ws_.give_[i] > 0.0 && giver(i)) {
-      const SlopeRule& r = rule_at(i);
-      const double hi = surface(i), t = tan_of(i, r);
+    const int s = ws_.slot_[i];
+    if (s >= 0 && ws_.factor_[static_cast<std::size_t>(s)] > 0.0) {
+      const double* e = &ws_.excess_[8 * static_cast<std::size_t>(s)];
       for (int k = 0; k < 8; ++k) {
-        if (!inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) continue;
-        const std::size_t n = neighbour(x, y, k);
-        const double e = excess(hi, n, t, k);
-        if (e <= o_.tolerance) continue;
-        const double f = flow(i, e, n);
+        if (e[k] <= o_.tolerance) continue;
+        const double f = flow(static_cast<std::size_t>(s), e[k], ws_.take_[i + offset_[k]]);
         if (!(f > 0.0)) continue;
         out += f, moved = true;
         if (disturbed) *disturbed += static_cast<float>(f);
@@ -302,96 +332,93 @@ class SlopeRelaxer {
     }
     if (ws_.take_[i] > 0.0)
       for_offers(i, x, y, [&](std::size_t n, double e) {
-        const double f = flow(n, e, i);
+        const double f = flow(n, e, ws_.take_[i]);
         if (!(f > 0.0)) return;
         in += f, moved = true;
         if (disturbed) *disturbed += static_cast<float>(f);
       });
-    ws_.delta_[i] = in - out;
+    h_[i] += in - out;
     ws_.touched_[i] = moved;
     return out;
   }
 
-  // One Jacobi pass over the active tiles; returns the height moved.
-  double pass(const std::vector<int>& active) {
-    for_tiles(active, [&](int t) {
-      for_cells(t, [&](std::size_t i, int x, int y) {
-        if (giver(i)) ws_.give_[i] = give_factor(i, x, y);
-      });
-    });
-    near_ = with_neighbours(active);
-    for_tiles(near_, [&](int t) {
-      for_cells(t, [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
-    });
-    gave_.assign(near_.size(), 0.0);
-    for_each_index(near_.size(), [&](std::size_t k) {
-      double gave = 0.0;
-      bool any = false;
-      for_cells(near_[k], [&](std::size_t i, int x, int y) {
-        gave += change(i, x, y);
-        any = any || ws_.touched_[i];
-      });
-      gave_[k] = gave;
-      ws_.tile_touched_[static_cast<std::size_t>(near_[k])] = any;
-    });
-    for_tiles(near_, [&](int t) {
-      for_cells(t, [&](std::size_t i, int, int) {
-        h_[i] += ws_.delta_[i];
-        ws_.give_[i] = ws_.take_[i] = ws_.delta_[i] = 0.0;
-      });
-    });
+  // One Jacobi pass: the cells of `active` that may give, and every cell of
+  // `near` (the active cells and all their neighbours) takes; each phase is a
+  // function of each cell alone, so the lists' order and the thread count do
+  // not matter. Returns the height moved.
+  double pass(const std::vector<int>& active, const std::vector<int>& near) {
+    if (ws_.excess_.size() < 8 * active.size()) {
+      ws_.excess_.resize(8 * active.size());
+      ws_.mult_.resize(active.size()), ws_.post_.resize(active.size());
+      ws_.factor_.resize(active.size());
+    }
+    for_each_index(
+        active.size(),
+        [&](std::size_t s) {
+          const auto i = static_cast<std::size_t>(active[s]);
+          if (giver(i)) give(s, i);
+        },
+        kParallelCells);
+    for_each_cell(near, [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
+    gave_.assign(near.size(), 0.0);
+    for_each_index(
+        near.size(),
+        [&](std::size_t k) {
+          const int c = near[k];
+          gave_[k] = change(static_cast<std::size_t>(c), c % w_, c / w_);
+        },
+        kParallelCells);
+    for (int c : active) ws_.slot_[static_cast<std::size_t>(c)] = -1;
     double moved = 0.0;
     for (double g : gave_) moved += g;
     return moved;
   }
 
-  // Cell lists (run_cells): `mark_` keeps a list free of duplicates.
-  void add_once(std::vector<int>& list, std::size_t i) {
-    if (!ws_.mark_[i]) ws_.mark_[i] = 1, list.push_back(static_cast<int>(i));
+  // Cell lists (run_cells): a stamp per cell keeps a list free of duplicates
+  // without clearing marks afterwards; new_list() starts a list.
+  void new_list() {
+    if (++ws_.stamp_now_ == 0) {  // wrapped: old stamps could collide
+      std::fill(ws_.stamp_.begin(), ws_.stamp_.end(), 0u);
+      ws_.stamp_now_ = 1;
+    }
   }
-  void clear_marks(const std::vector<int>& list) {
-    for (int c : list) ws_.mark_[static_cast<std::size_t>(c)] = 0;
+  void add_once(std::vector<int>& list, std::size_t i) {
+    if (ws_.stamp_[i] != ws_.stamp_now_)
+      ws_.stamp_[i] = ws_.stamp_now_, list.push_back(static_cast<int>(i));
+  }
+  // `out`: the cells of `cells` and their 8 neighbours, each once, in the
+  // order first met. Branch-free: every candidate is written, the length
+  // grows only for a cell not yet in the list.
+  void dilate(const std::vector<int>& cells, std::vector<int>& out) {
+    new_list();
+    out.resize(9 * cells.size());
+    const std::uint32_t now = ws_.stamp_now_;
+    std::uint32_t* stamp = ws_.stamp_.data();
+    std::size_t n = 0;
+    auto add = [&](std::size_t i) {
+      out[n] = static_cast<int>(i);
+      n += stamp[i] != now;
+      stamp[i] = now;
+    };
+    for (int c : cells) {
+      const int x = c % w_, y = c / w_;
+      const auto i = static_cast<std::size_t>(c);
+      if (x > 0 && y > 0 && x < w_ - 1 && y < hgt_ - 1) {
+        add(i);
+        for (int k = 0; k < 8; ++k) add(i + offset_[k]);
+      } else {
+        with_neighbour_cells(c, add);
+      }
+    }
+    out.resize(n);
   }
   template <class Fn>
   void with_neighbour_cells(int c, const Fn& fn) const {
     const int x = c % w_, y = c / w_;
-    fn(static_cast<std::size_t>(c));
+    const auto i = static_cast<std::size_t>(c);
+    fn(i);
     for (int k = 0; k < 8; ++k)
-      if (inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy)) fn(neighbour(x, y, k));
-  }
-  // One Jacobi pass over the active cells and their neighbours; returns the
-  // height moved.
-  double pass_cells(const std::vector<int>& active) {
-    near_cells_.clear();
-    for (int c : active) with_neighbour_cells(c, [&](std::size_t n) { add_once(near_cells_, n); });
-    clear_marks(near_cells_);
-    // Rough cells' angles once a pass, not once a neighbour (a hash each).
-    cached_tan_ = false;
-    for_each_cell(near_cells_, [&](std::size_t i, int, int) {
-      const SlopeRule& r = rule_at(i);
-      ws_.tan_[i] = r.rough ? rough_tan(i, r) : r.tan_repose;
-    });
-    cached_tan_ = true;
-    for_each_cell(active, [&](std::size_t i, int x, int y) {
-      if (giver(i)) ws_.give_[i] = give_factor(i, x, y);
-    });
-    for_each_cell(near_cells_,
-                  [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
-    gave_.assign(near_cells_.size(), 0.0);
-    for_each_index(
-        near_cells_.size(),
-        [&](std::size_t k) {
-          const int c = near_cells_[k];
-          gave_[k] = change(static_cast<std::size_t>(c), c % w_, c / w_);
-        },
-        kParallelCells);
-    for_each_cell(near_cells_, [&](std::size_t i, int, int) {
-      h_[i] += ws_.delta_[i];
-      ws_.give_[i] = ws_.take_[i] = ws_.delta_[i] = 0.0;
-    });
-    double moved = 0.0;
-    for (double g : gave_) moved += g;
-    return moved;
+      if (has(x, y, k)) fn(i + offset_[k]);
   }
   template <class Fn>
   void for_each_cell(const std::vector<int>& cells, const Fn& fn) const {
@@ -438,9 +465,7 @@ class SlopeRelaxer {
     bool any = false;
     for_cells(t, [&](std::size_t i, int x, int y) {
       bool a = ws_.touched_[i] != 0;
-      for (int k = 0; k < 8 && !a; ++k)
-        a = inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy) &&
-            ws_.touched_[neighbour(x, y, k)];
+      for (int k = 0; k < 8 && !a; ++k) a = has(x, y, k) && ws_.touched_[i + offset_[k]];
       ws_.active_[i] = a;
       any = any || a;
     });
@@ -455,10 +480,12 @@ class SlopeRelaxer {
   const SlopePassFn& on_pass_;
   int w_, hgt_;
   std::array<double, 8> distance_{};
-  std::vector<int> near_;        // this pass: active tiles and their neighbours
-  std::vector<int> near_cells_;  // run_cells: this pass's active cells and their neighbours
-  bool cached_tan_ = false;      // run_cells: ws_.tan_ holds the angles of near_cells_
-  std::vector<double> gave_;     // per tile of near_
+  std::uint64_t seed_ = mix64(o_.seed);     // the roughness draws' (tan_of)
+  std::array<std::ptrdiff_t, 8> offset_{};  // flat index of neighbour k - the cell's
+  std::vector<int> near_;                   // run(): this pass's active tiles and their neighbours
+  std::vector<int> givers_;                 // run(): this pass's active cells
+  std::vector<int> near_cells_;             // this pass's active cells and their neighbours
+  std::vector<double> gave_;                // per cell of near_cells_
 };
 
 SlopeRelaxReport relax_slopes(Grid<double>& heights, const std::vector<int>& active,

@@ -29,8 +29,11 @@
 // neighbours, in parallel (TBB) when there are many (relax_slopes_everywhere);
 // relax_slopes keeps lists of the active cells instead and visits only them
 // and their neighbours (paper 000, 3.5: only where needed), with the same
-// flows and bits. Storage: three doubles and four bytes a cell in the
-// workspace, none per flow.
+// flows and bits: both loops run the same pass. A pass works out each giver's
+// eight excesses once and keeps them (ten doubles a giver), so takers and
+// flows read them instead of evaluating each pair three times. Storage: a double,
+// a slot index, a list stamp and three flag bytes a cell in the workspace (19
+// bytes), none per flow.
 #pragma once
 
 #include <cstdint>
@@ -94,7 +97,7 @@ struct SlopeRelaxReport {
 };
 
 // Scratch space sized to a grid, kept between calls so that a call costs what
-// it touches, not the grid's size (all of it is back to zero between calls).
+// it touches, not the grid's size (its flags are back to zero between calls).
 class SlopeRelaxWorkspace {
  public:
   void fit(int width, int height);
@@ -102,11 +105,14 @@ class SlopeRelaxWorkspace {
  private:
   friend class SlopeRelaxer;
   int width_ = 0, height_ = 0, tiles_x_ = 0, tiles_y_ = 0;
-  std::vector<double> give_;  // per giver: its factor this pass (0: gives nothing)
-  std::vector<double> take_;  // per taker: the share of its offers it takes
-  std::vector<double> delta_;
-  std::vector<double> tan_;  // relax_slopes only: per cell, its angle's tangent this pass
-  std::vector<std::uint8_t> active_, touched_, ever_, mark_;  // per cell
+  std::vector<double> take_;  // per taker: the share of its offers it takes this pass
+  std::vector<int> slot_;     // per cell: its place in this pass's givers, -1: not giving
+  // Per giver of a pass: its eight excesses, its factor (0: gives nothing),
+  // its offers' factor and its flows'.
+  std::vector<double> excess_, factor_, mult_, post_;
+  std::vector<std::uint8_t> active_, touched_, ever_;  // per cell
+  std::vector<std::uint32_t> stamp_;                   // per cell: the list it was last added to
+  std::uint32_t stamp_now_ = 0;
   std::vector<std::uint8_t> tile_active_, tile_touched_, tile_ever_, tile_mark_;
 };
 

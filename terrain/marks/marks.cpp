@@ -190,8 +190,9 @@ MarksSimulation::MarksSimulation(const terrain::HeightField& ground, MaterialFie
   const std::uint64_t cells = static_cast<std::uint64_t>(ground.width()) * ground.height();
   // Heights, ceiling (double), disturbance, expiry (4 bytes), material (1), the
   // float copy written out (4), and the erosion's workspace (terrain/slope_relax:
-  // give, take, delta, angle, 8 bytes each; 4 bytes of flags).
-  require_memory(cells * (8 + 8 + 4 + 4 + 1) + cells * 4 + cells * (4 * 8 + 4),
+  // a taker's share, 8 bytes; a giver's slot and a list stamp, 4 each; 3 bytes
+  // of flags).
+  require_memory(cells * (8 + 8 + 4 + 4 + 1) + cells * 4 + cells * (8 + 4 + 4 + 3),
                  "marks state for a " + std::to_string(ground.width()) + " x " +
                      std::to_string(ground.height()) + " ground",
                  "crop the ground (drift import --crop) or coarsen it (drift import --resample)");

@@ -139,6 +139,21 @@ struct MarksResult {
 // false to cancel.
 using StepFn = std::function<bool(int step, const MarksSimulation& state)>;
 
+// Where an object stands at time t (s, clamped to its keyframes), as the run
+// places it: its keyframes' pose, raised by the ground under its origin when
+// it follows the ground.
+Pose object_pose(const MarkObject& object, const terrain::HeightField& ground, double t);
+
+// The objects' meshes at their poses at time t, in the ground's CRS measured
+// from the raster's north-west corner (the mesh's origin), merged into one (issue 32 item 7: a
+// scene shows the mark with the thing that made it, placed by the same keyframes). Objects whose
+// keyframes do not reach t stand at their nearest keyframe.
+terrain::Mesh posed_objects(const std::vector<MarkObject>& objects,
+                            const terrain::HeightField& ground, double t);
+
+// The time the run ends: the last keyframe of any object (s).
+double run_end(const std::vector<MarkObject>& objects);
+
 // Runs every object along its keyframes from the first keyframe of any to the
 // last. Throws drift::Error for bad options, trajectories or meshes, and when
 // the state does not fit in memory (checked before allocating).

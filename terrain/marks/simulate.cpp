@@ -34,6 +34,40 @@ void validate_objects(const std::vector<MarkObject>& objects) {
 
 }  // namespace
 
+Pose object_pose(const MarkObject& object, const terrain::HeightField& ground, double t) {
+  Pose p = object.trajectory.at(t);
+  if (object.follow_ground) {
+    const GridFrame f = GridFrame::of(ground.geo());
+    p.position.z() += ground_under(ground, f, p.position.x(), p.position.y());
+  }
+  return p;
+}
+
+terrain::Mesh posed_objects(const std::vector<MarkObject>& objects,
+                            const terrain::HeightField& ground, double t) {
+  terrain::Mesh out;
+  // Float positions measured from the raster's north-west corner (a UTM
+  // coordinate would lose its centimetres in a float).
+  const auto& gt = ground.geo().geotransform;
+  out.origin = {gt[0], gt[3], 0.0};
+  for (const MarkObject& o : objects) {
+    const Pose p = object_pose(o, ground, t);
+    const Eigen::Matrix3d r = p.rotation.toRotationMatrix();
+    const int base = static_cast<int>(out.positions.size());
+    for (const auto& v : o.mesh.positions)
+      out.positions.push_back((p.position + r * v.cast<double>() - out.origin).cast<float>());
+    for (const auto& tri : o.mesh.triangles)
+      out.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
+  }
+  return out;
+}
+
+double run_end(const std::vector<MarkObject>& objects) {
+  double t1 = -1e300;
+  for (const MarkObject& o : objects) t1 = std::max(t1, o.trajectory.end());
+  return t1;
+}
+
 MarksResult simulate_marks(const terrain::HeightField& ground,
                            const std::vector<MarkObject>& objects, MaterialField materials,
                            const MarksOptions& options, const StepFn& on_step,
@@ -52,12 +86,7 @@ MarksResult simulate_marks(const terrain::HeightField& ground,
   if (span > 1e7)
     throw Error("marks: the keyframes span " + std::to_string(span) + " steps; raise 'step'");
   const int steps = static_cast<int>(std::ceil(span - 1e-9));
-  auto pose_of = [&](const MarkObject& o, double t) {
-    Pose p = o.trajectory.at(t);
-    if (o.follow_ground)
-      p.position.z() += ground_under(ground, sim.frame(), p.position.x(), p.position.y());
-    return p;
-  };
+  auto pose_of = [&](const MarkObject& o, double t) { return object_pose(o, ground, t); };
   MarksResult result;
   for (const MarkObject& o : objects) result.report.objects.push_back({o.name});
   if (progress && !progress(0.0, "marks")) throw Cancelled();

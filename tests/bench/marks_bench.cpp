@@ -4,6 +4,9 @@
 // sub-steps and swept (the paper's table 1: 0.022, 0.22, 0.027 s a step on a
 // Pentium 4 with a GeForce4). Also the object's bottom rendered by the CPU
 // z-buffer against OSMesa at growing windows. Counters: steps/s, peak memory.
+// docs/marks.md, Performance, tabulates them beside the paper's table 1; the
+// "Time" column is wall time, "CPU" one thread's (compare those on a shared
+// machine).
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -82,7 +85,7 @@ void BM_MarksBallDragCoarse(benchmark::State& state) {
 }
 BENCHMARK(BM_MarksBallDragCoarse)
     ->ArgNames({"n", "level"})
-    ->ArgsProduct({{256}, {1, 2, 4}})
+    ->ArgsProduct({{256, 1024}, {1, 2, 4}})
     ->Unit(benchmark::kMillisecond);
 
 // The bottom of a ball of `radius` cells by each renderer.

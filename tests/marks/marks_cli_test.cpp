@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
 #include "tests/dem_fixture.h"
 #include "tests/test_files.h"
@@ -62,6 +63,32 @@ TEST(MarksCli, WritesTheMarkedGroundDisturbanceAndFrames) {
   EXPECT_EQ(dist(2, 2), 0.0f);
   EXPECT_TRUE(fs::exists(d / "frames" / "frame_00000.tif"));
   EXPECT_TRUE(fs::exists(d / "frames" / "frame_00005.tif"));
+}
+
+// Issue 32 item 7: --posed writes the objects where the track's keyframes put
+// them at --posed-at (default: the last keyframe), from the raster's
+// north-west corner, so a scene shows the mark with the thing that made it.
+TEST(MarksCli, PosedWritesTheObjectAtItsPoseAtAChosenTime) {
+  const fs::path d = dir(), g = ground(d);
+  std::ofstream(d / "track.toml") << track();
+  for (const char* at : {"", " --posed-at 0.3"}) {
+    ASSERT_EQ(run(g.string() + " --track " + (d / "track.toml").string() + " -o " +
+                      (d / "out.tif").string() + " --posed " + (d / "ball.obj").string() + at,
+                  d),
+              0)
+        << output(d);
+    const drift::terrain::Mesh m = drift::terrain::read_obj(d / "ball.obj");
+    ASSERT_FALSE(m.positions.empty());
+    Eigen::Vector3f lo = m.positions[0], hi = m.positions[0];
+    for (const auto& p : m.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    // The ground's corner is (600000, 4000000); the ball (radius 5 cm) is
+    // centred at (0.32, -0.32) from it, at 2000.1 m at the end, 2000.02 at 0.3 s.
+    const Eigen::Vector3f centre = 0.5f * (lo + hi);
+    EXPECT_NEAR(centre.x(), 0.32f, 1e-3f);
+    EXPECT_NEAR(centre.y(), -0.32f, 1e-3f);
+    EXPECT_NEAR(centre.z(), *at ? 2000.02f : 2000.1f, 1e-3f);
+    EXPECT_NEAR(hi.x() - lo.x(), 0.1f, 2e-3f);
+  }
 }
 
 TEST(MarksCli, BadTrackFilesExitOneNamingTheProblemAndWriteNothing) {

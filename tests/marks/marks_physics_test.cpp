@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 #include "terrain/error.h"
 #include "terrain/marks/marks.h"
@@ -151,6 +152,21 @@ TEST(MarksSymmetry, ABallPressedStraightDownLeavesASymmetricMark) {
   EXPECT_LE(worst, 1e-8) << "largest asymmetry (m)";
 }
 
+// A 96 x 48 field of 1 cm cells in materials `m` (a region each half) with a
+// ball pressed kDepth into the middle of each half.
+// (A pointer: the simulation is not movable.)
+std::unique_ptr<MarksSimulation> press_both_halves(const MaterialField& m) {
+  auto sim = std::make_unique<MarksSimulation>(
+      terrain::HeightField(96, 48, 1.0f, terrain::local_georeference(kCell)), m, MarksOptions{});
+  const ObjectShape shape = ObjectShape::of(sphere(kRadius));
+  MarkObject object;
+  for (double col : {24.0, 72.0}) {
+    const Pose pose{at_cell(*sim, col, 24, 1.0 + kRadius - kDepth), Eigen::Quaterniond::Identity()};
+    sim->move(shape, object, pose, pose, true);
+  }
+  return sim;
+}
+
 TEST(MarksMaterials, PerRegionMaterialsFromASnowDepthRaster) {
   // The west half under 30 cm of snow, the east half bare sand.
   terrain::Grid<float> snow_depth(96, 48, 0.0f);
@@ -158,14 +174,8 @@ TEST(MarksMaterials, PerRegionMaterialsFromASnowDepthRaster) {
     for (int c = 0; c < 48; ++c) snow_depth(c, r) = 0.3f;
   MaterialField m = materials_from_snow_depth(snow_depth, 0.01, *material_preset("sand"),
                                               *material_preset("snow"));
-  MarksSimulation sim(terrain::HeightField(96, 48, 1.0f, terrain::local_georeference(kCell)), m,
-                      {});
-  const ObjectShape shape = ObjectShape::of(sphere(kRadius));
-  MarkObject object;
-  for (double col : {24.0, 72.0}) {
-    const Pose pose{at_cell(sim, col, 24, 1.0 + kRadius - kDepth), Eigen::Quaterniond::Identity()};
-    sim.move(shape, object, pose, pose, true);
-  }
+  const auto pressed = press_both_halves(m);
+  MarksSimulation& sim = *pressed;
   settle(sim, 5);
   double snow_top = -1, sand_top = -1;
   for (int r = 0; r < 48; ++r)
@@ -185,14 +195,8 @@ TEST(MarksMaterials, PerRegionMaterialsFromAPaintedRaster) {
     for (int c = 0; c < 48; ++c) painted(c, r) = 1.0f;  // the west half mud
   const MaterialField m = materials_from_raster(
       painted, {*material_preset("sand"), *material_preset("mud")}, "paint.tif");
-  MarksSimulation sim(terrain::HeightField(96, 48, 1.0f, terrain::local_georeference(kCell)), m,
-                      {});
-  const ObjectShape shape = ObjectShape::of(sphere(kRadius));
-  MarkObject object;
-  for (double col : {24.0, 72.0}) {
-    const Pose pose{at_cell(sim, col, 24, 1.0 + kRadius - kDepth), Eigen::Quaterniond::Identity()};
-    sim.move(shape, object, pose, pose, true);
-  }
+  const auto pressed = press_both_halves(m);
+  MarksSimulation& sim = *pressed;
   settle(sim, 10);
   auto steepest = [&](int c0, int c1) {
     double worst = 0;
