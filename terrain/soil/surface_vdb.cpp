@@ -2,11 +2,14 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/VolumeToMesh.h>
+#include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -35,6 +38,48 @@ openvdb::FloatGrid::Ptr to_grid(const terrain::Grid3Shape& g, const std::vector<
         const float v = field[g.index(x, y, z)];
         if (v != 0.0f) acc.setValue(openvdb::Coord(x, y, z), sign * v);
       }
+  return grid;
+}
+
+// The surface's grid: the values of to_grid(field, -1), built leaf by leaf
+// in parallel, with only the voxels that have a face neighbour across the
+// iso-value (density 0.5) active. volumeToMesh takes every grid edge whose
+// ends lie on both sides of the iso-value and one of which is active
+// (evalInternalVoxelEdges, tools/VolumeToMesh.h); both ends of such an edge
+// have a neighbour across, so the edges, and with the same values the mesh,
+// are those of the fully active grid, while the soil's interior is skipped
+// (issue 33, item 8; SoilSurface.BandGridGivesTheFullGridsMesh).
+openvdb::FloatGrid::Ptr surface_grid(const terrain::Grid3Shape& g,
+                                     const std::vector<float>& field) {
+  using Leaf = openvdb::FloatTree::LeafNodeType;
+  constexpr int D = Leaf::DIM;
+  const int bx = (g.nx + D - 1) / D, by = (g.ny + D - 1) / D, bz = (g.nz + D - 1) / D;
+  auto inside = [&](int x, int y, int z) {
+    return x >= 0 && y >= 0 && z >= 0 && x < g.nx && y < g.ny && z < g.nz &&
+           field[g.index(x, y, z)] > 0.5f;
+  };
+  std::vector<std::unique_ptr<Leaf>> leaves(static_cast<std::size_t>(bx) * by * bz);
+  tbb::parallel_for(0, static_cast<int>(leaves.size()), [&](int b) {
+    const int X = D * (b % bx), Y = D * (b / bx % by), Z = D * (b / (bx * by));
+    std::unique_ptr<Leaf> leaf;
+    for (int x = X; x < std::min(g.nx, X + D); ++x)
+      for (int y = Y; y < std::min(g.ny, Y + D); ++y)
+        for (int z = Z; z < std::min(g.nz, Z + D); ++z) {
+          const float v = field[g.index(x, y, z)];
+          if (v == 0.0f) continue;
+          if (!leaf) leaf = std::make_unique<Leaf>(openvdb::Coord(X, Y, Z), 0.0f, false);
+          const openvdb::Coord c(x, y, z);
+          leaf->setValueOnly(c, -v);
+          const bool in = v > 0.5f;
+          if (inside(x - 1, y, z) != in || inside(x + 1, y, z) != in || inside(x, y - 1, z) != in ||
+              inside(x, y + 1, z) != in || inside(x, y, z - 1) != in || inside(x, y, z + 1) != in)
+            leaf->setValueOn(c);
+        }
+    leaves[b] = std::move(leaf);
+  });
+  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+  for (auto& leaf : leaves)
+    if (leaf) grid->tree().addLeaf(leaf.release());
   return grid;
 }
 
@@ -73,11 +118,13 @@ void stamp_content_uuid(const std::filesystem::path& file, const std::string& sh
 
 }  // namespace
 
-terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>& field) {
+terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>& field,
+                          IsoGrid kind) {
   init_openvdb();
   // Negated so that "inside" is below the iso-value, as for a level set:
   // volumeToMesh then orients faces outwards; the background (0) is outside.
-  const openvdb::FloatGrid::Ptr grid = to_grid(g, field, -1.0f);
+  const openvdb::FloatGrid::Ptr grid =
+      kind == IsoGrid::Band ? surface_grid(g, field) : to_grid(g, field, -1.0f);
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;

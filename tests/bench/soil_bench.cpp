@@ -61,6 +61,23 @@ void BM_SoilStepAndSurface(benchmark::State& state) {
 }
 BENCHMARK(BM_SoilStepAndSurface)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The surface alone, of the push at 64^3 after 20 steps: the ridge fix's
+// density, then the mesh.
+void BM_SoilSurfaceDensity(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  SoilSimulation sim = make_simulation(fixtures::push_scenario(n, thesis_options(4)));
+  sim.run(20);
+  for (auto _ : state) benchmark::DoNotOptimize(surface_density(sim.state(), {}));
+}
+BENCHMARK(BM_SoilSurfaceDensity)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_SoilSurface(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  SoilSimulation sim = make_simulation(fixtures::push_scenario(n, thesis_options(4)));
+  sim.run(20);
+  for (auto _ : state) benchmark::DoNotOptimize(soil_surface(sim.state(), {}));
+}
+BENCHMARK(BM_SoilSurface)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_SoilPushIterations(benchmark::State& state) {
   run_push(state, 72, static_cast<int>(state.range(0)));
 }
