@@ -7,10 +7,9 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <string>
 
 #include "terrain/atomic_file.h"
@@ -92,10 +91,7 @@ constexpr std::size_t kUuidOffset = 21, kUuidLength = 36;
 // two identical runs wrote different bytes. The UUID only lets readers tell
 // files apart; replace it by one derived from the rest of the file (FNV-1a,
 // formatted as a UUID), so the same grids give the same bytes.
-void stamp_content_uuid(const std::filesystem::path& file, const std::string& shown) {
-  std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(io)), std::istreambuf_iterator<char>());
-  if (!io.good() && !io.eof()) throw Error("cannot read back '" + shown + "'");
+void stamp_content_uuid(std::string& bytes, const std::string& shown) {
   if (bytes.size() < kUuidOffset + kUuidLength || bytes[kUuidOffset + 8] != '-')
     throw Error("'" + shown + "': unexpected OpenVDB header (no UUID at byte 21)");
   std::uint64_t h[2] = {1469598103934665603ull, 1099511628211ull * 31};
@@ -109,12 +105,24 @@ void stamp_content_uuid(const std::filesystem::path& file, const std::string& sh
                 static_cast<unsigned>(0x5000 | (h[0] & 0x0fff)),  // version 5 style: name-based
                 static_cast<unsigned>(0x8000 | ((h[1] >> 48) & 0x3fff)),
                 static_cast<unsigned long long>(h[1] & 0xffffffffffffull));
-  io.clear();
-  io.seekp(static_cast<std::streamoff>(kUuidOffset));
-  io.write(uuid, kUuidLength);
-  io.close();
-  if (!io) throw Error("cannot write '" + shown + "'");
+  bytes.replace(kUuidOffset, kUuidLength, uuid, kUuidLength);
 }
+
+// OpenVDB's archive written into memory with the layout io::File writes
+// (seekable: grid offsets in the file, so readers can load one grid):
+// io::File writes through an std::ofstream whose failed writes on a full disk
+// it never checks, which left a truncated VDB behind with exit 0. In memory,
+// every byte then goes through write_all_bytes, which checks each write
+// (issue 34).
+class MemoryArchive : public openvdb::io::Archive {
+ public:
+  std::string encode(const openvdb::GridPtrVec& grids) const {
+    std::ostringstream os(std::ios_base::out | std::ios_base::binary);
+    Archive::write(os, grids, /*seekable=*/true);
+    if (!os) throw Error("OpenVDB could not encode the grids");
+    return std::move(os).str();
+  }
+};
 
 }  // namespace
 
@@ -189,15 +197,15 @@ void write_density_vdb(const SoilState& s, const std::filesystem::path& path, do
   velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
   velocity->setTransform(transform);
   grids.push_back(velocity);
-  AtomicFile out(path);
+  std::string bytes;
   try {
-    openvdb::io::File file(out.temp_path().string());
-    file.write(grids);
-    file.close();
+    bytes = MemoryArchive().encode(grids);
   } catch (const openvdb::Exception& e) {
     throw Error("cannot write '" + path.string() + "': " + e.what());
   }
-  stamp_content_uuid(out.temp_path(), path.string());
+  stamp_content_uuid(bytes, path.string());
+  AtomicFile out(path);
+  write_all_bytes(out.temp_path(), bytes.data(), bytes.size(), path);
   out.commit();
 }
 
