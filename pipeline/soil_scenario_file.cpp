@@ -1,6 +1,7 @@
 #include "pipeline/soil_scenario_file.h"
 
 #include <cmath>
+#include <sstream>
 
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
@@ -129,15 +130,63 @@ WindowWithApron with_apron(const terrain::RasterWindow& w, const terrain::Raster
   return a;
 }
 
+std::string list(const Eigen::Vector4d& v) {
+  std::ostringstream os;
+  os << v[0] << ", " << v[1] << ", " << v[2] << ", " << v[3];
+  return os.str();
+}
+
+// Beside a [terrain] dem, the DEM sets the grid's voxel (its cell over
+// `upsample`), its x, y size (the window's) and its origin: a [grid] voxel,
+// origin or x, y size that says otherwise was silently ignored (issue 34).
+// Values equal to the DEM's are honoured; others are refused, naming the key,
+// the value, what the DEM sets and the fix.
+void refuse_grid_keys_set_by_dem(const toml::table& root, const std::filesystem::path& file,
+                                 const terrain::Grid3Shape& shape,
+                                 const terrain::RasterWindow& window, int up) {
+  const toml::table* grid = root["grid"].as_table();
+  if (!grid) return;
+  Section g(grid, "grid", file, kDoc);
+  std::ostringstream set_by;
+  set_by << "the [terrain] dem sets it (" << window.width << " x " << window.height << " pixels of "
+         << shape.voxel_size * up << " m, upsample " << up << ")";
+  if (const auto v = g.number("voxel", shape.voxel_size, 0, 1e30);
+      std::abs(v - shape.voxel_size) > 1e-9 * shape.voxel_size) {
+    std::ostringstream what;
+    what << "is " << v << " m, but " << set_by.str() << " to " << shape.voxel_size
+         << " m; remove it, or set [terrain] upsample for finer voxels";
+    g.invalid("voxel", what.str());
+  }
+  if (const auto size = g.vector<3>("size", 0, 4096);
+      size && ((*size)[0] != 0 || (*size)[1] != 0) &&
+      ((*size)[0] != shape.nx || (*size)[1] != shape.ny)) {
+    std::ostringstream what;
+    what << "is [" << (*size)[0] << ", " << (*size)[1] << ", " << (*size)[2] << "], but "
+         << set_by.str() << " to x, y = " << shape.nx << ", " << shape.ny << "; write [0, 0, "
+         << (*size)[2] << "]";
+    g.invalid("size", what.str());
+  }
+  if (g.vector<3>("origin", -kBig, kBig))
+    g.invalid("origin",
+              "is set by the [terrain] dem (the window's corner, [terrain] depth below the "
+              "lowest column); remove it");
+}
+
 // The DEM crop under the grid: `window` pixels of the raster, each cell split
 // into `upsample` x `upsample` columns (bilinear over the window and its
 // apron), the grid's floor `depth` metres below the lowest column.
-void read_dem(Section& s, const std::filesystem::path& file,
+void read_dem(Section& s, const toml::table& root, const std::filesystem::path& file,
               const std::filesystem::path& dem_override, soil::SoilScenario& sc) {
   const std::filesystem::path dem =
       dem_override.empty() ? file.parent_path() / *s.string("dem") : dem_override;
   const auto w = s.vector<4>("window", 0, 1e6);
   if (!w) s.invalid_table("with dem needs window = [x_off, y_off, width, height] (pixels)");
+  // Pixels are whole: a fractional window was truncated without a word (issue 34).
+  for (int i = 0; i < 4; ++i)
+    if ((*w)[i] != std::floor((*w)[i]) || (i >= 2 && (*w)[i] < 1))
+      s.invalid("window", "is [" + list(*w) +
+                              "]; it must be whole pixels [x_off, y_off, width, height], width "
+                              "and height at least 1: round them");
   const int up = s.integer("upsample", 1, 1, 64);
   const double depth = s.number("depth", 2.0, 0, 1e4);
   const terrain::RasterWindow window{static_cast<int>((*w)[0]), static_cast<int>((*w)[1]),
@@ -166,6 +215,7 @@ void read_dem(Section& s, const std::filesystem::path& file,
     }
   }
   sc.shape.origin = {0, 0, lo - depth};
+  refuse_grid_keys_set_by_dem(root, file, sc.shape, window, up);
   sc.geo = heights.geo();
   sc.terrain.kind = soil::TerrainSource::Kind::HeightField;
   sc.terrain.heights = std::move(heights);
@@ -179,7 +229,7 @@ void read_terrain(const toml::table& root, const std::filesystem::path& file,
   if (kind == "dem") {
     if (!s.string("dem"))
       s.invalid_table("needs dem = \"FILE\" (a metric GeoTIFF) or kind = \"voxel\"");
-    read_dem(s, file, dem_override, sc);
+    read_dem(s, root, file, dem_override, sc);
   } else if (kind == "voxel") {
     sc.terrain.kind = soil::TerrainSource::Kind::Voxel;
     sc.terrain.base = s.number("base", 0.5, -kBig, kBig);

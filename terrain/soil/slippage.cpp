@@ -21,6 +21,15 @@ constexpr float kSolid = 1.0f - 1e-5f;
 
 double run_of(int d) { return std::hypot(kDx[d], kDy[d]); }  // in voxels
 
+// The 16 directions in the order of their angle from +x, and the angle from
+// each to the next (26.6 and 18.4 degrees in turn).
+constexpr int kByAngle[16] = {0, 8, 4, 10, 2, 15, 7, 13, 1, 9, 5, 11, 3, 14, 6, 12};
+const double kGap[16] = {
+    std::atan(0.5), M_PI / 4 - std::atan(0.5), M_PI / 4 - std::atan(0.5), std::atan(0.5),
+    std::atan(0.5), M_PI / 4 - std::atan(0.5), M_PI / 4 - std::atan(0.5), std::atan(0.5),
+    std::atan(0.5), M_PI / 4 - std::atan(0.5), M_PI / 4 - std::atan(0.5), std::atan(0.5),
+    std::atan(0.5), M_PI / 4 - std::atan(0.5), M_PI / 4 - std::atan(0.5), std::atan(0.5)};
+
 std::size_t slot(std::size_t column, int pile, int dir) {
   return (column * Slippage::kMaxPiles + pile) * Slippage::kDirections + dir;
 }
@@ -94,7 +103,7 @@ void add_up(float* rho, const float* psi, int from, int nz, float amount) {
 Slippage::Slippage(const terrain::Grid3Shape& shape)
     : shape_(shape),
       out_(shape.columns() * kMaxPiles * kDirections),
-      speed_(shape.columns() * kMaxPiles * kDirections, 0.0f),
+      speed_(shape.columns() * kMaxPiles, 0.0f),
       pile_span_(shape.columns() * kMaxPiles, -1),
       down_(shape.columns() * kMaxPiles, -1),
       up_(shape.columns() * kMaxPiles, -1),
@@ -226,10 +235,8 @@ void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
           slide_pile(x, y, pile, spans_.column(col)[s], k);
           continue;
         }
-        for (int d = 0; d < kDirections; ++d) {
-          out_[slot(col, pile, d)] = Out{};
-          speed_[slot(col, pile, d)] = 0;
-        }
+        for (int d = 0; d < kDirections; ++d) out_[slot(col, pile, d)] = Out{};
+        speed_[col * kMaxPiles + pile] = 0;
       }
     }
   });
@@ -253,21 +260,71 @@ bool Slippage::open_path(int x, int y, int d, const HeightSpan& p) const {
 
 void Slippage::slide_pile(int x, int y, int pile, const HeightSpan& p, const SliceConstants& k) {
   const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
-  const double rest = rest_[col * kMaxPiles + pile];
-  double total = 0;
+  const std::size_t node = col * kMaxPiles + pile;
+  const double rest = rest_[node];
+  float& v = speed_[node];
+  // Each direction's slice: its target and its slope (rise over run), -1
+  // where no slice can form.
+  double slope[kDirections];
   for (int d = 0; d < kDirections; ++d) {
     Out& o = out_[slot(col, pile, d)];
-    float& v = speed_[slot(col, pile, d)];
     o = Out{};
+    slope[d] = -1;
     const int nx = x + kDx[d], ny = y + kDy[d];
     if (nx < 0 || ny < 0 || nx >= shape_.nx || ny >= shape_.ny ||
-        (d >= kNear && !open_path(x, y, d, p))) {
-      v = 0;
+        (d >= kNear && !open_path(x, y, d, p)))
       continue;
-    }
     const std::size_t ncol = static_cast<std::size_t>(ny) * shape_.nx + nx;
-    slide_slice(p, spans_.column(ncol), spans_.count[ncol], d, rest, k, o, v);
-    total += o.dh;
+    const double rise = slice_rise(p, spans_.column(ncol), spans_.count[ncol], k, o);
+    if (rise > 0) slope[d] = rise / run_of(d);
+  }
+  // The steepest descent: along one direction, or between two neighbouring
+  // ones (a plane through both slices, D-infinity's facets, Tarboton 1997):
+  // with slopes s1, s2 along directions Delta apart, the plane's gradient
+  // lies at a from the first, tan(a) = (s2 / s1 - cos(Delta)) / sin(Delta),
+  // and is s1 / cos(a) steep.
+  double steepest = 0, along = 0;
+  int d1 = -1, d2 = -1;
+  for (int i = 0; i < kDirections; ++i) {
+    const int a = kByAngle[i], b = kByAngle[(i + 1) % kDirections];
+    if (slope[a] > steepest) steepest = slope[a], d1 = a, d2 = -1, along = 0;
+    if (slope[a] <= 0 || slope[b] <= 0) continue;
+    const double gap = kGap[i];
+    const double t = (slope[b] / slope[a] - std::cos(gap)) / std::sin(gap);
+    if (!(t > 0) || std::atan(t) >= gap) continue;
+    const double g = slope[a] * std::sqrt(1 + t * t);
+    if (g > steepest) steepest = g, d1 = a, d2 = b, along = std::atan(t);
+  }
+  // Failure of the slope along its steepest descent, over one voxel's run;
+  // once stopped, only above the static angle.
+  const double h = k.voxel;
+  const double margin = (v > 0 ? kStopDeg : kStaticDeg) * M_PI / 180.0;
+  const double wedge = (steepest - std::tan(rest)) * h;  // above the rest plane, m
+  if (d1 < 0 || std::atan(steepest) <= rest + margin || (v > 0 && wedge <= kStopHeight)) {
+    v = 0;
+    return;
+  }
+  const double rise = steepest * h;
+  v += static_cast<float>(k.gravity * net_force(rise, h, rest, k.gamma) /
+                          wedge_weight(rise, h, rest, k.gamma) * k.dt);
+  // Eq. 10's height over one voxel's run, as a flux: soil times the distance
+  // it travels. Split between the two directions bracketing the descent so
+  // that the flux points down the true gradient, and each direction gets
+  // its share over its own run (a knight's move carries it sqrt(5) voxels):
+  // no lattice direction is preferred.
+  const double flux = wedge * std::min(kMaxShare, v * k.dt / h) / h;  // voxels x voxels
+  double w1 = 1, w2 = 0;
+  if (d2 >= 0) {
+    const double gap = std::atan2(kDy[d2], kDx[d2]) - std::atan2(kDy[d1], kDx[d1]);
+    const double sg = std::sin(std::remainder(gap, 2 * M_PI));
+    w1 = std::sin(std::remainder(gap, 2 * M_PI) - along) / sg;
+    w2 = std::sin(along) / sg;
+  }
+  double total = flux * w1 / run_of(d1);
+  out_[slot(col, pile, d1)].dh = static_cast<float>(flux * w1 / run_of(d1));
+  if (d2 >= 0) {
+    out_[slot(col, pile, d2)].dh = static_cast<float>(flux * w2 / run_of(d2));
+    total += flux * w2 / run_of(d2);
   }
   // A pile cannot give more soil than it holds.
   if (total > p.soil && total > 0) {
@@ -276,8 +333,8 @@ void Slippage::slide_pile(int x, int y, int pile, const HeightSpan& p, const Sli
   }
 }
 
-void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d, double rest,
-                           const SliceConstants& k, Out& o, float& v) const {
+double Slippage::slice_rise(const HeightSpan& p, const HeightSpan* n, int ncount,
+                            const SliceConstants& k, Out& o) const {
   float low_top, ceiling;
   const int q = lower_pile(p, n, ncount);
   if (q >= 0) {
@@ -293,23 +350,9 @@ void Slippage::slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount,
     o.edge_voxel =
         static_cast<std::int16_t>(std::min<int>(shape_.nz - 1, static_cast<int>(p.bottom)));
   } else {
-    v = 0;
-    return;
+    return 0;
   }
-  const double h = k.voxel;
-  const double rise = (std::min(p.top, ceiling) - low_top) * h;  // m
-  const double dx = h * run_of(d);
-  // Fails above its rest angle; once stopped, only above the static one.
-  const double margin = (v > 0 ? kStopDeg : kStaticDeg) * M_PI / 180.0;
-  const double wedge = rise - std::tan(rest) * dx;  // above the rest plane, m
-  if (!(rise > 0) || std::atan2(rise, dx) <= rest + margin || (v > 0 && wedge <= kStopHeight)) {
-    v = 0;
-    return;
-  }
-  const double w = wedge_weight(rise, dx, rest, k.gamma);
-  v += static_cast<float>(k.gravity * net_force(rise, dx, rest, k.gamma) / w * k.dt);
-  const double share = std::min(kMaxShare, v * k.dt / dx);  // eq. 10's v dt / dx
-  o.dh = static_cast<float>(wedge * share / h);
+  return std::min(p.top, ceiling) - low_top;  // eq. 32, voxels
 }
 
 void Slippage::apply(SoilState& state) const {

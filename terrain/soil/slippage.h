@@ -24,12 +24,22 @@
 // critical height 4 c / gamma tan(45 + phi / 2)). A slice whose slope is
 // steeper fails on the plane at that angle: the wedge above it accelerates
 // (eqs. 8-9, a = g f / W) and eq. 10's height moves from the higher pile to
-// the lower; the slice's speed is kept from step to step. A sliding slice
-// stops once its slope is within kStopDeg of the rest angle (or its wedge is
-// under kStopHeight thick); a slice at rest starts again only kStaticDeg above it (static
-// friction), so piles come to rest instead of creeping for ever. Each pile's net change is applied
-// to its density column from its top voxel (fig. 36): removed downwards, added upwards into open
-// voxels (never through a body).
+// the lower; the pile's speed is kept from step to step.
+//
+// A pile slides along its steepest descent, not along each lattice direction
+// on its own: the slope between two neighbouring directions is the plane
+// through their two slices (D-infinity's facets, Tarboton 1997, over the 16
+// directions), the failure test and eq. 10's flux use that true slope, and the
+// flux is split between the two bracketing directions so that it points down
+// the true gradient, each direction's soil divided by its run (issue 33, item
+// 4: a collapsed column's half-height radius varied 6.4 % with direction when
+// each direction failed on its own slope, 1.5 % now). A sliding pile stops
+// once its slope is within kStopDeg of the rest angle (or its wedge is under
+// kStopHeight thick); a pile at rest starts again only kStaticDeg above it
+// (static friction), so piles come to rest instead of creeping for ever.
+// Each pile's net change is applied to its density column from its top voxel
+// (fig. 36): removed downwards, added upwards into open voxels (never through
+// a body).
 //
 // Each slice is computed once, by its higher column, and the lower column
 // gathers what it receives, so the same bits come out on any thread count and
@@ -48,9 +58,9 @@ class Slippage {
  public:
   static constexpr int kMaxPiles = 4;  // per column that can slide; higher piles stay put
   static constexpr int kDirections = 16;
-  // Largest share of a wedge one slice moves in a step: 16 slices may drain a
-  // pile at once, and together they must not take it below its neighbours.
-  static constexpr double kMaxShare = 1.0 / kDirections;
+  // Largest share of its wedge a pile moves in a step: its neighbours uphill
+  // feed it at once, and together they must not take it below them.
+  static constexpr double kMaxShare = 0.25;
   // Static friction: the angle of maximum stability of a granular slope lies
   // about 2 degrees above its angle of repose (Jaeger, Nagel & Behringer 1996,
   // "Granular solids, liquids, and gases", Rev. Mod. Phys. 68, sec. III).
@@ -94,9 +104,10 @@ class Slippage {
   void compute_slices(const SoilType& soil, double gravity, double dt);
   // The slices of pile `pile` (span p) of column (x, y) towards its 16 neighbours.
   void slide_pile(int x, int y, int pile, const HeightSpan& p, const SliceConstants& k);
-  // One slice from pile p to the column n along direction d: o.dh and the speed v.
-  void slide_slice(const HeightSpan& p, const HeightSpan* n, int ncount, int d, double rest,
-                   const SliceConstants& k, Out& o, float& v) const;
+  // The slice from pile p to the column n: its rise (eq. 32, voxels; 0 if
+  // none forms) and its target in o.
+  double slice_rise(const HeightSpan& p, const HeightSpan* n, int ncount, const SliceConstants& k,
+                    Out& o) const;
   // A knight's slice from (x, y) along d crosses two columns: both must hold
   // a pile below p's top with nothing solid between it and p's top.
   bool open_path(int x, int y, int d, const HeightSpan& p) const;
@@ -105,7 +116,7 @@ class Slippage {
   terrain::Grid3Shape shape_;
   HeightSpans spans_;
   std::vector<Out> out_;                            // columns x kMaxPiles x kDirections
-  std::vector<float> speed_;                        // same layout: slice speeds, m/s
+  std::vector<float> speed_;                        // per node: slide speed, m/s
   std::vector<std::int8_t> pile_span_;              // per node: span index, -1 none
   std::vector<int> down_, up_, toe_, crest_, hop_;  // per node
   std::vector<float> rest_;                         // per node: rest angle, rad

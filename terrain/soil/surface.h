@@ -47,7 +47,12 @@ std::vector<float> surface_density(const SoilState& state, const SurfaceOptions&
 // The iso-0.5 surface of `field` (a grid of `state.shape`) in metres,
 // outward-facing, closed where the field meets the grid's sides. Empty if the
 // field is empty.
-terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<float>& field);
+// `kind`: Band (the default) activates only the voxels beside the iso-value,
+// Full every non-zero voxel (as before issue 33's item 8, kept to test that
+// both give the same mesh).
+enum class IsoGrid { Band, Full };
+terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<float>& field,
+                          IsoGrid kind = IsoGrid::Band);
 
 // The soil's surface, with a per-vertex "wetness" = moisture (for the
 // renderer's wet coat).

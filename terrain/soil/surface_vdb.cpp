@@ -2,12 +2,14 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/VolumeToMesh.h>
+#include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
+#include <memory>
 #include <mutex>
+#include <sstream>
 #include <string>
 
 #include "terrain/atomic_file.h"
@@ -38,6 +40,48 @@ openvdb::FloatGrid::Ptr to_grid(const terrain::Grid3Shape& g, const std::vector<
   return grid;
 }
 
+// The surface's grid: the values of to_grid(field, -1), built leaf by leaf
+// in parallel, with only the voxels that have a face neighbour across the
+// iso-value (density 0.5) active. volumeToMesh takes every grid edge whose
+// ends lie on both sides of the iso-value and one of which is active
+// (evalInternalVoxelEdges, tools/VolumeToMesh.h); both ends of such an edge
+// have a neighbour across, so the edges, and with the same values the mesh,
+// are those of the fully active grid, while the soil's interior is skipped
+// (issue 33, item 8; SoilSurface.BandGridGivesTheFullGridsMesh).
+openvdb::FloatGrid::Ptr surface_grid(const terrain::Grid3Shape& g,
+                                     const std::vector<float>& field) {
+  using Leaf = openvdb::FloatTree::LeafNodeType;
+  constexpr int D = Leaf::DIM;
+  const int bx = (g.nx + D - 1) / D, by = (g.ny + D - 1) / D, bz = (g.nz + D - 1) / D;
+  auto inside = [&](int x, int y, int z) {
+    return x >= 0 && y >= 0 && z >= 0 && x < g.nx && y < g.ny && z < g.nz &&
+           field[g.index(x, y, z)] > 0.5f;
+  };
+  std::vector<std::unique_ptr<Leaf>> leaves(static_cast<std::size_t>(bx) * by * bz);
+  tbb::parallel_for(0, static_cast<int>(leaves.size()), [&](int b) {
+    const int X = D * (b % bx), Y = D * (b / bx % by), Z = D * (b / (bx * by));
+    std::unique_ptr<Leaf> leaf;
+    for (int x = X; x < std::min(g.nx, X + D); ++x)
+      for (int y = Y; y < std::min(g.ny, Y + D); ++y)
+        for (int z = Z; z < std::min(g.nz, Z + D); ++z) {
+          const float v = field[g.index(x, y, z)];
+          if (v == 0.0f) continue;
+          if (!leaf) leaf = std::make_unique<Leaf>(openvdb::Coord(X, Y, Z), 0.0f, false);
+          const openvdb::Coord c(x, y, z);
+          leaf->setValueOnly(c, -v);
+          const bool in = v > 0.5f;
+          if (inside(x - 1, y, z) != in || inside(x + 1, y, z) != in || inside(x, y - 1, z) != in ||
+              inside(x, y + 1, z) != in || inside(x, y, z - 1) != in || inside(x, y, z + 1) != in)
+            leaf->setValueOn(c);
+        }
+    leaves[b] = std::move(leaf);
+  });
+  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+  for (auto& leaf : leaves)
+    if (leaf) grid->tree().addLeaf(leaf.release());
+  return grid;
+}
+
 // OpenVDB's header (io/Archive.cc, writeHeader): magic (8 bytes), file
 // version, library major and minor (4 each), the grid-offsets flag (1), then
 // the archive's UUID as 36 ASCII characters.
@@ -47,10 +91,7 @@ constexpr std::size_t kUuidOffset = 21, kUuidLength = 36;
 // two identical runs wrote different bytes. The UUID only lets readers tell
 // files apart; replace it by one derived from the rest of the file (FNV-1a,
 // formatted as a UUID), so the same grids give the same bytes.
-void stamp_content_uuid(const std::filesystem::path& file, const std::string& shown) {
-  std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(io)), std::istreambuf_iterator<char>());
-  if (!io.good() && !io.eof()) throw Error("cannot read back '" + shown + "'");
+void stamp_content_uuid(std::string& bytes, const std::string& shown) {
   if (bytes.size() < kUuidOffset + kUuidLength || bytes[kUuidOffset + 8] != '-')
     throw Error("'" + shown + "': unexpected OpenVDB header (no UUID at byte 21)");
   std::uint64_t h[2] = {1469598103934665603ull, 1099511628211ull * 31};
@@ -64,20 +105,34 @@ void stamp_content_uuid(const std::filesystem::path& file, const std::string& sh
                 static_cast<unsigned>(0x5000 | (h[0] & 0x0fff)),  // version 5 style: name-based
                 static_cast<unsigned>(0x8000 | ((h[1] >> 48) & 0x3fff)),
                 static_cast<unsigned long long>(h[1] & 0xffffffffffffull));
-  io.clear();
-  io.seekp(static_cast<std::streamoff>(kUuidOffset));
-  io.write(uuid, kUuidLength);
-  io.close();
-  if (!io) throw Error("cannot write '" + shown + "'");
+  bytes.replace(kUuidOffset, kUuidLength, uuid, kUuidLength);
 }
+
+// OpenVDB's archive written into memory with the layout io::File writes
+// (seekable: grid offsets in the file, so readers can load one grid):
+// io::File writes through an std::ofstream whose failed writes on a full disk
+// it never checks, which left a truncated VDB behind with exit 0. In memory,
+// every byte then goes through write_all_bytes, which checks each write
+// (issue 34).
+class MemoryArchive : public openvdb::io::Archive {
+ public:
+  std::string encode(const openvdb::GridPtrVec& grids) const {
+    std::ostringstream os(std::ios_base::out | std::ios_base::binary);
+    Archive::write(os, grids, /*seekable=*/true);
+    if (!os) throw Error("OpenVDB could not encode the grids");
+    return std::move(os).str();
+  }
+};
 
 }  // namespace
 
-terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>& field) {
+terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>& field,
+                          IsoGrid kind) {
   init_openvdb();
   // Negated so that "inside" is below the iso-value, as for a level set:
   // volumeToMesh then orients faces outwards; the background (0) is outside.
-  const openvdb::FloatGrid::Ptr grid = to_grid(g, field, -1.0f);
+  const openvdb::FloatGrid::Ptr grid =
+      kind == IsoGrid::Band ? surface_grid(g, field) : to_grid(g, field, -1.0f);
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;
@@ -142,15 +197,15 @@ void write_density_vdb(const SoilState& s, const std::filesystem::path& path, do
   velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
   velocity->setTransform(transform);
   grids.push_back(velocity);
-  AtomicFile out(path);
+  std::string bytes;
   try {
-    openvdb::io::File file(out.temp_path().string());
-    file.write(grids);
-    file.close();
+    bytes = MemoryArchive().encode(grids);
   } catch (const openvdb::Exception& e) {
     throw Error("cannot write '" + path.string() + "': " + e.what());
   }
-  stamp_content_uuid(out.temp_path(), path.string());
+  stamp_content_uuid(bytes, path.string());
+  AtomicFile out(path);
+  write_all_bytes(out.temp_path(), bytes.data(), bytes.size(), path);
   out.commit();
 }
 

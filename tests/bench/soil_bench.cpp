@@ -45,12 +45,17 @@ BENCHMARK(BM_SoilPushResolution)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// The push of the thesis's benchmark on an n^3 grid, 20 steps in.
+SoilSimulation pushing(int n) {
+  SoilSimulation sim = make_simulation(fixtures::push_scenario(n, thesis_options(4)));
+  sim.run(20);
+  return sim;
+}
+
 // Step plus surface extraction (the thesis's frame: simulate and mesh), at
 // 64^3: the thesis's 60 frames a second is 16.7 ms.
 void BM_SoilStepAndSurface(benchmark::State& state) {
-  const int n = static_cast<int>(state.range(0));
-  SoilSimulation sim = make_simulation(fixtures::push_scenario(n, thesis_options(4)));
-  sim.run(20);
+  SoilSimulation sim = pushing(static_cast<int>(state.range(0)));
   std::size_t triangles = 0;
   for (auto _ : state) {
     sim.step();
@@ -60,6 +65,25 @@ void BM_SoilStepAndSurface(benchmark::State& state) {
   state.counters["triangles"] = static_cast<double>(triangles);
 }
 BENCHMARK(BM_SoilStepAndSurface)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The surface alone (the ridge fix's density, then the mesh) and the density
+// alone, of the same push.
+void BM_SoilSurface(benchmark::State& state) {
+  const SoilSimulation sim = pushing(static_cast<int>(state.range(0)));
+  const bool mesh = state.range(1) != 0;
+  for (auto _ : state) {
+    if (mesh)
+      benchmark::DoNotOptimize(soil_surface(sim.state(), {}));
+    else
+      benchmark::DoNotOptimize(surface_density(sim.state(), {}));
+  }
+}
+BENCHMARK(BM_SoilSurface)
+    ->ArgNames({"n", "mesh"})
+    ->Args({64, 0})
+    ->Args({64, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_SoilPushIterations(benchmark::State& state) {
   run_push(state, 72, static_cast<int>(state.range(0)));

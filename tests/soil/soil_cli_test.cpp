@@ -1,13 +1,17 @@
 // drift soil: runs a scenario and writes the mesh, the VDB and the rasters;
 // bad scenarios exit 1 and bad flags exit 2, naming what was wrong, and
 // write nothing.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/mount.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
@@ -160,6 +164,87 @@ TEST(SoilCli, BadScenariosAreErrorsNamingTheValueAndWriteNothing) {
   EXPECT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.ply").string() + " --phi 75", d), 2);
   EXPECT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.stl").string(), d), 2);
   EXPECT_FALSE(fs::exists(d / "soil.ply"));
+}
+
+// A DEM scenario's keys that the DEM sets, or that it cannot honour, are
+// refused naming the file, the key, the value and the fix (issue 34): a
+// fractional window was truncated and a [grid] voxel, x, y size or origin
+// beside the dem ignored, without a word. Values equal to the DEM's are
+// honoured (DemGroundFollowsTheDemUpToTheWindowsEdges gives voxel = 2.5).
+TEST(SoilCli, DemScenarioRefusesWhatTheDemSetsOrCannotHonour) {
+  const fs::path d = dir();
+  const auto plane = [](double x, double y) { return 1000.0 + 0.8 * x - 0.3 * y; };
+  drift::terrain::write_geotiff(drift::testing::dem_from(16, 10.0, 0.5, plane), d / "dem.tif");
+  const std::string base =
+      "[grid]\nsize = [0, 0, 40]\nvoxel = 2.5\n[terrain]\ndem = \"dem.tif\"\n"
+      "window = [4, 5, 6, 4]\nupsample = 4\n[simulation]\nsteps = 0\n"
+      "[[soil_body]]\non_ground = true\nposition = [30, 20, 4]\n"
+      "[[soil_body.primitive]]\nshape = \"sphere\"\nradius = 6\n";
+  const struct {
+    std::string from, to;
+    std::vector<std::string> expect;
+  } cases[] = {
+      {"window = [4, 5, 6, 4]", "window = [4.5, 5, 6, 4]", {"'terrain.window'", "4.5", "whole"}},
+      {"window = [4, 5, 6, 4]", "window = [4, 5, 0, 4]", {"'terrain.window'", "at least 1"}},
+      {"voxel = 2.5", "voxel = 1", {"'grid.voxel'", "is 1 m", "2.5 m", "upsample"}},
+      {"size = [0, 0, 40]", "size = [30, 16, 40]", {"'grid.size'", "24, 16", "[0, 0, 40]"}},
+      {"voxel = 2.5", "voxel = 2.5\norigin = [1, 2, 3]", {"'grid.origin'", "remove it"}},
+  };
+  for (const auto& c : cases) {
+    std::string text = base;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    std::ofstream(d / "bad.toml") << text;
+    EXPECT_EQ(run((d / "bad.toml").string() + " -o " + (d / "soil.obj").string(), d), 1)
+        << c.to << ": " << output(d);
+    for (const std::string& e : c.expect)
+      EXPECT_NE(output(d).find(e), std::string::npos) << c.to << ": " << output(d);
+    EXPECT_NE(output(d).find("bad.toml"), std::string::npos) << output(d);
+    EXPECT_FALSE(fs::exists(d / "soil.obj"));
+  }
+  // size [24, 16, 40] is the DEM's own: honoured.
+  std::string same = base;
+  same.replace(same.find("size = [0, 0, 40]"), 17, "size = [24, 16, 40]");
+  std::ofstream(d / "same.toml") << same;
+  EXPECT_EQ(run((d / "same.toml").string() + " -o " + (d / "soil.obj").string(), d), 0)
+      << output(d);
+}
+
+// The VDB on a disk that fills while it is written (a 64 KiB tmpfs with 8 KiB
+// left, the VDB about 45 KiB): exit 1 naming the file, the old file kept, no
+// temporary file left (issue 34). OpenVDB's io::File never checked its
+// stream, and the UUID stamp read back and rewrote the truncated file: exit 0
+// with a VDB cut at 8 KiB. Skipped where a tmpfs cannot be mounted.
+TEST(SoilCli, VdbOnAFullDiskFailsAndKeepsTheOldFile) {
+  const fs::path d = dir();
+  const fs::path full = d / "full";
+  fs::create_directories(full);
+  if (mount("tmpfs", full.c_str(), "tmpfs", 0, "size=64k") != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs here (needs root): not tested";
+  std::ofstream(full / "soil.vdb") << "old";
+  {
+    const int fd = open((full / "filler").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    const std::string block(4096, 'x');
+    while (write(fd, block.data(), block.size()) > 0) {
+    }
+    const off_t size = lseek(fd, 0, SEEK_END);
+    EXPECT_EQ(ftruncate(fd, size - 8192), 0);
+    close(fd);
+  }
+  std::ofstream(d / "s.toml") << kScenario;
+  const int status = run((d / "s.toml").string() + " -o " + (d / "soil.ply").string() + " --vdb " +
+                             (full / "soil.vdb").string(),
+                         d);
+  const std::string log = output(d);
+  std::ifstream in(full / "soil.vdb");
+  const std::string kept((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  int hidden = 0;
+  for (const auto& e : fs::directory_iterator(full))
+    hidden += e.path().filename().string().front() == '.';
+  umount(full.c_str());
+  EXPECT_EQ(status, 1) << log;
+  EXPECT_NE(log.find("soil.vdb"), std::string::npos) << log;
+  EXPECT_EQ(kept, "old");
+  EXPECT_EQ(hidden, 0);
 }
 
 }  // namespace

@@ -34,22 +34,57 @@ int run_until_settled(SoilSimulation& sim, int max_steps, int window, float tole
   return max_steps;
 }
 
-double pile_angle_deg(const SoilState& s, double* spread_deg) {
+PileTops pile_tops(const SoilState& s) {
   const auto& g = s.shape;
-  std::vector<float> top(g.columns());
-  float peak = 0;
-  double cx = 0, cy = 0, w = 0;
+  PileTops p;
+  p.nx = g.nx;
+  p.ny = g.ny;
+  p.top.resize(g.columns());
+  double w = 0;
   for (int y = 0; y < g.ny; ++y)
     for (int x = 0; x < g.nx; ++x) {
       const float t = column_top(s, x, y);
-      top[static_cast<std::size_t>(y) * g.nx + x] = t;
-      peak = std::max(peak, t);
-      cx += t * (x + 0.5);
-      cy += t * (y + 0.5);
+      p.top[static_cast<std::size_t>(y) * g.nx + x] = t;
+      p.peak = std::max(p.peak, t);
+      p.cx += t * (x + 0.5);
+      p.cy += t * (y + 0.5);
       w += t;
     }
-  cx /= w;
-  cy /= w;
+  p.cx /= w;
+  p.cy /= w;
+  return p;
+}
+
+double PileTops::at(double x, double y) const {
+  x -= 0.5;  // to column indices
+  y -= 0.5;
+  const int x0 = std::clamp(static_cast<int>(std::floor(x)), 0, nx - 2),
+            y0 = std::clamp(static_cast<int>(std::floor(y)), 0, ny - 2);
+  const double fx = std::clamp(x - x0, 0.0, 1.0), fy = std::clamp(y - y0, 0.0, 1.0);
+  const auto& t = *this;
+  return (1 - fy) * ((1 - fx) * t(x0, y0) + fx * t(x0 + 1, y0)) +
+         fy * ((1 - fx) * t(x0, y0 + 1) + fx * t(x0 + 1, y0 + 1));
+}
+
+double radius_spread(const SoilState& s, double fraction, int directions) {
+  const PileTops p = pile_tops(s);
+  double lo = 1e9, hi = 0;
+  for (int k = 0; k < directions; ++k) {
+    const double a = 2 * M_PI * k / directions;
+    double r = 0;
+    while (r < p.nx && p.at(p.cx + r * std::cos(a), p.cy + r * std::sin(a)) > fraction * p.peak)
+      r += 0.005;
+    lo = std::min(lo, r), hi = std::max(hi, r);
+  }
+  return hi / lo - 1;
+}
+
+double pile_angle_deg(const SoilState& s, double* spread_deg) {
+  const auto& g = s.shape;
+  const PileTops p = pile_tops(s);
+  const std::vector<float>& top = p.top;
+  const float peak = p.peak;
+  const double cx = p.cx, cy = p.cy;
   // Per sector of 45 degrees and overall: fit top = a - b r.
   double sums[9][5] = {};  // n, sr, st, srr, srt
   for (int y = 0; y < g.ny; ++y)

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "terrain/soil/simulation.h"
 
@@ -15,6 +16,24 @@ SoilSimulation column_scene(int n, int nz, double radius, double height, double 
 // Runs until no voxel changes by more than `tolerance` over `window` steps,
 // or `max_steps`; returns the steps taken.
 int run_until_settled(SoilSimulation& sim, int max_steps, int window = 20, float tolerance = 1e-4f);
+
+// The column tops of a pile (voxels) and their top-weighted centroid, in
+// voxel units with column x's centre at x + 0.5 (the one convention of the
+// measures below).
+struct PileTops {
+  int nx = 0, ny = 0;
+  std::vector<float> top;  // nx * ny, row y at y * nx
+  float peak = 0;
+  double cx = 0, cy = 0;
+  float operator()(int x, int y) const { return top[static_cast<std::size_t>(y) * nx + x]; }
+  // Bilinear between the column centres at (x, y) in voxel units.
+  double at(double x, double y) const;
+};
+PileTops pile_tops(const SoilState& state);
+
+// Radius (voxels) at which the pile's top falls below `fraction` of its peak,
+// walking out from the centroid along `directions` directions: max / min - 1.
+double radius_spread(const SoilState& state, double fraction, int directions);
 
 // Slope angle (degrees) of a settled pile's flank: least-squares fit of the
 // column tops against the distance from the pile's axis, over columns whose
