@@ -13,6 +13,7 @@
 #include "pipeline/scene_file.h"
 #include "pipeline/scene_products.h"
 #include "render/image_io.h"
+#include "render/map_output.h"
 #include "render/renderer.h"
 #include "render/tiles.h"
 #include "terrain/error.h"
@@ -42,7 +43,34 @@ struct RenderOptions {
   std::string sun_time;
   double exposure_ev = 0.0;
   double compensation_ev = 0.0;
+  bool map = false;
+  std::string map_box;
+  double cell = 0.0;
 };
+
+// --map, --map-box W,S,E,N and --cell M: a map render (either of the last
+// two implies --map) over the scene's [camera].
+void apply_map_flags(const RenderOptions& o, SceneFile& scene) {
+  if (!o.map && o.map_box.empty() && o.cell <= 0.0) return;
+  MapRequest request = scene.map.value_or(MapRequest{});
+  if (!o.map_box.empty()) {
+    std::smatch m;
+    const std::string number = R"(\s*([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*)";
+    if (!std::regex_match(o.map_box, m,
+                          std::regex(number + "," + number + "," + number + "," + number))) {
+      usage_error(
+          "--map-box '" + o.map_box +
+          "' must be WEST,SOUTH,EAST,NORTH in the DEM's CRS, e.g. 741000,4025000,745000,4029000");
+    }
+    const std::array<double, 4> box = {std::stod(m[1]), std::stod(m[2]), std::stod(m[3]),
+                                       std::stod(m[4])};
+    if (!(box[2] > box[0]) || !(box[3] > box[1]))
+      usage_error("--map-box '" + o.map_box + "' must have EAST > WEST and NORTH > SOUTH");
+    request.box = box;
+  }
+  if (o.cell > 0.0) request.cell = o.cell;
+  scene.map = request;
+}
 
 // --sun-time "YYYY-MM-DD HH:MM[:SS] [+HH:MM]" (the offset as in [sun]
 // timezone, default UTC) -> the scene's date and time.
@@ -118,6 +146,9 @@ void apply_overrides(const RenderOptions& o, const CLI::App& sub, SceneFile& sce
   }
   if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
   apply_product_flags(o, scene);
+  apply_map_flags(o, scene);
+  if (scene.map && !o.size.empty())
+    usage_error("--size and a map render: a map's size is its box over its --cell");
   if (!o.outputs.empty()) {
     scene.outputs.clear();
     for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
@@ -133,8 +164,10 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
   for (const auto& f : scene.outputs) {
     std::string ext = f.extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (scene.map && render::is_geotiff_path(f)) continue;  // a GeoTIFF of the map
     if (ext != ".png" && ext != ".exr") {
-      throw Error("cannot write '" + f.string() + "': use a .png or .exr file name");
+      throw Error("cannot write '" + f.string() + "': use a .png or .exr file name" +
+                  (scene.map ? ", or .tif (a GeoTIFF of the map)" : ""));
     }
   }
   if (o.tile.empty()) return;
@@ -177,6 +210,21 @@ std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
   return hex;
 }
 
+// Every output; a map's with its georeference (render/map_output.h).
+void write_outputs(const SceneFile& scene, const render::Image& image) {
+  render::MapGeoreference geo;
+  geo.geotransform = scene.map_geotransform;
+  geo.crs_wkt = scene.input.terrain.geo().crs_wkt;
+  for (const auto& f : scene.outputs) {
+    if (scene.map && render::is_geotiff_path(f)) {
+      render::write_map_geotiff(image, scene.display, geo, f);
+      continue;
+    }
+    render::write_image(image, f, scene.display);
+    if (scene.map && f.extension() == ".png") render::write_map_png_sidecars(f, geo);
+  }
+}
+
 void print_summary(const SceneFile& scene, const render::Image& image,
                    const render::RenderStats& stats, double seconds) {
   if (scene.settings.noise_target > 0.0f) {
@@ -199,7 +247,13 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   check_outputs(o, scene);
   std::vector<std::filesystem::path> inputs = scene_inputs(scene);
   inputs.emplace_back(o.scene);
-  OutputSet outputs(scene.outputs, inputs);
+  std::vector<std::filesystem::path> written = scene.outputs;
+  if (scene.map) {  // a map PNG's world file and .aux.xml are written with it
+    for (const auto& f : scene.outputs)
+      if (f.extension() == ".png")
+        for (const auto& side : render::map_png_sidecars(f)) written.push_back(side);
+  }
+  OutputSet outputs(written, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
   const render::TerrainScene embree_scene(scene.input);
@@ -220,7 +274,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       {"white_balance",
        scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"},
       {"scene", scene_identity(o, scene)}};
-  for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
+  write_outputs(scene, image);
   outputs.commit();
   print_summary(scene, image, stats, seconds);
   print_exposure(image, scene.display, o.tile.empty());
@@ -273,6 +327,16 @@ void add_render_command(CLI::App& root) {
   sub->add_option("--exposure-compensation", o->compensation_ev,
                   "EV added to the metered exposure (overrides [output] exposure_compensation)")
       ->check(CLI::Range(-render::DisplayTransform::kMaxEv, render::DisplayTransform::kMaxEv));
+  sub->add_flag("--map", o->map,
+                "render a map: straight down over the DEM (or --map-box) at --cell metres a "
+                "pixel, georeferenced (.tif GeoTIFF; .png with a world file and .aux.xml)");
+  sub->add_option("--map-box", o->map_box,
+                  "the map's box WEST,SOUTH,EAST,NORTH in the DEM's CRS (implies --map; default "
+                  "the DEM's extent)");
+  sub->add_option("--cell", o->cell,
+                  "the map's cell size in metres (implies --map; default the "
+                  "DEM's)")
+      ->check(CLI::Range(1e-3, 1e6));
   add_seed_option(*sub, o->seed);
 }
 

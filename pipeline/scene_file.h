@@ -3,6 +3,7 @@
 // key, the file and the line. See docs/rendering.md for every key.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -21,6 +22,15 @@ namespace drift::pipeline {
 struct GeoPoint {
   double lon = 0.0, lat = 0.0;  // degrees, WGS 84
   double above_ground = 0.0;    // metres
+};
+
+// A map render ([camera] projection = "map", or drift render --map): straight
+// down over `box` (west, south, east, north in the DEM's CRS; none: the
+// DEM's extent) at `cell` metres a pixel (0: the DEM's cell), placed by
+// load_scene_terrain.
+struct MapRequest {
+  std::optional<std::array<double, 4>> box;
+  double cell = 0.0;
 };
 
 struct SceneFile {
@@ -46,6 +56,10 @@ struct SceneFile {
   // [sun] date/time/timezone: the sun over the DEM's centre, placed by
   // load_scene_terrain.
   std::optional<render::LocalTime> sun_time;
+  // A map render: resolved by load_scene_terrain into input.camera, the
+  // size in `settings` and `map_geotransform` (GDAL's, of the frame).
+  std::optional<MapRequest> map;
+  std::array<double, 6> map_geotransform{0, 1, 0, 0, 0, -1};
   render::SceneInput input;  // terrain not loaded yet (see load_scene_terrain)
   render::RenderSettings settings;
   std::vector<std::filesystem::path> outputs;  // resolved against the current directory
