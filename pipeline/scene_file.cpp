@@ -375,6 +375,35 @@ void read_lens(Section& cam, render::Camera& camera) {
     cam.invalid("focus_distance", "must be 0 (automatic) or at least 0.001 m");
 }
 
+// [[camera.keyframe]] entries, in increasing time; `fov` defaults to the
+// camera's.
+std::vector<KeyframeSpec> read_keyframes(Section& cam, const fs::path& path, double fov) {
+  std::vector<KeyframeSpec> keys;
+  for (const toml::table* table : cam.tables("keyframe")) {
+    Section k(table, "camera.keyframe", path);
+    KeyframeSpec key;
+    if (!k.has("time")) k.invalid_table("needs 'time' (seconds along the path)");
+    key.time = k.number("time", 0.0, -1e9, 1e9);
+    key.from = k.vector<3>("from", -1e8, 1e8);
+    key.to = k.vector<3>("to", -1e8, 1e8);
+    const auto from_ll = k.vector<2>("from_lonlat", -180.0, 180.0);
+    const auto to_ll = k.vector<2>("to_lonlat", -180.0, 180.0);
+    const double from_height = k.number("from_height", 2.0, -1e4, 1e6);
+    const double to_height = k.number("to_height", 0.0, -1e4, 1e6);
+    key.fov_deg = k.number("fov", fov, 0.1, 179.0);
+    k.finish();
+    if (from_ll) key.from_lonlat = GeoPoint{(*from_ll)[0], (*from_ll)[1], from_height};
+    if (to_ll) key.to_lonlat = GeoPoint{(*to_ll)[0], (*to_ll)[1], to_height};
+    if (!!key.from == !!key.from_lonlat || !!key.to == !!key.to_lonlat)
+      k.invalid_table("needs one of 'from' / 'from_lonlat' and one of 'to' / 'to_lonlat'");
+    if (!keys.empty() && !(key.time > keys.back().time))
+      k.invalid("time", "must be later than the keyframe before's (" +
+                            std::to_string(keys.back().time) + ")");
+    keys.push_back(key);
+  }
+  return keys;
+}
+
 // [camera]: where it stands and looks (CRS points, or lon/lat placed on the
 // DEM by load_scene_terrain) and its lens.
 void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene) {
@@ -397,7 +426,14 @@ void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene
   const double from_height = cam.number("from_height", 2.0, -1e4, 1e6);
   const double to_height = cam.number("to_height", 0.0, -1e4, 1e6);
   read_lens(cam, camera);
+  scene.keyframes = read_keyframes(cam, path, camera.vertical_fov_deg);
   cam.finish();
+  if (!scene.keyframes.empty()) {
+    if (projection == "map" || from || to || from_lonlat || to_lonlat)
+      cam.invalid_table("has keyframes: give the camera's ends in them, not 'from'/'to'");
+    scene.input.camera = camera;  // the lens; placed by load_scene_terrain
+    return;
+  }
   if (projection == "map") {
     if (from || to || from_lonlat || to_lonlat)
       cam.invalid_table("is a map (straight down): give 'map_box' and 'cell', not 'from'/'to'");
@@ -551,9 +587,9 @@ void place_sun(SceneFile& scene) {
 
 // Turns the camera's lon/lat ends into CRS points at their height above the
 // (exaggerated) ground, which must be inside the DEM.
-void place_lonlat_camera(SceneFile& scene) {
+Eigen::Vector3d place_geo_point(const SceneFile& scene, const GeoPoint& p, const char* key) {
   const terrain::HeightField& dem = scene.input.terrain;
-  auto place = [&](const GeoPoint& p, const char* key) {
+  {
     const auto xy = terrain::from_lonlat(dem.geo().crs_wkt, p.lon, p.lat);
     const float ground = render::sample_raster(dem, xy[0], xy[1], NAN);
     if (std::isnan(ground)) {
@@ -564,7 +600,11 @@ void place_lonlat_camera(SceneFile& scene) {
     }
     return Eigen::Vector3d(xy[0], xy[1],
                            ground * scene.input.vertical_exaggeration + p.above_ground);
-  };
+  }
+}
+
+void place_lonlat_camera(SceneFile& scene) {
+  auto place = [&](const GeoPoint& p, const char* key) { return place_geo_point(scene, p, key); };
   if (scene.camera_from_lonlat)
     scene.input.camera->from = place(*scene.camera_from_lonlat, "from_lonlat");
   if (scene.camera_to_lonlat) scene.input.camera->to = place(*scene.camera_to_lonlat, "to_lonlat");
@@ -578,6 +618,21 @@ bool uses_position(const render::TerrainSurface& surface) {
 }
 
 }  // namespace
+
+// The camera on its path at the scene's time (its first key's by default).
+void place_camera_path(SceneFile& scene) {
+  std::vector<render::CameraKey> keys;
+  for (const KeyframeSpec& k : scene.keyframes) {
+    render::CameraKey key;
+    key.time = k.time;
+    key.from = k.from ? *k.from : place_geo_point(scene, *k.from_lonlat, "keyframe from_lonlat");
+    key.to = k.to ? *k.to : place_geo_point(scene, *k.to_lonlat, "keyframe to_lonlat");
+    key.fov_deg = k.fov_deg;
+    keys.push_back(key);
+  }
+  scene.input.camera = render::camera_at(keys, scene.time.value_or(keys.front().time),
+                                         scene.input.camera.value_or(render::Camera{}));
+}
 
 // A map: the box (the DEM's extent by default) in whole cells from its
 // north-west corner, the camera straight down over it, and its geotransform.
@@ -614,7 +669,9 @@ void load_scene_terrain(SceneFile& scene) {
   if (scene.terrain_repeat > 1) {
     scene.input.terrain = terrain::repeat_periodic(scene.input.terrain, scene.terrain_repeat);
   }
-  if (scene.map) {
+  if (!scene.keyframes.empty()) {
+    place_camera_path(scene);
+  } else if (scene.map) {
     place_map(scene);
   } else {
     place_lonlat_camera(scene);
@@ -631,6 +688,25 @@ void load_scene_terrain(SceneFile& scene) {
   if (uses_position(surface))
     surface.position = render::topographic_position(scene.input.terrain, scene.position_radius);
   for (const auto& [section, load] : scene.product_loaders) load(scene);
+}
+
+void read_camera_path(const fs::path& path, SceneFile& scene) {
+  const toml::table root = parse_toml_file(path, "camera path");
+  for (const auto& [k, node] : root) {
+    if (k.str() != "camera")
+      throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
+                  ": unknown section '" + std::string(k.str()) +
+                  "' (a camera path holds only [[camera.keyframe]] entries)");
+  }
+  Section cam(subtable(root, "camera", path), "camera", path);
+  const double fov = scene.input.camera ? scene.input.camera->vertical_fov_deg : 40.0;
+  scene.keyframes = read_keyframes(cam, path, fov);
+  cam.finish();
+  if (scene.keyframes.empty())
+    throw Error(path.string() + ": no [[camera.keyframe]] entries; give at least one");
+  scene.map.reset();
+  scene.camera_from_lonlat.reset();
+  scene.camera_to_lonlat.reset();
 }
 
 std::vector<fs::path> scene_inputs(const SceneFile& scene) {

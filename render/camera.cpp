@@ -171,4 +171,54 @@ std::array<float, 16> world_to_ndc(const CameraRays& c, const Eigen::Vector3d& l
   return out;
 }
 
+namespace {
+
+// Cubic Hermite between values a (at t0) and b (at t1) with slopes ma, mb
+// (per second), at s in [0, 1] of the interval.
+template <class T>
+T hermite(const T& a, const T& b, const T& ma, const T& mb, double s, double dt) {
+  const double s2 = s * s, s3 = s2 * s;
+  return a * (2 * s3 - 3 * s2 + 1) + ma * (dt * (s3 - 2 * s2 + s)) + b * (-2 * s3 + 3 * s2) +
+         mb * (dt * (s3 - s2));
+}
+
+// The Catmull-Rom slope at key i of values v: central difference over the
+// neighbours' times, one-sided at the ends.
+template <class T, class Get>
+T slope(const std::vector<CameraKey>& keys, std::size_t i, Get get) {
+  const std::size_t lo = i == 0 ? 0 : i - 1, hi = i + 1 == keys.size() ? i : i + 1;
+  return (get(keys[hi]) - get(keys[lo])) * (1.0 / (keys[hi].time - keys[lo].time));
+}
+
+}  // namespace
+
+Camera camera_at(const std::vector<CameraKey>& keys, double time, const Camera& base) {
+  if (keys.empty()) throw Error("a camera path needs at least one keyframe");
+  Camera c = base;
+  c.projection = Projection::Perspective;
+  auto at = [&](const CameraKey& k) {
+    c.from = k.from;
+    c.to = k.to;
+    c.vertical_fov_deg = k.fov_deg;
+    return c;
+  };
+  if (keys.size() == 1 || time <= keys.front().time) return at(keys.front());
+  if (time >= keys.back().time) return at(keys.back());
+  std::size_t i = 0;
+  while (keys[i + 1].time < time) ++i;  // keys[i].time <= time < keys[i + 1].time
+  const double dt = keys[i + 1].time - keys[i].time, s = (time - keys[i].time) / dt;
+  auto from = [](const CameraKey& k) { return k.from; };
+  auto to = [](const CameraKey& k) { return k.to; };
+  auto fov = [](const CameraKey& k) { return k.fov_deg; };
+  c.from = hermite<Eigen::Vector3d>(keys[i].from, keys[i + 1].from,
+                                    slope<Eigen::Vector3d>(keys, i, from),
+                                    slope<Eigen::Vector3d>(keys, i + 1, from), s, dt);
+  c.to = hermite<Eigen::Vector3d>(keys[i].to, keys[i + 1].to, slope<Eigen::Vector3d>(keys, i, to),
+                                  slope<Eigen::Vector3d>(keys, i + 1, to), s, dt);
+  c.vertical_fov_deg =
+      hermite<double>(keys[i].fov_deg, keys[i + 1].fov_deg, slope<double>(keys, i, fov),
+                      slope<double>(keys, i + 1, fov), s, dt);
+  return c;
+}
+
 }  // namespace drift::render

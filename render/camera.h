@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <optional>
+#include <vector>
 
 namespace drift::render {
 
@@ -85,5 +86,26 @@ CameraRays make_camera_rays(const TerrainScene& scene, const Camera& camera, int
 std::array<float, 16> world_to_camera(const CameraRays& camera,
                                       const Eigen::Vector3d& local_to_world);
 std::array<float, 16> world_to_ndc(const CameraRays& camera, const Eigen::Vector3d& local_to_world);
+
+}  // namespace drift::render
+
+namespace drift::render {
+
+// One key of a camera path ([[camera.keyframe]]): at `time` (seconds) the
+// camera stands at `from`, looks at `to` (CRS metres) with a vertical field
+// of view of `fov_deg`.
+struct CameraKey {
+  double time = 0.0;
+  Eigen::Vector3d from{0, 0, 0}, to{0, 1, 0};
+  double fov_deg = 40.0;
+};
+
+// The camera at `time` on the path through `keys` (sorted by time, at least
+// one): a Catmull-Rom spline through the keys with tangents by central
+// differences over the keys' own times (a C1 cubic Hermite; one-sided at
+// the ends), for `from`, `to` and the field of view alike. It passes
+// through every key, moves evenly along keys evenly spaced on a line, and
+// holds the first or last key outside their times. `base` gives the lens.
+Camera camera_at(const std::vector<CameraKey>& keys, double time, const Camera& base = {});
 
 }  // namespace drift::render
