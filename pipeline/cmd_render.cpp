@@ -1,5 +1,6 @@
 // drift render SCENE.toml: path-trace a scene file into EXR and/or PNG.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -13,9 +14,12 @@
 #include "pipeline/scene_file.h"
 #include "pipeline/scene_products.h"
 #include "pipeline/scene_variables.h"
+#include "render/frame_sidecar.h"
 #include "render/image_io.h"
+#include "render/map_output.h"
 #include "render/renderer.h"
 #include "render/tiles.h"
+#include "terrain/atomic_file.h"
 #include "terrain/error.h"
 #include "terrain/output_set.h"
 
@@ -44,7 +48,73 @@ struct RenderOptions {
   std::string sun_time;
   double exposure_ev = 0.0;
   double compensation_ev = 0.0;
+  bool map = false;
+  bool sidecar = false;
+  double time = 0.0;
+  std::string camera_path;
+  std::string from, to;  // --from/--to X,Y,Z in the CRS
+  std::string map_box;
+  double cell = 0.0;
 };
+
+// X,Y,Z (CRS metres) of --from or --to.
+Eigen::Vector3d parse_point(const std::string& flag, const std::string& text) {
+  std::smatch m;
+  const std::string number = R"(\s*([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*)";
+  if (!std::regex_match(text, m, std::regex(number + "," + number + "," + number)))
+    usage_error(flag + " '" + text + "' must be X,Y,Z in the DEM's CRS (metres), e.g. " +
+                "741000,4029000,3200");
+  return {std::stod(m[1]), std::stod(m[2]), std::stod(m[3])};
+}
+
+// --from and --to: where the camera stands and looks, over [camera]'s.
+void apply_camera_flags(const RenderOptions& o, SceneFile& scene) {
+  if (o.from.empty() && o.to.empty()) return;
+  if (o.from.empty() || o.to.empty()) usage_error("--from and --to go together");
+  render::Camera camera = scene.input.camera.value_or(render::Camera{});
+  camera.from = parse_point("--from", o.from);
+  camera.to = parse_point("--to", o.to);
+  scene.input.camera = camera;
+  scene.camera_from_lonlat.reset();
+  scene.camera_to_lonlat.reset();
+}
+
+// --sidecar: NAME.json beside the first image output (its EXR if any).
+void add_sidecar(const RenderOptions& o, SceneFile& scene) {
+  if (!o.sidecar) return;
+  std::filesystem::path image;
+  for (const auto& f : scene.outputs)
+    if (image.empty() || f.extension() == ".exr") image = f;
+  if (image.empty()) return;  // check_outputs says there is nothing to write
+  std::filesystem::path json = image;
+  json.replace_extension(".json");
+  if (std::find(scene.outputs.begin(), scene.outputs.end(), json) == scene.outputs.end())
+    scene.outputs.push_back(json);
+}
+
+// --map, --map-box W,S,E,N and --cell M: a map render (either of the last
+// two implies --map) over the scene's [camera].
+void apply_map_flags(const RenderOptions& o, SceneFile& scene) {
+  if (!o.map && o.map_box.empty() && o.cell <= 0.0) return;
+  MapRequest request = scene.map.value_or(MapRequest{});
+  if (!o.map_box.empty()) {
+    std::smatch m;
+    const std::string number = R"(\s*([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*)";
+    if (!std::regex_match(o.map_box, m,
+                          std::regex(number + "," + number + "," + number + "," + number))) {
+      usage_error(
+          "--map-box '" + o.map_box +
+          "' must be WEST,SOUTH,EAST,NORTH in the DEM's CRS, e.g. 741000,4025000,745000,4029000");
+    }
+    const std::array<double, 4> box = {std::stod(m[1]), std::stod(m[2]), std::stod(m[3]),
+                                       std::stod(m[4])};
+    if (!(box[2] > box[0]) || !(box[3] > box[1]))
+      usage_error("--map-box '" + o.map_box + "' must have EAST > WEST and NORTH > SOUTH");
+    request.box = box;
+  }
+  if (o.cell > 0.0) request.cell = o.cell;
+  scene.map = request;
+}
 
 // --sun-time "YYYY-MM-DD HH:MM[:SS] [+HH:MM]" (the offset as in [sun]
 // timezone, default UTC) -> the scene's date and time.
@@ -120,10 +190,26 @@ void apply_overrides(const RenderOptions& o, const CLI::App& sub, SceneFile& sce
   }
   if (!o.terrain.empty()) scene.terrain_raster = o.terrain;
   apply_product_flags(o, scene);
+  if (!o.camera_path.empty()) read_camera_path(o.camera_path, scene);
+  if (sub.count("--time")) {
+    if (scene.keyframes.empty())
+      usage_error("--time needs a camera path: [[camera.keyframe]] in '" + o.scene +
+                  "' or --camera-path FILE");
+    scene.time = o.time;
+  }
+  apply_map_flags(o, scene);
+  apply_camera_flags(o, scene);
+  if (!scene.keyframes.empty() && (scene.map || !o.from.empty()))
+    usage_error("a camera path and --map or --from/--to: give one camera");
+  if (scene.map && !o.from.empty())
+    usage_error("--from/--to and a map render: a map looks straight down over its box");
+  if (scene.map && !o.size.empty())
+    usage_error("--size and a map render: a map's size is its box over its --cell");
   if (!o.outputs.empty()) {
     scene.outputs.clear();
     for (const auto& f : o.outputs) scene.outputs.emplace_back(f);
   }
+  add_sidecar(o, scene);
 }
 
 // Outputs are PNG or EXR, a tile (--tile i/n) only EXR.
@@ -135,8 +221,11 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
   for (const auto& f : scene.outputs) {
     std::string ext = f.extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (scene.map && render::is_geotiff_path(f)) continue;  // a GeoTIFF of the map
+    if (ext == ".json") continue;                           // the frame's ground truth
     if (ext != ".png" && ext != ".exr") {
-      throw Error("cannot write '" + f.string() + "': use a .png or .exr file name");
+      throw Error("cannot write '" + f.string() + "': use a .png, .exr or .json file name" +
+                  (scene.map ? ", or .tif (a GeoTIFF of the map)" : ""));
     }
   }
   if (o.tile.empty()) return;
@@ -151,7 +240,7 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
   scene.settings.row_begin = rows.begin;
   scene.settings.row_end = rows.end;
   for (const auto& f : scene.outputs) {
-    if (f.extension() != ".exr") {
+    if (f.extension() != ".exr" && f.extension() != ".json") {
       throw Error("a tile is written as EXR (it keeps its place in the frame); '" + f.string() +
                   "' is not: give -o TILE.exr and join the tiles with drift merge");
     }
@@ -164,7 +253,15 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
 std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
   std::ifstream in(o.scene, std::ios::binary);
   std::string text((std::istreambuf_iterator<char>(in)), {});
-  std::vector<std::string> parts = {o.size, o.terrain};
+  std::vector<std::string> parts = {o.size,
+                                    o.terrain,
+                                    o.from,
+                                    o.to,
+                                    o.camera_path,
+                                    std::to_string(o.time),
+                                    o.map_box,
+                                    std::to_string(o.map),
+                                    std::to_string(o.cell)};
   for (const RenderOptions::ProductFlag& f : o.product_flags) parts.push_back(f.value);
   parts.insert(
       parts.end(),
@@ -177,6 +274,30 @@ std::string scene_identity(const RenderOptions& o, const SceneFile& scene) {
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
   return hex;
+}
+
+// Every output; a map's with its georeference (render/map_output.h).
+void write_outputs(const SceneFile& scene, const render::Image& image,
+                   const render::TerrainScene& embree_scene, const render::Camera& camera) {
+  render::MapGeoreference geo;
+  geo.geotransform = scene.map_geotransform;
+  geo.crs_wkt = scene.input.terrain.geo().crs_wkt;
+  for (const auto& f : scene.outputs) {
+    if (f.extension() == ".json") {
+      const std::string json =
+          render::frame_sidecar_json(embree_scene, scene.input, camera, scene.settings);
+      AtomicFile file(f);
+      write_all_bytes(file.temp_path(), json.data(), json.size(), f);
+      file.commit();
+      continue;
+    }
+    if (scene.map && render::is_geotiff_path(f)) {
+      render::write_map_geotiff(image, scene.display, geo, f);
+      continue;
+    }
+    render::write_image(image, f, scene.display);
+    if (scene.map && f.extension() == ".png") render::write_map_png_sidecars(f, geo);
+  }
 }
 
 void print_summary(const SceneFile& scene, const render::Image& image,
@@ -215,7 +336,13 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   check_outputs(o, scene);
   std::vector<std::filesystem::path> inputs = scene_inputs(scene);
   inputs.emplace_back(o.scene);
-  OutputSet outputs(scene.outputs, inputs);
+  std::vector<std::filesystem::path> written = scene.outputs;
+  if (scene.map) {  // a map PNG's world file and .aux.xml are written with it
+    for (const auto& f : scene.outputs)
+      if (f.extension() == ".png")
+        for (const auto& side : render::map_png_sidecars(f)) written.push_back(side);
+  }
+  OutputSet outputs(written, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
   const render::TerrainScene embree_scene(scene.input);
@@ -236,7 +363,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       {"white_balance",
        scene.display.white_balance == render::kDaylightWhiteBalance ? "daylight" : "none"},
       {"scene", scene_identity(o, scene)}};
-  for (const auto& f : scene.outputs) render::write_image(image, f, scene.display);
+  write_outputs(scene, image, embree_scene, camera);
   outputs.commit();
   print_summary(scene, image, stats, seconds);
   print_exposure(image, scene.display, o.tile.empty());
@@ -292,6 +419,28 @@ void add_render_command(CLI::App& root) {
   sub->add_option("--exposure-compensation", o->compensation_ev,
                   "EV added to the metered exposure (overrides [output] exposure_compensation)")
       ->check(CLI::Range(-render::DisplayTransform::kMaxEv, render::DisplayTransform::kMaxEv));
+  sub->add_option("--time", o->time,
+                  "render the camera path ([[camera.keyframe]] or --camera-path) at this time, "
+                  "seconds (default: its first key)");
+  sub->add_option("--camera-path", o->camera_path,
+                  "a TOML file of [[camera.keyframe]] entries (time, from/from_lonlat, "
+                  "to/to_lonlat, fov) replacing the scene's camera");
+  sub->add_flag("--sidecar", o->sidecar,
+                "also write the frame's ground truth as JSON beside the first image output "
+                "(NAME.json: size, intrinsics, pose, sun, CRS, Cryptomatte IDs); -o NAME.json "
+                "names it");
+  sub->add_option("--from", o->from, "where the camera stands, X,Y,Z in the DEM's CRS (with --to)");
+  sub->add_option("--to", o->to, "where the camera looks, X,Y,Z in the DEM's CRS (with --from)");
+  sub->add_flag("--map", o->map,
+                "render a map: straight down over the DEM (or --map-box) at --cell metres a "
+                "pixel, georeferenced (.tif GeoTIFF; .png with a world file and .aux.xml)");
+  sub->add_option("--map-box", o->map_box,
+                  "the map's box WEST,SOUTH,EAST,NORTH in the DEM's CRS (implies --map; default "
+                  "the DEM's extent)");
+  sub->add_option("--cell", o->cell,
+                  "the map's cell size in metres (implies --map; default the "
+                  "DEM's)")
+      ->check(CLI::Range(1e-3, 1e6));
   add_seed_option(*sub, o->seed);
 }
 

@@ -110,11 +110,25 @@ void require_material(const Section& s, const render::MaterialOverride& m) {
   }
 }
 
-// The coverage channel of a rule or layer (render/coverage.h): `name`, else
-// its preset's name, else `fallback`.
-std::string coverage_name(Section& s, const std::string& preset, const std::string& fallback) {
+// The coverage channel of a rule or layer (render/coverage.h), which the
+// CryptoMaterial matte names too: `name`, else its preset's name, else the
+// fields it sets ("wetness", "color_roughness"), never its index: a name
+// says what the mask is in a compositor. `fallback` only for what sets
+// none of them (detail alone).
+std::string coverage_name(Section& s, const std::string& preset, const render::MaterialOverride& m,
+                          const std::string& fallback) {
   const auto name = s.string("name");
-  if (!name) return preset.empty() ? fallback : preset;
+  if (!name) {
+    if (!preset.empty()) return preset;
+    std::string fields;
+    auto add = [&](bool set, const char* field) {
+      if (set) fields.append(fields.empty() ? "" : "_").append(field);
+    };
+    add(m.albedo.has_value(), "color");
+    add(m.roughness.has_value(), "roughness");
+    add(m.wetness.has_value(), "wetness");
+    return fields.empty() ? fallback : fields;
+  }
   static const std::regex word("[A-Za-z0-9_-]{1,32}");
   if (!std::regex_match(*name, word)) {
     s.invalid("name", "is '" + *name + "'; use 1-32 letters, digits, '_' or '-' (it names the " +
@@ -145,7 +159,7 @@ render::MaterialRule read_rule(const toml::table* table, const fs::path& file, s
   render::MaterialRule rule;
   std::string preset;
   rule.material = read_material(s, preset);
-  rule.name = coverage_name(s, preset, "rule" + std::to_string(index + 1));
+  rule.name = coverage_name(s, preset, rule.material, "rule" + std::to_string(index + 1));
   rule.altitude = read_range(s, "altitude", -1e4, 1e5, 100.0);
   rule.slope = read_range(s, "slope", 0.0, 90.0, 5.0);
   rule.position = read_range(s, "position", -5000.0, 5000.0, 10.0);
@@ -168,7 +182,7 @@ render::MaterialLayer read_layer(const toml::table* table, const fs::path& file,
   const auto mask_file = s.string("mask");
   std::string preset;
   layer.material = read_material(s, preset);
-  layer.name = coverage_name(s, preset, "layer" + std::to_string(index + 1));
+  layer.name = coverage_name(s, preset, layer.material, "layer" + std::to_string(index + 1));
   layer.opacity = static_cast<float>(s.number("opacity", 1.0, 0.0, 1.0));
   // Snow shows a partial mask as flakes, as snow cover does (render/surface.h).
   layer.flakes = s.boolean("flakes", preset == "snow");
@@ -362,6 +376,35 @@ void read_lens(Section& cam, render::Camera& camera) {
     cam.invalid("focus_distance", "must be 0 (automatic) or at least 0.001 m");
 }
 
+// [[camera.keyframe]] entries, in increasing time; `fov` defaults to the
+// camera's.
+std::vector<KeyframeSpec> read_keyframes(Section& cam, const fs::path& path, double fov) {
+  std::vector<KeyframeSpec> keys;
+  for (const toml::table* table : cam.tables("keyframe")) {
+    Section k(table, "camera.keyframe", path);
+    KeyframeSpec key;
+    if (!k.has("time")) k.invalid_table("needs 'time' (seconds along the path)");
+    key.time = k.number("time", 0.0, -1e9, 1e9);
+    key.from = k.vector<3>("from", -1e8, 1e8);
+    key.to = k.vector<3>("to", -1e8, 1e8);
+    const auto from_ll = k.vector<2>("from_lonlat", -180.0, 180.0);
+    const auto to_ll = k.vector<2>("to_lonlat", -180.0, 180.0);
+    const double from_height = k.number("from_height", 2.0, -1e4, 1e6);
+    const double to_height = k.number("to_height", 0.0, -1e4, 1e6);
+    key.fov_deg = k.number("fov", fov, 0.1, 179.0);
+    k.finish();
+    if (from_ll) key.from_lonlat = GeoPoint{(*from_ll)[0], (*from_ll)[1], from_height};
+    if (to_ll) key.to_lonlat = GeoPoint{(*to_ll)[0], (*to_ll)[1], to_height};
+    if (!!key.from == !!key.from_lonlat || !!key.to == !!key.to_lonlat)
+      k.invalid_table("needs one of 'from' / 'from_lonlat' and one of 'to' / 'to_lonlat'");
+    if (!keys.empty() && !(key.time > keys.back().time))
+      k.invalid("time", "must be later than the keyframe before's (" +
+                            std::to_string(keys.back().time) + ")");
+    keys.push_back(key);
+  }
+  return keys;
+}
+
 // [camera]: where it stands and looks (CRS points, or lon/lat placed on the
 // DEM by load_scene_terrain) and its lens.
 void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene) {
@@ -369,6 +412,14 @@ void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene
   if (!cam_table) return;
   Section cam(cam_table, "camera", path);
   render::Camera camera;
+  const std::string projection = cam.string("projection").value_or("perspective");
+  if (projection != "perspective" && projection != "map") {
+    cam.invalid("projection", "is '" + projection +
+                                  "'; use \"perspective\" (a view) or \"map\" (straight down, "
+                                  "georeferenced)");
+  }
+  const auto box = cam.vector<4>("map_box", -1e8, 1e8);
+  const double cell = cam.number("cell", 0.0, 0.0, 1e6);
   const auto from = cam.vector<3>("from", -1e8, 1e8);
   const auto to = cam.vector<3>("to", -1e8, 1e8);
   const auto from_lonlat = cam.vector<2>("from_lonlat", -180.0, 180.0);
@@ -376,7 +427,27 @@ void read_camera(const toml::table& root, const fs::path& path, SceneFile& scene
   const double from_height = cam.number("from_height", 2.0, -1e4, 1e6);
   const double to_height = cam.number("to_height", 0.0, -1e4, 1e6);
   read_lens(cam, camera);
+  scene.keyframes = read_keyframes(cam, path, camera.vertical_fov_deg);
   cam.finish();
+  if (!scene.keyframes.empty()) {
+    if (projection == "map" || from || to || from_lonlat || to_lonlat)
+      cam.invalid_table("has keyframes: give the camera's ends in them, not 'from'/'to'");
+    scene.input.camera = camera;  // the lens; placed by load_scene_terrain
+    return;
+  }
+  if (projection == "map") {
+    if (from || to || from_lonlat || to_lonlat)
+      cam.invalid_table("is a map (straight down): give 'map_box' and 'cell', not 'from'/'to'");
+    if (box && (!((*box)[2] > (*box)[0]) || !((*box)[3] > (*box)[1])))
+      cam.invalid("map_box", "must be [west, south, east, north] with east > west, north > south");
+    scene.map = MapRequest{
+        box ? std::optional(std::array<double, 4>{(*box)[0], (*box)[1], (*box)[2], (*box)[3]})
+            : std::nullopt,
+        cell};
+    return;
+  }
+  if (box || cell > 0.0)
+    cam.invalid_table("gives 'map_box' or 'cell' without projection = \"map\"");
   if (from_lonlat && std::fabs((*from_lonlat)[1]) > 90.0)
     cam.invalid("from_lonlat", "has a latitude off the globe; latitudes lie in [-90, 90]");
   if (to_lonlat && std::fabs((*to_lonlat)[1]) > 90.0)
@@ -436,22 +507,35 @@ void read_output(const toml::table& root, const fs::path& path, SceneFile& scene
   out.finish();
 }
 
+// [[objects]] name: the object's matte (render/mattes.h); empty: "object<N>".
+std::string read_object_name(Section& s) {
+  const auto name = s.string("name");
+  if (!name) return {};
+  static const std::regex word("[A-Za-z0-9_.-]{1,64}");
+  if (!std::regex_match(*name, word))
+    s.invalid("name", "is '" + *name + "'; use 1-64 letters, digits, '_', '.' or '-'");
+  return *name;
+}
+
 // A scene's [[objects]]: the shared keys (pipeline/object_list.h) and
 // `material`, a preset (render/material.h) whose albedo `color` overrides.
 std::vector<terrain::PlacedMesh> read_objects_with_materials(const toml::table& root,
-                                                             const fs::path& path) {
+                                                             const fs::path& path,
+                                                             std::vector<std::string>& names) {
   struct Choice {
     std::string preset;
     bool color = false;
+    std::string name;
   };
   std::vector<Choice> chosen;
   std::vector<terrain::PlacedMesh> meshes = read_objects(root, path, [&](Section& s, std::size_t) {
-    chosen.push_back({read_preset_name(s), s.has("color")});
+    chosen.push_back({read_preset_name(s), s.has("color"), read_object_name(s)});
   });
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     meshes[i].material = chosen[i].preset;
     if (!chosen[i].preset.empty() && !chosen[i].color)
       meshes[i].albedo = render::material_preset(chosen[i].preset)->albedo;
+    names.push_back(chosen[i].name);
   }
   return meshes;
 }
@@ -469,7 +553,7 @@ SceneFile read_scene_file(const fs::path& path, const SceneVariables& variables)
   read_sky(root, path, scene.input.sky);
   read_clouds(root, path, scene.input);
   read_camera(root, path, scene);
-  scene.input.meshes = read_objects_with_materials(root, path);
+  scene.input.meshes = read_objects_with_materials(root, path, scene.input.object_names);
   if (objects_file) {
     for (auto& placed : read_objects_file(*objects_file))
       scene.input.meshes.push_back(std::move(placed));
@@ -505,9 +589,9 @@ void place_sun(SceneFile& scene) {
 
 // Turns the camera's lon/lat ends into CRS points at their height above the
 // (exaggerated) ground, which must be inside the DEM.
-void place_lonlat_camera(SceneFile& scene) {
+Eigen::Vector3d place_geo_point(const SceneFile& scene, const GeoPoint& p, const char* key) {
   const terrain::HeightField& dem = scene.input.terrain;
-  auto place = [&](const GeoPoint& p, const char* key) {
+  {
     const auto xy = terrain::from_lonlat(dem.geo().crs_wkt, p.lon, p.lat);
     const float ground = render::sample_raster(dem, xy[0], xy[1], NAN);
     if (std::isnan(ground)) {
@@ -518,7 +602,11 @@ void place_lonlat_camera(SceneFile& scene) {
     }
     return Eigen::Vector3d(xy[0], xy[1],
                            ground * scene.input.vertical_exaggeration + p.above_ground);
-  };
+  }
+}
+
+void place_lonlat_camera(SceneFile& scene) {
+  auto place = [&](const GeoPoint& p, const char* key) { return place_geo_point(scene, p, key); };
   if (scene.camera_from_lonlat)
     scene.input.camera->from = place(*scene.camera_from_lonlat, "from_lonlat");
   if (scene.camera_to_lonlat) scene.input.camera->to = place(*scene.camera_to_lonlat, "to_lonlat");
@@ -533,13 +621,63 @@ bool uses_position(const render::TerrainSurface& surface) {
 
 }  // namespace
 
+// The camera on its path at the scene's time (its first key's by default).
+void place_camera_path(SceneFile& scene) {
+  std::vector<render::CameraKey> keys;
+  for (const KeyframeSpec& k : scene.keyframes) {
+    render::CameraKey key;
+    key.time = k.time;
+    key.from = k.from ? *k.from : place_geo_point(scene, *k.from_lonlat, "keyframe from_lonlat");
+    key.to = k.to ? *k.to : place_geo_point(scene, *k.to_lonlat, "keyframe to_lonlat");
+    key.fov_deg = k.fov_deg;
+    keys.push_back(key);
+  }
+  scene.input.camera = render::camera_at(keys, scene.time.value_or(keys.front().time),
+                                         scene.input.camera.value_or(render::Camera{}));
+}
+
+// A map: the box (the DEM's extent by default) in whole cells from its
+// north-west corner, the camera straight down over it, and its geotransform.
+void place_map(SceneFile& scene) {
+  const terrain::HeightField& dem = scene.input.terrain;
+  const auto& gt = dem.geo().geotransform;
+  const double cell = scene.map->cell > 0.0 ? scene.map->cell : dem.geo().cell_size_x();
+  const std::array<double, 4> box = scene.map->box.value_or(std::array<double, 4>{
+      gt[0], gt[3] + gt[5] * dem.height(), gt[0] + gt[1] * dem.width(), gt[3]});
+  const double columns = std::round((box[2] - box[0]) / cell);
+  const double rows = std::round((box[3] - box[1]) / cell);
+  constexpr int kMax = render::RenderSettings::kMaxSide;
+  if (columns < 1 || rows < 1 || columns > kMax || rows > kMax) {
+    throw Error("the map of " + std::to_string(box[2] - box[0]) + " x " +
+                std::to_string(box[3] - box[1]) + " m at a cell of " + std::to_string(cell) +
+                " m would be " + std::to_string(columns) + " x " + std::to_string(rows) +
+                " pixels; give a cell (--cell or [camera] cell) that makes 1.." +
+                std::to_string(kMax) + " a side");
+  }
+  scene.settings.width = static_cast<int>(columns);
+  scene.settings.height = static_cast<int>(rows);
+  render::Camera camera;
+  camera.projection = render::Projection::Map;
+  // Whole cells from the north-west corner: the east and south edges move
+  // by under half a cell when the box is not a multiple of it.
+  camera.map_box = {box[0], box[3] - rows * cell, box[0] + columns * cell, box[3]};
+  scene.input.camera = camera;
+  scene.map_geotransform = {box[0], cell, 0.0, box[3], 0.0, -cell};
+}
+
 void load_scene_terrain(SceneFile& scene) {
   render::TerrainSurface& surface = scene.input.surface;
   scene.input.terrain = read_metric_raster(scene.terrain_raster);
   if (scene.terrain_repeat > 1) {
     scene.input.terrain = terrain::repeat_periodic(scene.input.terrain, scene.terrain_repeat);
   }
-  place_lonlat_camera(scene);
+  if (!scene.keyframes.empty()) {
+    place_camera_path(scene);
+  } else if (scene.map) {
+    place_map(scene);
+  } else {
+    place_lonlat_camera(scene);
+  }
   if (scene.sun_time) place_sun(scene);
   if (!scene.albedo_map.empty()) {
     surface.albedo_map = render::read_albedo_map(scene.albedo_map);
@@ -552,6 +690,25 @@ void load_scene_terrain(SceneFile& scene) {
   if (uses_position(surface))
     surface.position = render::topographic_position(scene.input.terrain, scene.position_radius);
   for (const auto& [section, load] : scene.product_loaders) load(scene);
+}
+
+void read_camera_path(const fs::path& path, SceneFile& scene) {
+  const toml::table root = parse_toml_file(path, "camera path");
+  for (const auto& [k, node] : root) {
+    if (k.str() != "camera")
+      throw Error(path.string() + ":" + std::to_string(node.source().begin.line) +
+                  ": unknown section '" + std::string(k.str()) +
+                  "' (a camera path holds only [[camera.keyframe]] entries)");
+  }
+  Section cam(subtable(root, "camera", path), "camera", path);
+  const double fov = scene.input.camera ? scene.input.camera->vertical_fov_deg : 40.0;
+  scene.keyframes = read_keyframes(cam, path, fov);
+  cam.finish();
+  if (scene.keyframes.empty())
+    throw Error(path.string() + ": no [[camera.keyframe]] entries; give at least one");
+  scene.map.reset();
+  scene.camera_from_lonlat.reset();
+  scene.camera_to_lonlat.reset();
 }
 
 std::vector<fs::path> scene_inputs(const SceneFile& scene) {

@@ -3,6 +3,8 @@
 // key, the file and the line. See docs/rendering.md for every key.
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -22,6 +24,24 @@ namespace drift::pipeline {
 struct GeoPoint {
   double lon = 0.0, lat = 0.0;  // degrees, WGS 84
   double above_ground = 0.0;    // metres
+};
+
+// One [[camera.keyframe]]: its time and camera ends (CRS points, or lon/lat
+// placed on the DEM by load_scene_terrain) and field of view.
+struct KeyframeSpec {
+  double time = 0.0;
+  std::optional<Eigen::Vector3d> from, to;
+  std::optional<GeoPoint> from_lonlat, to_lonlat;
+  double fov_deg = 40.0;
+};
+
+// A map render ([camera] projection = "map", or drift render --map): straight
+// down over `box` (west, south, east, north in the DEM's CRS; none: the
+// DEM's extent) at `cell` metres a pixel (0: the DEM's cell), placed by
+// load_scene_terrain.
+struct MapRequest {
+  std::optional<std::array<double, 4>> box;
+  double cell = 0.0;
 };
 
 struct SceneFile {
@@ -47,6 +67,15 @@ struct SceneFile {
   // [sun] date/time/timezone: the sun over the DEM's centre, placed by
   // load_scene_terrain.
   std::optional<render::LocalTime> sun_time;
+  // A camera path ([[camera.keyframe]], render/camera.h: camera_at) and the
+  // time to render it at (drift render --time; default its first key's),
+  // resolved into input.camera by load_scene_terrain.
+  std::vector<KeyframeSpec> keyframes;
+  std::optional<double> time;
+  // A map render: resolved by load_scene_terrain into input.camera, the
+  // size in `settings` and `map_geotransform` (GDAL's, of the frame).
+  std::optional<MapRequest> map;
+  std::array<double, 6> map_geotransform{0, 1, 0, 0, 0, -1};
   render::SceneInput input;  // terrain not loaded yet (see load_scene_terrain)
   render::RenderSettings settings;
   std::vector<std::filesystem::path> outputs;  // resolved against the current directory
@@ -70,6 +99,11 @@ SceneFile read_scene_file(const std::filesystem::path& path, const SceneVariable
 // Every file the scene reads (rasters, masks, product files), for refusing
 // them as outputs.
 std::vector<std::filesystem::path> scene_inputs(const SceneFile& scene);
+
+// Replaces the scene's camera path with the [[camera.keyframe]] entries of
+// the TOML file `path` (drift render --camera-path): one path for many
+// scenes, or many paths for one.
+void read_camera_path(const std::filesystem::path& path, SceneFile& scene);
 
 // Reads the scene's terrain raster and layer rasters; a geographic (degree)
 // raster is an error telling the user to run `drift import` first.

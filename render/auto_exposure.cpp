@@ -74,7 +74,8 @@ Metering meter_exposure(const Image& linear, const std::array<float, 3>& white_b
   if (r < 0 || g < 0 || b < 0) throw Error("cannot meter an image without R, G, B channels");
   const int ar = linear.channel_index("albedo.R"), ag = linear.channel_index("albedo.G"),
             ab = linear.channel_index("albedo.B"), sky = linear.channel_index("mask.sky"),
-            depth = linear.channel_index("depth");
+            depth = linear.channel_index("Z") >= 0 ? linear.channel_index("Z")
+                                                   : linear.channel_index("depth");
   const bool has_aovs = ar >= 0 && ag >= 0 && ab >= 0 && sky >= 0;
   // log(light) and weight per metered pixel, incident (ground) and reflected (all).
   std::vector<std::pair<double, double>> reflected;

@@ -3,6 +3,7 @@
 // channels ("depth", "normal.X", "albedo.R", ...), as EXR names them.
 #pragma once
 
+#include <array>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -25,6 +26,12 @@ struct Image {
   // Named text attributes kept in EXR files as "drift:NAME" (e.g. the display
   // settings a tile was rendered with, so `drift merge` can write the PNG).
   std::vector<std::pair<std::string, std::string>> attributes;
+  // Header attributes under their own names, for other tools: texts
+  // (Cryptomatte's manifest, the CRS), 4x4 matrices as OpenEXR's m44f
+  // (worldToCamera; row-major, row vectors) and 3-vectors as v3f.
+  std::vector<std::pair<std::string, std::string>> header_texts;
+  std::vector<std::pair<std::string, std::array<float, 16>>> header_matrices;
+  std::vector<std::pair<std::string, std::array<float, 3>>> header_vectors;
   const std::string* attribute(std::string_view name) const {
     for (const auto& [k, v] : attributes)
       if (k == name) return &v;

@@ -11,6 +11,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <vector>
@@ -62,6 +63,14 @@ void write_with_oiio(const std::filesystem::path& target, const std::filesystem:
   write_all_bytes(temp, encoded.data(), encoded.size(), target);
 }
 
+// The header attributes drift writes under their own names and keeps on
+// reading (so `drift merge` passes them on): OpenEXR's camera matrices, the
+// georeference, Cryptomatte's metadata.
+bool is_header_attribute(const std::string& name) {
+  return name == "worldToCamera" || name == "worldToNDC" || name == "worldOrigin" ||
+         name == "crsWKT" || name.rfind("cryptomatte/", 0) == 0;
+}
+
 // Linear data as stored, channel names kept (EXR names AOVs "albedo.R" etc.),
 // with the data window and drift's own attributes.
 Image linear_image(const OIIO::ImageSpec& spec, std::vector<float> raw) {
@@ -83,6 +92,17 @@ Image linear_image(const OIIO::ImageSpec& spec, std::vector<float> raw) {
     const std::string name = p.name().string();
     if (name.rfind("drift:", 0) == 0 && p.type() == OIIO::TypeDesc::STRING) {
       image.attributes.emplace_back(name.substr(6), p.get_string());
+    } else if (is_header_attribute(name) && p.type() == OIIO::TypeDesc::STRING) {
+      image.header_texts.emplace_back(name, p.get_string());
+    } else if (is_header_attribute(name) && p.type() == OIIO::TypeMatrix44) {
+      std::array<float, 16> m{};
+      std::memcpy(m.data(), p.data(), sizeof m);
+      image.header_matrices.emplace_back(name, m);
+    } else if (is_header_attribute(name) && p.type().basetype == OIIO::TypeDesc::FLOAT &&
+               p.type().aggregate == OIIO::TypeDesc::VEC3) {
+      std::array<float, 3> v{};
+      std::memcpy(v.data(), p.data(), sizeof v);
+      image.header_vectors.emplace_back(name, v);
     }
   }
   return image;
@@ -277,6 +297,11 @@ void write_exr(const Image& image, const std::filesystem::path& path) {
     spec.full_height = image.frame.full_height;
   }
   for (const auto& [name, value] : image.attributes) spec.attribute("drift:" + name, value);
+  for (const auto& [name, value] : image.header_texts) spec.attribute(name, value);
+  for (const auto& [name, m] : image.header_matrices)
+    spec.attribute(name, OIIO::TypeMatrix44, m.data());
+  for (const auto& [name, v] : image.header_vectors)
+    spec.attribute(name, OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::VEC3), v.data());
   // No creation date: OpenImageIO stamps the current time into capDate when
   // none is given, and two runs of one scene would differ in their bits
   // (same inputs and seed, same output). The file's time says when.
@@ -341,6 +366,11 @@ void write_png(const Image& linear, const std::filesystem::path& path,
   spec.attribute("oiio:ColorSpace", "sRGB");
   write_with_oiio(path, file.temp_path(), spec, OIIO::TypeDesc::UINT8, bytes.data());
   file.commit();
+}
+
+std::vector<std::uint8_t> display_pixels(const Image& linear, const DisplayTransform& display,
+                                         const std::filesystem::path& path) {
+  return to_srgb8(linear, resolve_exposure(linear, display), path);
 }
 
 void write_image(const Image& image, const std::filesystem::path& path,

@@ -2,7 +2,9 @@
 // (display-referred 8-bit sRGB, tone-mapped from linear radiance).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include "render/image.h"
 #include "render/tonemap.h"
@@ -26,6 +28,11 @@ void write_png(const Image& linear, const std::filesystem::path& path,
 // its exposure_ev added to the meter's, and the tone curve's middle_grey_ev
 // (render/tonemap.h), when auto_exposure is on.
 DisplayTransform resolve_exposure(const Image& linear, const DisplayTransform& display);
+
+// The 8-bit sRGB bytes (R, G, B interleaved) write_png would write, for
+// other writers (render/map_output.h); `path` names the target in errors.
+std::vector<std::uint8_t> display_pixels(const Image& linear, const DisplayTransform& display,
+                                         const std::filesystem::path& path);
 
 // Chooses by extension: .exr or .png (case-insensitive); anything else is an
 // error naming the path and the extensions allowed.

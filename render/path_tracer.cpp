@@ -14,6 +14,7 @@ namespace drift::render {
 namespace {
 
 using Eigen::Vector3f;
+constexpr float kPi = std::numbers::pi_v<float>;
 
 float ray_epsilon(const Vector3f& p) { return 1e-4f * (1.0f + p.cwiseAbs().maxCoeff()); }
 
@@ -34,9 +35,23 @@ constexpr int kSkySampledVertices = 1;
 
 }  // namespace
 
+Vector3f sky_radiance(const Sky& sky, const Vector3f& dir) {
+  if (sky.constant) return Vector3f::Constant(sky.intensity);
+  if (dir.z() < 0.0f) return sky.horizon * (sky.intensity * sky.ground_factor);
+  // A smooth rise from the pale horizon to the deep zenith, flat at the horizon
+  // so there is no visible seam with the below-horizon haze.
+  const float e = std::clamp(dir.z() / 0.7f, 0.0f, 1.0f);
+  const float t = 0.5f - 0.5f * std::cos(kPi * e);
+  return (sky.horizon * (1.0f - t) + sky.zenith * t) * sky.intensity;
+}
+
 PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const CameraRays& camera,
                        const RenderSettings& settings)
-    : scene_(scene), input_(input), camera_(camera), settings_(settings) {
+    : scene_(scene),
+      input_(input),
+      camera_(camera),
+      settings_(settings),
+      objects_(input.meshes, scene.origin()) {
   const Sun& sun = input.sun;
   sun_dir_ = terrain::direction_from_az_el(sun.azimuth_deg, sun.elevation_deg).cast<float>();
   sun_cos_max_ = static_cast<float>(std::cos(sun.angular_diameter_deg * std::numbers::pi / 360.0));
@@ -191,7 +206,7 @@ PathTracer::Path PathTracer::camera_path(int px, int py, SampleStream& rng) cons
     rng.skip();
   }
   // Camera rays start as wide as a pixel's angle; see RayCone.
-  path.cone = {0.0f, 2.0f * camera_.tan_half / static_cast<float>(settings_.height)};
+  path.cone = {camera_.footprint_width(), camera_.footprint_spread()};
   return path;
 }
 
@@ -212,7 +227,10 @@ PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& 
     if (air_) cross_air(path, hit, depth, out, rays);
     if (depth == settings_.max_depth) break;
     if (depth == 0) {
-      out.depth = hit.distance;
+      out.hit = true;
+      out.depth = camera_.view_depth(hit.position);
+      out.position = hit.position;
+      out.object = 1 + objects_.object_at(path.origin, path.dir, hit.distance);
       out.normal = hit.normal;
       out.albedo = hit.material.albedo;
       out.coverage = hit.coverage;

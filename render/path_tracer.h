@@ -14,21 +14,29 @@
 
 #include "render/atmosphere.h"
 #include "render/bsdf.h"
+#include "render/camera.h"
 #include "render/clouds.h"
 #include "render/light_shafts.h"
+#include "render/object_ids.h"
 #include "render/physical_sky.h"
 #include "render/random.h"
 #include "render/render_settings.h"
-#include "render/renderer.h"
 #include "render/sky_sampler.h"
 #include "render/terrain_scene.h"
 
 namespace drift::render {
 
+// Radiance of the simple sky in direction `dir` (unit, world z up); the sun's
+// disc is not included (the sun is sampled explicitly).
+Eigen::Vector3f sky_radiance(const Sky& sky, const Eigen::Vector3f& dir);
+
 // What one camera sample brings back: radiance and the first hit's AOVs.
 struct PixelSample {
   Eigen::Vector3f radiance{0, 0, 0};
-  float depth = 0.0f;
+  bool hit = false;                   // the camera ray met something
+  float depth = 0.0f;                 // along the view axis (the EXR's Z)
+  Eigen::Vector3f position{0, 0, 0};  // the hit, local frame
+  int object = -1;                    // -1 sky, 0 terrain, k + 1 object k (render/mattes.h)
   Eigen::Vector3f normal{0, 0, 0};
   Eigen::Vector3f albedo{0, 0, 0};
   Coverage coverage{};  // by TerrainScene::coverage_names()
@@ -90,6 +98,7 @@ class PathTracer {
   const SceneInput& input_;
   const CameraRays& camera_;
   const RenderSettings& settings_;
+  ObjectLocator objects_;  // which object a camera ray's first hit is on
   Eigen::Vector3f sun_dir_;
   float sun_cos_max_ = 1.0f;
   Eigen::Vector3f sun_irradiance_;

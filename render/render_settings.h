@@ -5,8 +5,10 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "render/camera.h"
 #include "render/clouds.h"
 #include "render/surface.h"
 #include "render/surround.h"
@@ -46,21 +48,6 @@ struct Sky {
   int shaft_steps = 16;
 };
 
-struct Camera {
-  Eigen::Vector3d from{0, 0, 0};  // world metres (x east, y north, z up)
-  Eigen::Vector3d to{0, 1, 0};
-  double vertical_fov_deg = 40.0;  // (0, 180)
-  // A real lens instead of a field of view: the focal length gives the
-  // horizontal field of view over the sensor's width (36 mm: full frame).
-  std::optional<double> focal_length_mm;
-  double sensor_width_mm = 36.0;
-  // Depth of field: a thin lens of aperture diameter focal length / f_number,
-  // sharp at focus_distance metres (default: the distance from `from` to
-  // `to`). f_number 0 keeps a pinhole. Needs focal_length_mm.
-  double f_number = 0.0;
-  std::optional<double> focus_distance;
-};
-
 struct RenderSettings {
   // The ranges the scene file and the command line both hold the settings to.
   static constexpr int kMaxSide = 16384;               // width and height, pixels
@@ -97,6 +84,9 @@ struct SceneInput {
   // Objects, each an attributed mesh (terrain/products.h) placed in the scene:
   // a kSnowCoverage attribute puts the snow material on it.
   std::vector<terrain::PlacedMesh> meshes;
+  // Their names for the object mattes (render/mattes.h), by index; missing
+  // or empty: "object<N>".
+  std::vector<std::string> object_names;
   Sun sun;
   Sky sky;
   CloudOptions clouds;           // a cloud layer (render/clouds.h); physical sky only

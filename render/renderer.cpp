@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "render/color.h"
+#include "render/mattes.h"
 #include "render/path_tracer.h"
 #include "render/random.h"
 #include "terrain/error.h"
@@ -24,7 +25,6 @@ namespace drift::render {
 namespace {
 
 using Eigen::Vector3f;
-constexpr float kPi = std::numbers::pi_v<float>;
 
 // Running mean and variance of a pixel's sample luminances (Welford 1962),
 // for adaptive sampling.
@@ -49,85 +49,6 @@ struct PixelNoise {
 
 }  // namespace
 
-Vector3f sky_radiance(const Sky& sky, const Vector3f& dir) {
-  if (sky.constant) return Vector3f::Constant(sky.intensity);
-  if (dir.z() < 0.0f) return sky.horizon * (sky.intensity * sky.ground_factor);
-  // A smooth rise from the pale horizon to the deep zenith, flat at the horizon
-  // so there is no visible seam with the below-horizon haze.
-  const float e = std::clamp(dir.z() / 0.7f, 0.0f, 1.0f);
-  const float t = 0.5f - 0.5f * std::cos(kPi * e);
-  return (sky.horizon * (1.0f - t) + sky.zenith * t) * sky.intensity;
-}
-
-Camera default_camera(const TerrainScene& scene) {
-  // Stand on the far side of the DEM's centre from its highest point, above the
-  // terrain, and look at the summit across the whole DEM. A summit at the very
-  // centre is looked at from the south.
-  const Vector3f top = scene.highest_point();
-  Eigen::Vector2f away = -top.head<2>();
-  if (away.norm() < 1e-3f * scene.extent().norm()) away = {0.0f, -1.0f};
-  away.normalize();
-  const float half = 0.5f * scene.extent().minCoeff();
-  const Eigen::Vector2f xy = away * (0.9f * half);
-  // Slightly above the summit, so ridges between camera and peak do not hide it.
-  const float z = std::max(scene.height_at(xy.x(), xy.y()), top.z()) + 0.12f * half;
-  const Eigen::Vector3d origin = scene.origin();
-  Camera camera;
-  camera.from = origin + Eigen::Vector3d(xy.x(), xy.y(), z);
-  // Aim a little below the summit: the peak sits in the upper part of the frame
-  // and the slopes in front fill the rest.
-  camera.to = origin + top.cast<double>() - Eigen::Vector3d(0, 0, 0.25 * half);
-  camera.vertical_fov_deg = 45.0;
-  return camera;
-}
-
-CameraRays make_camera_rays(const TerrainScene& scene, const Camera& camera, int width,
-                            int height) {
-  CameraRays p;
-  p.eye = scene.to_local(camera.from);
-  p.forward = scene.to_local(camera.to) - p.eye;
-  if (!(p.forward.norm() > 0.0f)) throw Error("camera 'from' and 'to' are the same point");
-  p.forward.normalize();
-  p.right = p.forward.cross(Vector3f::UnitZ());
-  if (p.right.norm() < 1e-6f) p.right = p.forward.cross(Vector3f::UnitY());
-  p.right.normalize();
-  p.up = p.right.cross(p.forward);
-  p.aspect = static_cast<float>(width) / static_cast<float>(height);
-  if (camera.focal_length_mm) {
-    // Horizontal half-width of the sensor over the focal length.
-    p.tan_half =
-        static_cast<float>(camera.sensor_width_mm / (2.0 * *camera.focal_length_mm)) / p.aspect;
-    if (camera.f_number > 0.0) {
-      p.lens_radius = static_cast<float>(*camera.focal_length_mm / 1000.0 / camera.f_number / 2.0);
-      p.focus_distance =
-          static_cast<float>(camera.focus_distance.value_or((camera.to - camera.from).norm()));
-    }
-  } else {
-    p.tan_half = static_cast<float>(std::tan(camera.vertical_fov_deg * std::numbers::pi / 360.0));
-  }
-  p.width = width;
-  p.height = height;
-  return p;
-}
-
-Vector3f CameraRays::direction(float x, float y) const {
-  const float sx = (2.0f * x / static_cast<float>(width) - 1.0f) * tan_half * aspect;
-  const float sy = (1.0f - 2.0f * y / static_cast<float>(height)) * tan_half;
-  return (forward + right * sx + up * sy).normalized();
-}
-
-void CameraRays::ray(float x, float y, float u1, float u2, Vector3f& origin, Vector3f& dir) const {
-  dir = direction(x, y);
-  origin = eye;
-  if (lens_radius <= 0.0f) return;
-  // Uniform point on the lens disc; the ray aims at where the pinhole ray
-  // crosses the focal plane (distance focus_distance along `forward`).
-  const float r = lens_radius * std::sqrt(u1), phi = 2.0f * kPi * u2;
-  const Vector3f focus = eye + dir * (focus_distance / dir.dot(forward));
-  origin = eye + right * (r * std::cos(phi)) + up * (r * std::sin(phi));
-  dir = (focus - origin).normalized();
-}
-
 namespace {
 
 void check_settings(const RenderSettings& settings, int row_begin, int row_end) {
@@ -143,36 +64,63 @@ void check_settings(const RenderSettings& settings, int row_begin, int row_end) 
   }
 }
 
+// What a render writes besides radiance: the first hit's AOVs under the
+// names compositors look for (Z, N, P) and the mattes.
+struct FrameLayout {
+  int coverage_count = 0;
+  bool adaptive = false;
+  const FrameMattes* mattes = nullptr;
+  Eigen::Vector3d local_to_world{0, 0, 0};  // P's frame: CRS less the header's worldOrigin
+};
+
 // The image's channels, in the order store_pixel writes them.
-std::vector<std::string> image_channels(const TerrainScene& scene, bool adaptive) {
-  std::vector<std::string> channels = {"R",        "G",        "B",        "depth",    "normal.X",
-                                       "normal.Y", "normal.Z", "albedo.R", "albedo.G", "albedo.B"};
+std::vector<std::string> image_channels(const TerrainScene& scene, const FrameLayout& layout) {
+  std::vector<std::string> channels = {"R",   "G",   "B",        "Z",        "N.X",
+                                       "N.Y", "N.Z", "albedo.R", "albedo.G", "albedo.B",
+                                       "P.X", "P.Y", "P.Z"};
   for (const std::string& name : scene.coverage_names()) channels.push_back("coverage." + name);
   channels.emplace_back("mask.sky");
-  if (adaptive) channels.emplace_back("samples");
+  if (layout.adaptive) channels.emplace_back("samples");
+  for (const CryptomatteLayer* layer : {&layout.mattes->material(), &layout.mattes->object()})
+    for (const std::string& c : layer->channels()) channels.push_back(c);
   return channels;
 }
 
-// The samples of one pixel: samples_per_pixel, or fewer once the noise target
-// is met. Returns their sum and sets `taken`.
-PixelSample sample_pixel(const PathTracer& tracer, const RenderSettings& settings, int x, int y,
-                         int coverage_count, int& taken, std::uint64_t& rays) {
+// A pixel's sums over its samples.
+struct PixelSums {
   PixelSample sum;
+  int hits = 0;                       // samples whose camera ray met something
+  Eigen::Vector3d position{0, 0, 0};  // of the hits, local frame
+  double depth = 0.0;                 // likewise
+  FrameMattes::Weights mattes;
+};
+
+// The samples of one pixel: samples_per_pixel, or fewer once the noise target
+// is met. Returns their sums and sets `taken`.
+PixelSums sample_pixel(const PathTracer& tracer, const RenderSettings& settings, int x, int y,
+                       const FrameLayout& layout, int& taken, std::uint64_t& rays) {
+  PixelSums sums;
+  PixelSample& sum = sums.sum;
+  sums.mattes = layout.mattes->weights();
   PixelNoise noise;
   const std::uint64_t pixel = static_cast<std::uint64_t>(y) * settings.width + x;
-  const bool adaptive = settings.noise_target > 0.0f;
   taken = 0;
   while (taken < settings.samples_per_pixel) {
     SampleStream rng(settings.seed, pixel, static_cast<std::uint64_t>(taken));
     const PixelSample one = tracer.trace(x, y, rng, rays);
     ++taken;
     sum.radiance += one.radiance;
-    sum.depth += one.depth;
     sum.normal += one.normal;
     sum.albedo += one.albedo;
-    for (int c = 0; c < coverage_count; ++c) sum.coverage[c] += one.coverage[c];
+    for (int c = 0; c < layout.coverage_count; ++c) sum.coverage[c] += one.coverage[c];
     sum.sky += one.sky;
-    if (adaptive) {
+    if (one.hit) {
+      ++sums.hits;
+      sums.depth += one.depth;
+      sums.position += one.position.cast<double>();
+    }
+    layout.mattes->add(sums.mattes, one.object, one.coverage);
+    if (layout.adaptive) {
       noise.add(luminance(one.radiance));
       // Decide every 8 samples: the estimate needs a few to settle, and the
       // decision only ever looks at this pixel's own samples, so the image
@@ -182,23 +130,51 @@ PixelSample sample_pixel(const PathTracer& tracer, const RenderSettings& setting
         break;
     }
   }
-  return sum;
+  return sums;
 }
 
+// Z where no sample met anything: far, as Blender writes its background.
+constexpr float kFarZ = 1e10f;
+
 // Writes the mean of `taken` samples into row `row` of the image, in the
-// order of image_channels().
-void store_pixel(Image& image, int x, int row, const PixelSample& sum, int taken,
-                 int coverage_count, bool adaptive) {
+// order of image_channels(). Z and P are means over the samples that hit
+// (an edge pixel's P lies on the ground, not between it and the sky).
+void store_pixel(Image& image, int x, int row, const PixelSums& sums, int taken,
+                 const FrameLayout& layout) {
+  const PixelSample& sum = sums.sum;
   const float inv = 1.0f / static_cast<float>(taken);
   int c = 0;
   auto put = [&](float v) { image.at(x, row, c++) = v; };
   for (int i = 0; i < 3; ++i) put(sum.radiance[i] * inv);
-  put(sum.depth * inv);
+  put(sums.hits ? static_cast<float>(sums.depth / sums.hits) : kFarZ);
   for (int i = 0; i < 3; ++i) put(sum.normal[i] * inv);
   for (int i = 0; i < 3; ++i) put(sum.albedo[i] * inv);
-  for (int i = 0; i < coverage_count; ++i) put(sum.coverage[i] * inv);
+  // P in double until it is relative to the header's origin: float32 then
+  // keeps a millimetre within 10 km of it.
+  const Eigen::Vector3d p = sums.hits
+                                ? Eigen::Vector3d(sums.position / sums.hits + layout.local_to_world)
+                                : Eigen::Vector3d::Zero();
+  for (int i = 0; i < 3; ++i) put(static_cast<float>(p[i]));
+  for (int i = 0; i < layout.coverage_count; ++i) put(sum.coverage[i] * inv);
   put(sum.sky * inv);
-  if (adaptive) put(static_cast<float>(taken));
+  if (layout.adaptive) put(static_cast<float>(taken));
+  layout.mattes->write(sums.mattes, taken, &image.at(x, row, c));
+}
+
+// The header: OpenEXR's camera matrices, the CRS and P's origin, the
+// mattes' metadata.
+void describe_frame(Image& image, const SceneInput& input, const CameraRays& camera,
+                    const FrameLayout& layout, const Eigen::Vector3d& world_origin) {
+  image.header_matrices = {{"worldToCamera", world_to_camera(camera, layout.local_to_world)},
+                           {"worldToNDC", world_to_ndc(camera, layout.local_to_world)}};
+  image.header_vectors = {
+      {"worldOrigin",
+       {static_cast<float>(world_origin.x()), static_cast<float>(world_origin.y()),
+        static_cast<float>(world_origin.z())}}};
+  if (!input.terrain.geo().crs_wkt.empty())
+    image.header_texts.emplace_back("crsWKT", input.terrain.geo().crs_wkt);
+  for (const CryptomatteLayer* layer : {&layout.mattes->material(), &layout.mattes->object()})
+    for (auto& entry : layer->header()) image.header_texts.push_back(std::move(entry));
 }
 
 }  // namespace
@@ -209,9 +185,16 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const int row_end = settings.row_end > 0 ? settings.row_end : settings.height;
   check_settings(settings, row_begin, row_end);
   const int band = row_end - row_begin;
-  const bool adaptive = settings.noise_target > 0.0f;
-  const int coverage_count = static_cast<int>(scene.coverage_names().size());
-  const std::vector<std::string> channels = image_channels(scene, adaptive);
+  const FrameMattes mattes(scene, input);
+  // P's origin: the scene's own (the DEM's centre) in whole metres, exact as
+  // the header's float32 vector (integers below 2^24: any UTM coordinate).
+  const Eigen::Vector3d world_origin = scene.origin().array().round().matrix();
+  FrameLayout layout;
+  layout.coverage_count = static_cast<int>(scene.coverage_names().size());
+  layout.adaptive = settings.noise_target > 0.0f;
+  layout.mattes = &mattes;
+  layout.local_to_world = scene.origin() - world_origin;
+  const std::vector<std::string> channels = image_channels(scene, layout);
   // The image and the film's per-pixel sums (about as much again).
   require_memory(
       static_cast<std::uint64_t>(settings.width) * band * channels.size() * sizeof(float) * 2,
@@ -223,6 +206,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
 
   const CameraRays camera_rays = make_camera_rays(scene, camera, settings.width, settings.height);
   const PathTracer tracer(scene, input, camera_rays, settings);
+  describe_frame(image, input, camera_rays, layout, world_origin);
 
   // Tiles of kTile x kTile pixels, in parallel; every pixel's samples are its
   // own, so the order does not matter.
@@ -241,10 +225,9 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
     for (int y = y0; y < std::min(y0 + kTile, row_end); ++y) {
       for (int x = x0; x < std::min(x0 + kTile, settings.width); ++x) {
         int taken = 0;
-        const PixelSample sum =
-            sample_pixel(tracer, settings, x, y, coverage_count, taken, tile_rays);
+        const PixelSums sums = sample_pixel(tracer, settings, x, y, layout, taken, tile_rays);
         tile_samples += static_cast<std::uint64_t>(taken);
-        store_pixel(image, x, y - row_begin, sum, taken, coverage_count, adaptive);
+        store_pixel(image, x, y - row_begin, sums, taken, layout);
       }
     }
     total_rays += tile_rays;

@@ -82,6 +82,9 @@ Image merge_tiles(const std::vector<Image>& tiles,
                  "merge fewer channels or a smaller frame");
   Image out(width, height, first.channels);
   out.attributes = first.attributes;
+  out.header_texts = first.header_texts;  // one render's: the same in every tile
+  out.header_matrices = first.header_matrices;
+  out.header_vectors = first.header_vectors;
   std::vector<int> owner(static_cast<std::size_t>(height), -1);
   const std::size_t row_floats = static_cast<std::size_t>(width) * first.channels.size();
   for (std::size_t i = 0; i < tiles.size(); ++i) {

@@ -495,10 +495,11 @@ TEST(SceneFile, ReadsMaterialRulesAndLayers) {
   EXPECT_FALSE(surface.layers[2].flakes);
   ASSERT_EQ(s.layer_masks.size(), 3u);
   EXPECT_EQ(s.layer_masks[0], p.parent_path() / "wet.tif");
-  // Coverage channels: the preset's name, else rule<N> / layer<N>, or `name`.
+  // Coverage channels: `name`, else the preset's name, else the fields the
+  // entry sets (never its index: the name is the matte's in a compositor).
   EXPECT_EQ(surface.ground_name, "rock");
   EXPECT_EQ(surface.rules[0].name, "grass");
-  EXPECT_EQ(surface.rules[1].name, "rule2");
+  EXPECT_EQ(surface.rules[1].name, "color");
   EXPECT_EQ(surface.layers[0].name, "puddles");
   EXPECT_NE(error_of(std::string(kTerrain) + "[[terrain.rule]]\nwetness = 1\nname = \"a b\"\n")
                 .find("terrain.rule.name"),

@@ -159,7 +159,7 @@ TEST(Surround, RaysHitItAndAovsReportGround) {
     camera.to = scene.origin() + Eigen::Vector3d(1000.0, 0, 0.0);
     camera.vertical_fov_deg = 2.0;
     const Image img = render_image(scene, in, camera, rs);
-    const int s = img.channel_index("mask.sky"), d = img.channel_index("depth");
+    const int s = img.channel_index("mask.sky"), d = img.channel_index("Z");
     sky = depth = 0.0f;
     for (int x = 0; x < 16; ++x) sky += img.at(x, 15, s) / 16, depth += img.at(x, 15, d) / 16;
   };
