@@ -229,16 +229,17 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
     }
   }
   if (o.tile.empty()) return;
-  std::pair<int, int> tile;
+  render::TileSpec tile;
   try {
-    tile = render::parse_tile(o.tile);
+    tile = render::parse_tile_spec(o.tile);
   } catch (const Error& e) {
     usage_error(std::string("--") + e.what());
   }
-  const auto [index, count] = tile;
-  const render::RowRange rows = render::tile_rows(scene.settings.height, index, count);
-  scene.settings.row_begin = rows.begin;
-  scene.settings.row_end = rows.end;
+  const render::TileRect rect = render::tile_rect(scene.settings.width, scene.settings.height, tile);
+  scene.settings.row_begin = rect.y.begin;
+  scene.settings.row_end = rect.y.end;
+  scene.settings.col_begin = rect.x.begin;
+  scene.settings.col_end = rect.x.end;
   for (const auto& f : scene.outputs) {
     if (f.extension() != ".exr" && f.extension() != ".json") {
       throw Error("a tile is written as EXR (it keeps its place in the frame); '" + f.string() +
@@ -345,7 +346,8 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   OutputSet outputs(written, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
-  const render::TerrainScene embree_scene(scene.input);
+  // The scene takes the DEM's storage for its heights: its cells are held once.
+  const render::TerrainScene embree_scene(scene.input, std::move(scene.input.terrain));
   const render::Camera camera =
       scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
   render::RenderStats stats;
@@ -405,8 +407,9 @@ void add_render_command(CLI::App& root) {
   sub->add_option("--terrain", o->terrain, "terrain raster (overrides [terrain] raster)");
   add_product_flags(*sub, *o);
   sub->add_option("--tile", o->tile,
-                  "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16) to EXR; "
-                  "join the bands with drift merge (docs/rendering.md)");
+                  "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16), or block "
+                  "INDEX/CxR of a grid of C columns and R rows (row by row, e.g. 5/4x4), to EXR; "
+                  "join the tiles with drift merge (docs/rendering.md)");
   sub->add_option("--sun-time", o->sun_time,
                   "put the sun where it stands over the DEM at this local time, "
                   "\"YYYY-MM-DD HH:MM[:SS] [UTC offset]\" (e.g. \"2026-10-15 17:05 +09:00\"; "

@@ -71,6 +71,9 @@ struct RenderSettings {
   // pixels are the same bits as in a whole-frame render. row_end 0: to the end.
   int row_begin = 0;
   int row_end = 0;
+  // Likewise columns [col_begin, col_end) (a block of a --tile i/CxR grid).
+  int col_begin = 0;
+  int col_end = 0;
 };
 
 struct SceneInput {

@@ -184,7 +184,12 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const int row_begin = settings.row_begin;
   const int row_end = settings.row_end > 0 ? settings.row_end : settings.height;
   check_settings(settings, row_begin, row_end);
-  const int band = row_end - row_begin;
+  const int col_begin = settings.col_begin;
+  const int col_end = settings.col_end > 0 ? settings.col_end : settings.width;
+  if (col_begin < 0 || col_begin >= col_end || col_end > settings.width)
+    throw Error("columns [" + std::to_string(col_begin) + ", " + std::to_string(col_end) +
+                ") are not inside the " + std::to_string(settings.width) + "-column frame");
+  const int band = row_end - row_begin, span = col_end - col_begin;
   const FrameMattes mattes(scene, input);
   // P's origin: the scene's own (the DEM's centre) in whole metres, exact as
   // the header's float32 vector (integers below 2^24: any UTM coordinate).
@@ -197,12 +202,13 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const std::vector<std::string> channels = image_channels(scene, layout);
   // The image and the film's per-pixel sums (about as much again).
   require_memory(
-      static_cast<std::uint64_t>(settings.width) * band * channels.size() * sizeof(float) * 2,
-      "a " + std::to_string(settings.width) + " x " + std::to_string(band) + " image of " +
+      static_cast<std::uint64_t>(span) * band * channels.size() * sizeof(float) * 2,
+      "a " + std::to_string(span) + " x " + std::to_string(band) + " image of " +
           std::to_string(channels.size()) + " channels",
       "render a smaller --size, or the frame in --tile bands joined by drift merge");
-  Image image(settings.width, band, channels);
-  if (band != settings.height) image.frame = {0, row_begin, settings.width, settings.height};
+  Image image(span, band, channels);
+  if (band != settings.height || span != settings.width)
+    image.frame = {col_begin, row_begin, settings.width, settings.height};
 
   const CameraRays camera_rays = make_camera_rays(scene, camera, settings.width, settings.height);
   const PathTracer tracer(scene, input, camera_rays, settings);
@@ -211,7 +217,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   // Tiles of kTile x kTile pixels, in parallel; every pixel's samples are its
   // own, so the order does not matter.
   constexpr int kTile = 32;
-  const int tiles_x = (settings.width + kTile - 1) / kTile;
+  const int tiles_x = (span + kTile - 1) / kTile;
   const int tiles_y = (band + kTile - 1) / kTile;
   const int tile_count = tiles_x * tiles_y;
   std::atomic<int> done{0};
@@ -220,14 +226,14 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   progress(0.0, "rendering");
   tbb::parallel_for(0, tile_count, [&](int tile) {
     if (cancelled.load(std::memory_order_relaxed)) return;
-    const int x0 = (tile % tiles_x) * kTile, y0 = row_begin + (tile / tiles_x) * kTile;
+    const int x0 = col_begin + (tile % tiles_x) * kTile, y0 = row_begin + (tile / tiles_x) * kTile;
     std::uint64_t tile_rays = 0, tile_samples = 0;
     for (int y = y0; y < std::min(y0 + kTile, row_end); ++y) {
-      for (int x = x0; x < std::min(x0 + kTile, settings.width); ++x) {
+      for (int x = x0; x < std::min(x0 + kTile, col_end); ++x) {
         int taken = 0;
         const PixelSums sums = sample_pixel(tracer, settings, x, y, layout, taken, tile_rays);
         tile_samples += static_cast<std::uint64_t>(taken);
-        store_pixel(image, x, y - row_begin, sums, taken, layout);
+        store_pixel(image, x - col_begin, y - row_begin, sums, taken, layout);
       }
     }
     total_rays += tile_rays;

@@ -61,18 +61,18 @@ std::vector<double> outward_distances(double first, double reach) {
 
 SurroundHeight::SurroundHeight(const DemVertices& dem, const SurroundOptions& options)
     : dem_(dem), options_(&options) {
-  const auto& v = *dem.vertices;
-  x0_ = v.front().x(), y0_ = v.front().y();
+  const std::vector<float>& v = dem.heights->z;
+  x0_ = dem.heights->x0, y0_ = dem.heights->y0;
   x1_ = x0_ + (dem.width - 1) * dem.dx, y1_ = y0_ - (dem.height - 1) * dem.dy;
   double s = 0.0, s2 = 0.0;
-  for (const Eigen::Vector3f& p : v) s += p.z(), s2 += double(p.z()) * p.z();
+  for (const float z : v) s += z, s2 += double(z) * z;
   const double n = static_cast<double>(v.size());
   mean_ = static_cast<float>(s / n);
   deviation_ = static_cast<float>(std::sqrt(std::max(0.0, s2 / n - (s / n) * (s / n))));
   decay_ = 0.125f * ((x1_ - x0_) + (y0_ - y1_));
   // Cumulative integral of the heights along the perimeter (trapezoids),
   // clockwise from the north-west corner.
-  const auto z = [&](int c, int r) { return v[static_cast<std::size_t>(r) * dem.width + c].z(); };
+  const auto z = [&](int c, int r) { return v[static_cast<std::size_t>(r) * dem.width + c]; };
   std::vector<std::pair<float, float>> loop;  // (step length, height) per perimeter vertex
   loop.reserve(2 * static_cast<std::size_t>(dem.width + dem.height));
   for (int c = 0; c < dem.width; ++c) loop.emplace_back(c ? dem.dx : 0.0f, z(c, 0));
@@ -96,7 +96,7 @@ float SurroundHeight::dem_height(float x, float y) const {
   const int r = std::min(static_cast<int>(fr), dem_.height - 2);
   const float tx = fx - c, tr = fr - r;
   const auto z = [&](int cc, int rr) {
-    return (*dem_.vertices)[static_cast<std::size_t>(rr) * dem_.width + cc].z();
+    return dem_.heights->at(cc, rr);
   };
   return (1 - tr) * ((1 - tx) * z(c, r) + tx * z(c + 1, r)) +
          tr * ((1 - tx) * z(c, r + 1) + tx * z(c + 1, r + 1));
@@ -117,7 +117,7 @@ float SurroundHeight::edge_mean(float x, float y, float half_width) const {
   // The integral of the heights up to perimeter position u (wrapping).
   const std::size_t n = sat_.size();
   const double total =
-      sat_.back() + 0.5 * dem_.dy * ((*dem_.vertices)[0].z() + (*dem_.vertices)[dem_.width].z());
+      sat_.back() + 0.5 * dem_.dy * (dem_.heights->z[0] + dem_.heights->z[dem_.width]);
   auto integral = [&](double u) {
     const double laps = std::floor(u / perimeter);
     u -= laps * perimeter;
@@ -228,8 +228,7 @@ SurroundGrids build_surround(const DemVertices& dem, const SurroundOptions& opti
   out.vertices.reserve(count);
   out.normals.reserve(count);
   out.reach = static_cast<float>(options.reach);
-  const auto& v = *dem.vertices;
-  const float x0 = v.front().x(), y0 = v.front().y();
+  const float x0 = dem.heights->x0, y0 = dem.heights->y0;
   const float x1 = x0 + (dem.width - 1) * dem.dx, y1 = y0 - (dem.height - 1) * dem.dy;
   auto spacing = [&](int i) {
     return static_cast<float>(d[std::min(i + 1, k - 1)] - d[std::max(i - 1, 0)]) * 0.5f;

@@ -28,6 +28,7 @@
 #include <optional>
 #include <vector>
 
+#include "render/height_field.h"
 #include "terrain/grid.h"
 
 namespace drift::render {
@@ -39,10 +40,10 @@ struct SurroundOptions {
   double blend = 0.0;  // metres over which the edge blends into a raster; 0: 10 of its cells
 };
 
-// The DEM as the scene holds it: the local vertex buffer (row 0 north,
-// x east) and the transform from local to CRS coordinates.
+// The DEM as the scene holds it: its local heights (row 0 north, x east;
+// render/height_field.h) and the transform from local to CRS coordinates.
 struct DemVertices {
-  const std::vector<Eigen::Vector3f>* vertices = nullptr;
+  const HeightGrid* heights = nullptr;
   int width = 0, height = 0;
   float dx = 1.0f, dy = 1.0f;
   Eigen::Vector3d origin{0, 0, 0};  // local -> CRS shift (heights exaggerated)

@@ -44,10 +44,11 @@ double footprint(const RayCone& cone, const Hit& hit) { return cone.width_at(hit
 
 // The surface traced: the ground with every height change laid on it (none:
 // nothing, the ground itself is traced).
-std::optional<terrain::HeightField> raised_ground(const SceneInput& input) {
+std::optional<terrain::HeightField> raised_ground(const terrain::HeightField& ground,
+                                                  const SceneInput& input) {
   std::optional<terrain::HeightField> raised;
   for (const terrain::products::HeightChange& change : input.height_changes)
-    raised = add_height_change(raised ? *raised : input.terrain, change.metres);
+    raised = add_height_change(raised ? *raised : ground, change.metres);
   return raised;
 }
 
@@ -66,6 +67,80 @@ Material object_material(const terrain::PlacedMesh& placed) {
 
 }  // namespace
 
+// The height field's user geometry (render/height_field.h). Every ray the
+// scene traces carries its prepared form in an extended context (Embree
+// passes the context to the callbacks unchanged), so that it is prepared once
+// and not once per block.
+struct HeightContext {
+  RTCIntersectContext context;  // first: Embree sees only this
+  const HeightRay* ray = nullptr;
+};
+
+void height_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto* blocks = static_cast<const HeightFieldBlocks*>(args->geometryUserPtr);
+  Eigen::Vector3f lo, hi;
+  blocks->block_bounds(args->primID, lo, hi);
+  // A little wider than the block: Embree's own box tests only cull, and a
+  // ray lying in a box's face (straight down along the DEM's west edge) must
+  // reach the block's exact test.
+  for (int a = 0; a < 3; ++a) {
+    const float pad = 1e-6f * std::max(std::fabs(lo[a]), std::fabs(hi[a])) + 1e-6f;
+    lo[a] -= pad, hi[a] += pad;
+  }
+  RTCBounds& b = *args->bounds_o;
+  b.lower_x = lo.x(), b.lower_y = lo.y(), b.lower_z = lo.z();
+  b.upper_x = hi.x(), b.upper_y = hi.y(), b.upper_z = hi.z();
+}
+
+void height_intersect(const RTCIntersectFunctionNArguments* args) {
+  const auto* blocks = static_cast<const HeightFieldBlocks*>(args->geometryUserPtr);
+  const auto* ctx = reinterpret_cast<const HeightContext*>(args->context);
+  RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, args->N);
+  RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, args->N);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (!args->valid[i]) continue;
+    const Eigen::Vector3f o(RTCRayN_org_x(rays, args->N, i), RTCRayN_org_y(rays, args->N, i),
+                            RTCRayN_org_z(rays, args->N, i));
+    const Eigen::Vector3f d(RTCRayN_dir_x(rays, args->N, i), RTCRayN_dir_y(rays, args->N, i),
+                            RTCRayN_dir_z(rays, args->N, i));
+    const std::optional<HeightRay> own =
+        args->N == 1 && ctx->ray ? std::nullopt : std::optional<HeightRay>(HeightRay(o, d));
+    const HeightRay& ray = own ? *own : *ctx->ray;
+    float tfar = RTCRayN_tfar(rays, args->N, i);
+    HeightHit hit;
+    if (!blocks->intersect(args->primID, ray, RTCRayN_tnear(rays, args->N, i), tfar, hit))
+      continue;
+    RTCRayN_tfar(rays, args->N, i) = tfar;
+    RTCHitN_Ng_x(hits, args->N, i) = hit.ng.x();
+    RTCHitN_Ng_y(hits, args->N, i) = hit.ng.y();
+    RTCHitN_Ng_z(hits, args->N, i) = hit.ng.z();
+    RTCHitN_u(hits, args->N, i) = 0.0f;
+    RTCHitN_v(hits, args->N, i) = 0.0f;
+    RTCHitN_primID(hits, args->N, i) = args->primID;
+    RTCHitN_geomID(hits, args->N, i) = args->geomID;
+    RTCHitN_instID(hits, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+void height_occluded(const RTCOccludedFunctionNArguments* args) {
+  const auto* blocks = static_cast<const HeightFieldBlocks*>(args->geometryUserPtr);
+  const auto* ctx = reinterpret_cast<const HeightContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (!args->valid[i]) continue;
+    RTCRayN* rays = args->ray;
+    const Eigen::Vector3f o(RTCRayN_org_x(rays, args->N, i), RTCRayN_org_y(rays, args->N, i),
+                            RTCRayN_org_z(rays, args->N, i));
+    const Eigen::Vector3f d(RTCRayN_dir_x(rays, args->N, i), RTCRayN_dir_y(rays, args->N, i),
+                            RTCRayN_dir_z(rays, args->N, i));
+    const std::optional<HeightRay> own =
+        args->N == 1 && ctx->ray ? std::nullopt : std::optional<HeightRay>(HeightRay(o, d));
+    const HeightRay& ray = own ? *own : *ctx->ray;
+    if (blocks->occluded(args->primID, ray, RTCRayN_tnear(rays, args->N, i),
+                         RTCRayN_tfar(rays, args->N, i)))
+      RTCRayN_tfar(rays, args->N, i) = -std::numeric_limits<float>::infinity();
+  }
+}
+
 struct TerrainScene::Embree {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
@@ -77,21 +152,39 @@ struct TerrainScene::Embree {
   }
 };
 
-TerrainScene::TerrainScene(const SceneInput& input) : embree_(std::make_unique<Embree>()) {
-  const std::optional<terrain::HeightField> raised = raised_ground(input);
-  const terrain::HeightField& dem = raised ? *raised : input.terrain;
+TerrainScene::TerrainScene(const SceneInput& input, TerrainGeometry geometry)
+    : embree_(std::make_unique<Embree>()) {
+  build(input, nullptr, geometry);
+}
+
+TerrainScene::TerrainScene(const SceneInput& input, terrain::HeightField&& terrain,
+                           TerrainGeometry geometry)
+    : embree_(std::make_unique<Embree>()) {
+  build(input, &terrain, geometry);
+}
+
+void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
+                         TerrainGeometry geometry) {
+  const terrain::HeightField& ground = adopt ? *adopt : input.terrain;
+  std::optional<terrain::HeightField> raised = raised_ground(ground, input);
+  if (raised && adopt) *adopt = terrain::HeightField();  // the raised copy is traced instead
+  const terrain::HeightField& dem = raised ? *raised : ground;
   check_terrain(dem);
   surface_ = input.surface;
   surface_.cell = std::min(std::abs(dem.geo().cell_size_x()), std::abs(dem.geo().cell_size_y()));
   coverage_ = coverage_channels(surface_);
-  fill_vertices(dem, static_cast<float>(input.vertical_exaggeration));
+  // A raised copy is the scene's own: its storage can become the heights.
+  fill_heights(dem, raised ? &*raised : adopt, static_cast<float>(input.vertical_exaggeration));
 
   embree_->device = rtcNewDevice("threads=0");
   if (!embree_->device) throw Error("cannot create an Embree device");
   rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
   embree_->scene = rtcNewScene(embree_->device);
   rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
-  attach_terrain_grids();
+  if (geometry == TerrainGeometry::Grid)
+    attach_terrain_grids();
+  else
+    attach_height_field();
   attach_surround(input.surround);
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
   rtcCommitScene(embree_->scene);
@@ -117,44 +210,89 @@ void TerrainScene::check_terrain(const terrain::HeightField& dem) {
   if (!(dx_ > 0) || !(dy_ > 0)) {
     throw Error("the terrain raster's cell size must be positive (north-up, metres)");
   }
-  // Vertices and Embree's own grid data (~17.5 B per vertex).
-  require_memory(dem.size() * (12 + 20), "the terrain scene", "crop or resample the DEM");
+  // Heights (shared with the caller's raster when adopted) and the min-max
+  // tree, ~0.7 B a cell, and Embree's BVH over its blocks (the grid
+  // geometry, kept for comparisons, needs 12 B of vertex and ~20 B of BVH).
+  require_memory(dem.size() * 5, "the terrain scene", "crop or resample the DEM");
 }
 
-void TerrainScene::fill_vertices(const terrain::HeightField& dem, float k) {
+void TerrainScene::fill_heights(const terrain::HeightField& dem, terrain::HeightField* adopt,
+                                float k) {
   // Local frame: origin at the DEM's centre (cell centres) and lowest height, so
   // float coordinates stay small. Nodata cells become the lowest valid height.
   const terrain::LocalFrame frame = terrain::local_frame(dem, "the terrain raster", k);
   const float lo = frame.lowest;
   exaggeration_ = k;
   origin_ = frame.origin;
-  const float x0 = static_cast<float>(frame.x0);
-  const float y0 = static_cast<float>(frame.y0);
+  heights_.width = width_;
+  heights_.height = height_;
+  heights_.x0 = static_cast<float>(frame.x0);
+  heights_.y0 = static_cast<float>(frame.y0);
+  heights_.dx = dx_;
+  heights_.dy = dy_;
 
-  // The vertex buffer is the only copy of the heights the scene keeps: shading
-  // normals are computed from it at each hit (vertex_normal), so a DEM costs
-  // 12 bytes a vertex here plus Embree's own grid data.
+  // The heights are the only copy of the terrain the scene keeps: shading
+  // normals are computed from them at each hit (vertex_normal). An adopted
+  // raster is rewritten in place (each cell read once, then overwritten).
   const std::size_t n = dem.size();
-  vertices_.resize(n);
+  const float* source = dem.values().data();
+  if (adopt) {
+    heights_.z = std::move(adopt->values());
+    *adopt = terrain::HeightField();
+  } else {
+    heights_.z.resize(n);
+  }
+  if (adopt) source = heights_.z.data();
+  float* z = heights_.z.data();
   const float z0 = static_cast<float>(origin_.z());
   tbb::parallel_for(0, height_, [&](int row) {
     for (int x = 0; x < width_; ++x) {
       const std::size_t i = static_cast<std::size_t>(row) * width_ + x;
-      const float h = std::isnan(dem.values()[i]) ? lo : dem.values()[i];
-      vertices_[i] = {x0 + x * dx_, y0 - row * dy_, h * k - z0};
+      const float h = std::isnan(source[i]) ? lo : source[i];
+      z[i] = h * k - z0;
     }
   });
   std::size_t hi_i = 0, lo_i = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (vertices_[i].z() > vertices_[hi_i].z()) hi_i = i;
-    if (vertices_[i].z() < vertices_[lo_i].z()) lo_i = i;
+    if (z[i] > z[hi_i]) hi_i = i;
+    if (z[i] < z[lo_i]) lo_i = i;
   }
-  highest_ = vertices_[hi_i];
-  lowest_ = vertices_[lo_i];
+  const auto vertex = [&](std::size_t i) {
+    return heights_.vertex(static_cast<int>(i % width_), static_cast<int>(i / width_));
+  };
+  highest_ = vertex(hi_i);
+  lowest_ = vertex(lo_i);
   extent_ = {(width_ - 1) * dx_, (height_ - 1) * dy_};
 }
 
+void TerrainScene::attach_height_field() {
+  blocks_ = std::make_unique<HeightFieldBlocks>(heights_);
+  RTCGeometry g = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(g, blocks_->block_count());
+  rtcSetGeometryUserData(g, blocks_.get());
+  rtcSetGeometryBoundsFunction(g, height_bounds, nullptr);
+  rtcSetGeometryIntersectFunction(g, height_intersect);
+  rtcSetGeometryOccludedFunction(g, height_occluded);
+  rtcCommitGeometry(g);
+  rtcAttachGeometryByID(embree_->scene, g, 0);
+  rtcReleaseGeometry(g);
+  terrain_geometries_ = 1;
+  mesh_material_.push_back(surface_.ground);
+  mesh_covers_.emplace_back();
+}
+
+std::size_t TerrainScene::terrain_bytes() const {
+  return heights_.z.size() * sizeof(float) + (blocks_ ? blocks_->bytes() : 0) +
+         vertices_.size() * sizeof(Eigen::Vector3f);
+}
+
 void TerrainScene::attach_terrain_grids() {
+  // Embree's float3 vertex buffer from the heights.
+  vertices_.resize(heights_.z.size());
+  tbb::parallel_for(0, height_, [&](int row) {
+    for (int x = 0; x < width_; ++x)
+      vertices_[static_cast<std::size_t>(row) * width_ + x] = heights_.vertex(x, row);
+  });
   // Grids of at most kMaxGridSide vertices a side over one shared vertex
   // buffer (stride = raster width); neighbours share their edge row.
   for (int gy = 0; gy < height_ - 1; gy += kMaxGridSide - 1) {
@@ -181,7 +319,7 @@ void TerrainScene::attach_terrain_grids() {
 }
 
 void TerrainScene::attach_surround(const SurroundOptions& options) {
-  DemVertices dem{&vertices_, width_, height_, dx_, dy_, origin_, exaggeration_};
+  DemVertices dem{&heights_, width_, height_, dx_, dy_, origin_, exaggeration_};
   SurroundGrids ring = build_surround(dem, options);
   if (ring.grids.empty()) return;
   surround_vertices_ = std::move(ring.vertices);
@@ -247,19 +385,15 @@ void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
 TerrainScene::~TerrainScene() = default;
 
 float TerrainScene::height_at(float x, float y) const {
-  const auto nw = vertices_.front();
-  auto h = [&](int xx, int rr) {
-    return vertices_[static_cast<std::size_t>(rr) * width_ + xx].z();
-  };
-  return terrain::bilinear_clamped(h, width_, height_, (x - nw.x()) / dx_, (nw.y() - y) / dy_);
+  auto h = [&](int xx, int rr) { return heights_.at(xx, rr); };
+  return terrain::bilinear_clamped(h, width_, height_, (x - heights_.x0) / dx_,
+                                   (heights_.y0 - y) / dy_);
 }
 
 Eigen::Vector3f TerrainScene::vertex_normal(int x, int row) const {
   // Horn's gradient of the exaggerated heights, as the slope and aspect
   // rasters compute it (terrain/derivatives.h), edges included.
-  const auto z = [&](int xx, int rr) {
-    return vertices_[static_cast<std::size_t>(rr) * width_ + xx].z();
-  };
+  const auto z = [&](int xx, int rr) { return heights_.at(xx, rr); };
   const terrain::Gradient g = terrain::horn_gradient(z, width_, height_, dx_, dy_, x, row);
   return Eigen::Vector3f(-g.dzdx, -g.dzdy, 1.0f).normalized();
 }
@@ -282,8 +416,10 @@ namespace {
 
 // The nearest hit of a ray from o along d (geomID invalid: none).
 RTCRayHit nearest_hit(RTCScene scene, const Eigen::Vector3f& o, const Eigen::Vector3f& d) {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  const HeightRay ray(o, d);
+  HeightContext context;
+  rtcInitIntersectContext(&context.context);
+  context.ray = &ray;
   RTCRayHit rh{};
   rh.ray.org_x = o.x(), rh.ray.org_y = o.y(), rh.ray.org_z = o.z();
   rh.ray.dir_x = d.x(), rh.ray.dir_y = d.y(), rh.ray.dir_z = d.z();
@@ -291,7 +427,7 @@ RTCRayHit nearest_hit(RTCScene scene, const Eigen::Vector3f& o, const Eigen::Vec
   rh.ray.tfar = std::numeric_limits<float>::infinity();
   rh.ray.mask = 0xffffffffu;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(scene, &context, &rh);
+  rtcIntersect1(scene, &context.context, &rh);
   return rh;
 }
 
@@ -299,6 +435,17 @@ RTCRayHit nearest_hit(RTCScene scene, const Eigen::Vector3f& o, const Eigen::Vec
 
 bool TerrainScene::hits(const Eigen::Vector3f& o, const Eigen::Vector3f& d) const {
   return nearest_hit(embree_->scene, o, d).hit.geomID != RTC_INVALID_GEOMETRY_ID;
+}
+
+float TerrainScene::hit_distance(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+                                 Eigen::Vector3f* normal) const {
+  const RTCRayHit rh = nearest_hit(embree_->scene, o, d);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::numeric_limits<float>::infinity();
+  if (normal) {
+    const Eigen::Vector3f n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
+    *normal = n.z() < 0.0f ? Eigen::Vector3f(-n) : n;
+  }
+  return rh.ray.tfar;
 }
 
 bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
@@ -327,7 +474,7 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
                                                 const std::optional<Eigen::Vector3f>& facet) const {
   // Smooth shading: bilinear vertex normals at the hit's cell position (on
   // the DEM), or the facet's normal turned up (beyond it).
-  const auto nw = vertices_.front();
+  const Eigen::Vector3f nw(heights_.x0, heights_.y0, 0.0f);
   auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
   const Eigen::Vector3f n =
       facet ? (facet->z() < 0.0f ? Eigen::Vector3f(-*facet) : *facet)
@@ -392,15 +539,17 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
 bool TerrainScene::occluded(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                             float max_distance) const {
   if (recorder_) recorder_->traced(o, d, max_distance, true);
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  const HeightRay prepared(o, d);
+  HeightContext context;
+  rtcInitIntersectContext(&context.context);
+  context.ray = &prepared;
   RTCRay ray{};
   ray.org_x = o.x(), ray.org_y = o.y(), ray.org_z = o.z();
   ray.dir_x = d.x(), ray.dir_y = d.y(), ray.dir_z = d.z();
   ray.tnear = 0.0f;
   ray.tfar = max_distance;
   ray.mask = 0xffffffffu;
-  rtcOccluded1(embree_->scene, &context, &ray);
+  rtcOccluded1(embree_->scene, &context.context, &ray);
   return ray.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
 

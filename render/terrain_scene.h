@@ -1,6 +1,6 @@
-// The Embree 3 scene of a render: the height field as grid geometry
-// (RTC_GEOMETRY_TYPE_GRID, 12 bytes of vertex per DEM cell instead of a triangle
-// soup) plus triangle meshes.
+// The Embree 3 scene of a render: the height field as a user geometry over its
+// heights (render/height_field.h: 4 bytes a DEM cell plus a min-max tree, the
+// same triangles as Embree's grid geometry) plus triangle meshes.
 //
 // Coordinates: the interface speaks the raster's own CRS (x east, y north,
 // metres) and heights in metres. Inside, everything is shifted by `origin()`
@@ -13,6 +13,7 @@
 #include <optional>
 #include <vector>
 
+#include "render/height_field.h"
 #include "render/render_settings.h"
 
 namespace drift::render {
@@ -48,11 +49,23 @@ class RayRecorder {
                       bool shadow) = 0;
 };
 
+// How the height field is given to Embree: its heights with a min-max tree
+// (render/height_field.h, the default), or Embree's grid geometry over a float3
+// vertex a cell (36 B a cell at the peak; kept for comparisons in tests and
+// benchmarks). Both trace the same triangles.
+enum class TerrainGeometry { HeightField, Grid };
+
 class TerrainScene {
  public:
   // Throws drift::Error for an empty or all-nodata terrain. NaN (nodata) cells
   // are filled with the lowest valid height so that holes read as low ground.
-  explicit TerrainScene(const SceneInput& input);
+  explicit TerrainScene(const SceneInput& input,
+                        TerrainGeometry geometry = TerrainGeometry::HeightField);
+  // The same with the terrain taken from `terrain` (input.terrain is not
+  // read): its storage becomes the scene's heights, so a DEM's cells are held
+  // once; `terrain` is left empty.
+  TerrainScene(const SceneInput& input, terrain::HeightField&& terrain,
+               TerrainGeometry geometry = TerrainGeometry::HeightField);
   ~TerrainScene();
   TerrainScene(const TerrainScene&) = delete;
   TerrainScene& operator=(const TerrainScene&) = delete;
@@ -67,6 +80,13 @@ class TerrainScene {
   // Raw Embree: whether the ray meets anything (rtcIntersect1 alone, nothing
   // shaded, not recorded). The ceiling intersect() is measured against.
   bool hits(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir) const;
+  // Raw Embree's nearest hit: its distance (infinity: none) and geometric
+  // normal (unit, facing up on the terrain); for tests of the geometry.
+  float hit_distance(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
+                     Eigen::Vector3f* normal = nullptr) const;
+  // Bytes the terrain geometry holds: heights, min-max tree or float3
+  // vertices (Embree's own BVH not included).
+  std::size_t terrain_bytes() const;
   // Every ray intersect() and occluded() trace goes to `recorder` too (none:
   // nullptr); for benchmarks, not to be changed while rays are traced.
   void record_rays(RayRecorder* recorder) { recorder_ = recorder; }
@@ -92,11 +112,14 @@ class TerrainScene {
 
  private:
   // The constructor's steps: checks the raster's shape and takes its size;
-  // fills the vertex buffer in the local frame; adds the grids over it; adds
-  // one object.
+  // fills the heights in the local frame (from `adopt`'s own storage when
+  // given); adds the terrain geometry over them; adds one object.
+  void build(const SceneInput& input, terrain::HeightField* adopt, TerrainGeometry geometry);
   void check_terrain(const terrain::HeightField& dem);
-  void fill_vertices(const terrain::HeightField& dem, float vertical_exaggeration);
+  void fill_heights(const terrain::HeightField& dem, terrain::HeightField* adopt,
+                    float vertical_exaggeration);
   void attach_terrain_grids();
+  void attach_height_field();
   void attach_mesh(const terrain::PlacedMesh& placed);
 
   // The hit's material and coverage on the terrain (a footprint from
@@ -118,8 +141,11 @@ class TerrainScene {
   float dx_ = 1.0f, dy_ = 1.0f;
   float exaggeration_ = 1.0f;
   Eigen::Vector3d origin_{0, 0, 0};
-  // Embree's shared vertex buffer: local x, y and the filled, exaggerated
-  // heights, row 0 = north.
+  // The filled, exaggerated heights in the local frame, row 0 = north, and
+  // the min-max tree over them (TerrainGeometry::HeightField) or Embree's
+  // float3 vertex buffer (TerrainGeometry::Grid).
+  HeightGrid heights_;
+  std::unique_ptr<HeightFieldBlocks> blocks_;
   std::vector<Eigen::Vector3f> vertices_;
   TerrainSurface surface_;
   CoverageChannels coverage_;

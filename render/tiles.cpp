@@ -33,6 +33,32 @@ std::pair<int, int> parse_tile(const std::string& text) {
   return {index, count};
 }
 
+TileSpec parse_tile_spec(const std::string& text) {
+  std::smatch m;
+  if (!std::regex_match(text, m, std::regex(R"((\d{1,6})/(\d{1,5})x(\d{1,5}))"))) {
+    const auto [index, count] = parse_tile(text);  // bands, or its error
+    return {index, 1, count};
+  }
+  const int index = std::stoi(m[1]), columns = std::stoi(m[2]), rows = std::stoi(m[3]);
+  const long long count = static_cast<long long>(columns) * rows;
+  if (columns < 1 || rows < 1 || index >= count) {
+    throw Error("tile '" + text + "' does not exist: block INDEX/CxR counts from 0 to C R - 1 " +
+                "row by row, e.g. " + std::to_string(std::max(count, 1LL) - 1) + "/" +
+                std::to_string(std::max(columns, 1)) + "x" + std::to_string(std::max(rows, 1)));
+  }
+  return {index, columns, rows};
+}
+
+TileRect tile_rect(int width, int height, const TileSpec& tile) {
+  if (tile.columns > width) {
+    throw Error("tile " + std::to_string(tile.index) + "/" + std::to_string(tile.columns) + "x" +
+                std::to_string(tile.rows) + " does not exist: use at most as many columns as the " +
+                "image is wide (" + std::to_string(width) + ")");
+  }
+  const int column = tile.index % tile.columns, row = tile.index / tile.columns;
+  return {tile_rows(width, column, tile.columns), tile_rows(height, row, tile.rows)};
+}
+
 namespace {
 
 // drift render records which scene and settings a tile comes from ("scene");
@@ -72,42 +98,65 @@ Image merge_tiles(const std::vector<Image>& tiles,
       throw Error(name + " has other channels than " + names[0].string() +
                   ": merge tiles of one render only");
     }
-    if (t.frame.x != 0 || t.width != width || t.frame.y < 0 || t.frame.y + t.height > height) {
-      throw Error(name + " does not lie inside its frame as a band of whole rows");
+    if (t.frame.x < 0 || t.frame.y < 0 || t.frame.x + t.width > width ||
+        t.frame.y + t.height > height || t.width < 1 || t.height < 1) {
+      throw Error(name + " does not lie inside its frame");
     }
     require_same_scene(first, t, names[0], names.at(i));
   }
   require_memory(static_cast<std::uint64_t>(width) * height * first.channels.size() * sizeof(float),
                  "the merged " + std::to_string(width) + "x" + std::to_string(height) + " frame",
                  "merge fewer channels or a smaller frame");
+  // Each row's tiles, by their first column: no two may overlap and together
+  // they must span the row.
+  std::vector<std::vector<std::size_t>> by_row(static_cast<std::size_t>(height));
+  for (std::size_t i = 0; i < tiles.size(); ++i)
+    for (int r = 0; r < tiles[i].height; ++r) by_row[tiles[i].frame.y + r].push_back(i);
+  // The first row with a gap: its columns (a band's missing rows are named as rows).
+  for (int y = 0; y < height; ++y) {
+    std::vector<std::size_t>& row = by_row[y];
+    std::sort(row.begin(), row.end(),
+              [&](std::size_t a, std::size_t b) { return tiles[a].frame.x < tiles[b].frame.x; });
+    int next = 0;
+    for (std::size_t k = 0; k <= row.size(); ++k) {
+      const int x = k < row.size() ? tiles[row[k]].frame.x : width;
+      if (x < next) {
+        throw Error(names[row[k - 1]].string() + " and " + names[row[k]].string() +
+                    " overlap at pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                    "): give each tile once");
+      }
+      if (x > next) {
+        if (next == 0 && x == width) {
+          int y1 = y;
+          while (y1 + 1 < height && by_row[y1 + 1].empty()) ++y1;
+          throw Error("rows " + std::to_string(y) + " to " + std::to_string(y1) + " of the " +
+                      std::to_string(width) + "x" + std::to_string(height) +
+                      " frame are in no tile: a tile is missing (or failed); render it and merge "
+                      "again");
+        }
+        throw Error("columns " + std::to_string(next) + " to " + std::to_string(x - 1) +
+                    " of row " + std::to_string(y) + " of the " + std::to_string(width) + "x" +
+                    std::to_string(height) +
+                    " frame are in no tile: a tile is missing (or failed); render it and merge "
+                    "again");
+      }
+      if (k < row.size()) next = x + tiles[row[k]].width;
+    }
+  }
   Image out(width, height, first.channels);
   out.attributes = first.attributes;
   out.header_texts = first.header_texts;  // one render's: the same in every tile
   out.header_matrices = first.header_matrices;
   out.header_vectors = first.header_vectors;
-  std::vector<int> owner(static_cast<std::size_t>(height), -1);
-  const std::size_t row_floats = static_cast<std::size_t>(width) * first.channels.size();
+  const std::size_t channels = first.channels.size();
   for (std::size_t i = 0; i < tiles.size(); ++i) {
     const Image& t = tiles[i];
+    const std::size_t row_floats = static_cast<std::size_t>(t.width) * channels;
     for (int r = 0; r < t.height; ++r) {
-      const int y = t.frame.y + r;
-      if (owner[y] >= 0) {
-        throw Error("row " + std::to_string(y) + " is in both " + names[owner[y]].string() +
-                    " and " + names[i].string() + ": give each tile once");
-      }
-      owner[y] = static_cast<int>(i);
-      std::memcpy(&out.pixels[static_cast<std::size_t>(y) * row_floats],
+      const std::size_t y = static_cast<std::size_t>(t.frame.y + r);
+      std::memcpy(&out.pixels[(y * width + t.frame.x) * channels],
                   &t.pixels[static_cast<std::size_t>(r) * row_floats], row_floats * sizeof(float));
     }
-  }
-  const auto hole = std::find(owner.begin(), owner.end(), -1);
-  if (hole != owner.end()) {
-    const int y0 = static_cast<int>(hole - owner.begin());
-    int y1 = y0;
-    while (y1 + 1 < height && owner[y1 + 1] < 0) ++y1;
-    throw Error("rows " + std::to_string(y0) + " to " + std::to_string(y1) + " of the " +
-                std::to_string(width) + "x" + std::to_string(height) +
-                " frame are in no tile: a tile is missing (or failed); render it and merge again");
   }
   return out;
 }

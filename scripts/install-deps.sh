@@ -7,7 +7,8 @@ packages=(
   build-essential cmake pkg-config make
   libembree-dev libeigen3-dev libtbb-dev
   libopenimageio-dev libopenexr-dev
-  libgdal-dev gdal-bin
+  libgdal-dev gdal-bin python3-gdal python3-numpy
+  parallel
   libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev libtinyobjloader-dev

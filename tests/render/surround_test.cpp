@@ -16,9 +16,11 @@
 namespace drift::render {
 namespace {
 
-// A local DEM's vertex buffer as TerrainScene lays it out (row 0 north).
+// A local DEM's vertices as TerrainScene lays them out (row 0 north), and its
+// heights as the scene holds them.
 struct TestDem {
   std::vector<Eigen::Vector3f> vertices;
+  HeightGrid heights;
   DemVertices view;
   TestDem(int w, int h, float cell) {
     for (int r = 0; r < h; ++r)
@@ -26,7 +28,9 @@ struct TestDem {
         const float x = c * cell, y = -r * cell;
         vertices.emplace_back(x, y, 300.0f + 40.0f * std::sin(x / 70.0f) + 0.3f * y);
       }
-    view = {&vertices, w, h, cell, cell, Eigen::Vector3d(500000.0, 4000000.0, 1000.0), 1.0f};
+    heights = {w, h, 0.0f, 0.0f, cell, cell, {}};
+    for (const Eigen::Vector3f& v : vertices) heights.z.push_back(v.z());
+    view = {&heights, w, h, cell, cell, Eigen::Vector3d(500000.0, 4000000.0, 1000.0), 1.0f};
   }
 };
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -55,6 +56,86 @@ TEST(Tiles, RowsCoverTheFrameOnce) {
   EXPECT_THROW(tile_rows(10, 0, 11), drift::Error);
   EXPECT_THROW(parse_tile("3of4"), drift::Error);
   EXPECT_EQ(parse_tile("3/16"), std::make_pair(3, 16));
+}
+
+TEST(Tiles, BlocksCoverTheFrameOnce) {
+  // "i/n" stays a band; "i/CxR" is block i of C columns and R rows, row by row.
+  const TileSpec band = parse_tile_spec("3/16");
+  EXPECT_EQ(band.index, 3);
+  EXPECT_EQ(band.columns, 1);
+  EXPECT_EQ(band.rows, 16);
+  const TileSpec block = parse_tile_spec("5/4x3");
+  EXPECT_EQ(block.index, 5);
+  EXPECT_EQ(block.columns, 4);
+  EXPECT_EQ(block.rows, 3);
+  EXPECT_THROW(parse_tile_spec("12/4x3"), drift::Error);
+  EXPECT_THROW(parse_tile_spec("0/0x3"), drift::Error);
+  EXPECT_THROW(parse_tile_spec("1/4by3"), drift::Error);
+  EXPECT_THROW(tile_rect(3, 90, {0, 4, 1}), drift::Error);  // more columns than pixels
+  std::vector<int> owner(50 * 37, -1);
+  for (int i = 0; i < 4 * 3; ++i) {
+    const TileRect r = tile_rect(50, 37, {i, 4, 3});
+    EXPECT_GT(r.x.end, r.x.begin);
+    EXPECT_GT(r.y.end, r.y.begin);
+    for (int y = r.y.begin; y < r.y.end; ++y)
+      for (int x = r.x.begin; x < r.x.end; ++x) {
+        EXPECT_EQ(owner[y * 50 + x], -1);
+        owner[y * 50 + x] = i;
+      }
+  }
+  EXPECT_EQ(std::count(owner.begin(), owner.end(), -1), 0);
+  const TileRect last = tile_rect(50, 37, {11, 4, 3});
+  EXPECT_EQ(last.x.end, 50);
+  EXPECT_EQ(last.y.end, 37);
+}
+
+TEST(Tiles, MergedBlocksAreBitIdenticalToOneRender) {
+  const SceneInput in = hills();
+  const TerrainScene scene(in);
+  const Camera camera = default_camera(scene);
+  RenderSettings rs;
+  rs.width = 41;
+  rs.height = 29;
+  rs.samples_per_pixel = 4;
+  const fs::path dir = temp_dir();
+  write_exr(render_image(scene, in, camera, rs), dir / "whole.exr");
+  const Image whole = read_image(dir / "whole.exr");
+  std::vector<Image> tiles;
+  std::vector<fs::path> names;
+  for (int i : {4, 0, 2, 5, 1, 3}) {  // any order
+    const TileRect r = tile_rect(rs.width, rs.height, {i, 3, 2});
+    RenderSettings part = rs;
+    part.row_begin = r.y.begin, part.row_end = r.y.end;
+    part.col_begin = r.x.begin, part.col_end = r.x.end;
+    names.push_back(dir / ("block" + std::to_string(i) + ".exr"));
+    write_exr(render_image(scene, in, camera, part), names.back());
+    tiles.push_back(read_image(names.back()));
+    EXPECT_EQ(tiles.back().frame.x, r.x.begin);
+    EXPECT_EQ(tiles.back().frame.y, r.y.begin);
+  }
+  const Image merged = merge_tiles(tiles, names);
+  ASSERT_EQ(merged.channels, whole.channels);
+  EXPECT_EQ(merged.pixels, whole.pixels);  // bit for bit
+  // A missing block is named by its columns and row; a doubled one by its files.
+  try {
+    merge_tiles({tiles[0], tiles[1], tiles[2], tiles[3], tiles[4]},
+                {names[0], names[1], names[2], names[3], names[4]});
+    ADD_FAILURE() << "a missing block must be an error";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("columns 0 to 12 of row 14"), std::string::npos)
+        << e.what();
+  }
+  try {
+    std::vector<Image> doubled = tiles;
+    doubled.push_back(tiles[2]);
+    std::vector<fs::path> doubled_names = names;
+    doubled_names.push_back(dir / "again.exr");
+    merge_tiles(doubled, doubled_names);
+    ADD_FAILURE() << "a doubled block must be an error";
+  } catch (const drift::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("overlap"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
 }
 
 TEST(Tiles, MergedBandsAreBitIdenticalToOneRender) {
@@ -134,5 +215,33 @@ TEST(Tiles, CommandLineTilesMergeToTheSingleRun) {
   // Without the last tile: exit 1, and no output written.
   EXPECT_EQ(run("merge " + (dir / "t0.exr").string() + " -o " + (dir / "part.exr").string()), 256);
   EXPECT_FALSE(fs::exists(dir / "part.exr"));
+  fs::remove_all(dir);
+}
+
+// The documented GNU parallel command (docs/rendering.md, "Tiles across
+// machines"): n local processes render the blocks of a 3x2 grid, drift merge
+// joins them, and the frame is the single run's, bit for bit.
+TEST(Tiles, GnuParallelBlocksMergeToTheSingleRun) {
+  ASSERT_EQ(std::system("command -v parallel > /dev/null 2>&1"), 0)
+      << "GNU parallel is missing: run scripts/install-deps.sh (Debian package parallel)";
+  const fs::path dir = temp_dir();
+  drift::terrain::write_geotiff(hills().terrain, dir / "dem.tif");
+  std::ofstream(dir / "s.toml") << "[terrain]\nraster = \"dem.tif\"\n"
+                                   "[render]\nwidth = 37\nheight = 23\nspp = 2\n";
+  const std::string drift = DRIFT_EXECUTABLE;
+  const std::string scene = (dir / "s.toml").string();
+  ASSERT_EQ(std::system((drift + " render " + scene + " -o " + (dir / "whole.exr").string() +
+                         " > /dev/null 2>&1")
+                            .c_str()),
+            0);
+  const std::string command = "cd " + dir.string() + " && seq 0 5 | parallel --halt now,fail=1 -j 3 " +
+                              drift + " render s.toml --tile {}/3x2 -o part_{}.exr --threads 1" +
+                              " > /dev/null 2>&1 && " + drift +
+                              " merge part_*.exr -o frame.exr > /dev/null 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const Image frame = read_image(dir / "frame.exr");
+  const Image whole = read_image(dir / "whole.exr");
+  ASSERT_EQ(frame.channels, whole.channels);
+  EXPECT_EQ(frame.pixels, whole.pixels);
   fs::remove_all(dir);
 }

@@ -1,0 +1,113 @@
+// The terrain as the renderer holds it: one float a vertex (the DEM's cell
+// centres), traced exactly as the triangulation Embree's grid geometry gives
+// (each cell v0 = (c, r), v1 = (c + 1, r), v2 = (c + 1, r + 1), v3 = (c, r + 1)
+// split along v1-v3 into triangles v0 v1 v3 and v2 v3 v1, as Embree's quads
+// are; rtcNewGeometry(3), RTC_GEOMETRY_TYPE_GRID and RTC_GEOMETRY_TYPE_QUAD)
+// but without its 12 B float3 vertex and ~20 B of grid BVH a vertex.
+//
+// Embree's grid geometry cannot read heights alone: its vertex buffer is
+// RTC_FORMAT_FLOAT3 (x, y, z a vertex; a stride only steps between rows of
+// vertices). So the terrain is an Embree user geometry (RTC_GEOMETRY_TYPE_USER)
+// of square blocks of cells, Embree's BVH over the blocks, and inside a block
+// a min-max quadtree of the heights (Tevs et al. 2008, "Maximum mipmaps for
+// fast, accurate, and scalable dynamic height field rendering") down to
+// leaves of kLeaf x kLeaf cells, whose triangles are intersected with Woop,
+// Benthin and Wald's watertight test (JCGT 2(1), 2013): neighbouring
+// triangles share each edge function bit for bit, so no ray slips between
+// them, whatever the cell, leaf or block boundary.
+//
+// Memory: 4 B a vertex of heights plus the min-max levels, 8 B per kLeaf^2
+// cells and a third more above (0.67 B a cell for kLeaf = 4), plus Embree's
+// BVH over (cells / kBlock^2) blocks.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace drift::render {
+
+// Heights of a north-up raster in the scene's local frame.
+struct HeightGrid {
+  int width = 0, height = 0;  // vertices
+  float x0 = 0, y0 = 0;       // local position of vertex (0, 0), the north-west one
+  float dx = 1, dy = 1;       // spacing; row r lies at y0 - r dy (rows run south)
+  std::vector<float> z;       // local heights, row-major, row 0 north
+
+  // The same expressions the float3 vertex buffer was filled with, so both
+  // geometries place every vertex on the same floats.
+  float x(int c) const { return x0 + static_cast<float>(c) * dx; }
+  float y(int r) const { return y0 - static_cast<float>(r) * dy; }
+  float at(int c, int r) const { return z[static_cast<std::size_t>(r) * width + c]; }
+  Eigen::Vector3f vertex(int c, int r) const { return {x(c), y(r), at(c, r)}; }
+};
+
+// A ray prepared once for every block it meets: its inverse direction for the
+// box tests and the shear of Woop et al.'s watertight triangle test.
+struct HeightRay {
+  Eigen::Vector3f origin, dir, inv_dir;
+  bool parallel[3];  // dir[a] is 0: the ray stays in one plane of that axis
+  int kx = 0, ky = 1, kz = 2;  // dir's largest component is kz
+  float sx = 0, sy = 0, sz = 1;
+  HeightRay(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir);
+};
+
+// A hit on the height field: the cell, which of its two triangles, and the
+// triangle's geometric normal (not normalised; it points down, as Embree's
+// Ng of the grid does: rows run south).
+struct HeightHit {
+  int cell_x = 0, cell_row = 0;
+  int triangle = 0;  // 0: v0 v1 v3, 1: v2 v3 v1
+  Eigen::Vector3f ng{0, 0, -1};
+};
+
+class HeightFieldBlocks {
+ public:
+  static constexpr int kLeaf = 4;        // cells a side of a min-max leaf
+  static constexpr int kBlockLevels = 4;  // min-max levels inside a block
+  static constexpr int kBlock = kLeaf << (kBlockLevels - 1);  // cells a side of a block
+
+  // Builds the min-max levels over `grid` (kept by pointer: it must outlive this).
+  explicit HeightFieldBlocks(const HeightGrid& grid);
+
+  // Embree's primitives: blocks of kBlock x kBlock cells (fewer at the east
+  // and south edges).
+  unsigned block_count() const { return static_cast<unsigned>(blocks_x_ * blocks_y_); }
+  void block_bounds(unsigned block, Eigen::Vector3f& lower, Eigen::Vector3f& upper) const;
+
+  // The nearest hit in `block` with tnear < t <= tfar: tfar becomes its
+  // distance and `hit` its cell and triangle. False if none.
+  bool intersect(unsigned block, const HeightRay& ray, float tnear, float& tfar,
+                 HeightHit& hit) const;
+  // True if the ray meets the block's triangles with tnear < t <= tfar.
+  bool occluded(unsigned block, const HeightRay& ray, float tnear, float tfar) const;
+
+  // Bytes of the min-max levels (the heights are the grid's).
+  std::size_t bytes() const;
+
+ private:
+  struct MinMax {
+    float lo, hi;
+  };
+  struct Level {
+    int nx = 0, ny = 0, size = 0;  // nodes a side, cells a node side
+    std::vector<MinMax> nodes;
+  };
+  template <bool kAnyHit>
+  bool trace(unsigned block, const HeightRay& ray, float tnear, float& tfar, HeightHit& hit) const;
+  template <bool kAnyHit>
+  bool trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray, float tnear, float& tfar,
+                  HeightHit& hit) const;
+  // The ray's entry distance into node (level, ix, iy) within [tnear, tfar],
+  // or a negative number if it misses.
+  bool node_entry(int level, int ix, int iy, const HeightRay& ray, float tnear, float tfar,
+                  float& entry) const;
+
+  const HeightGrid* grid_;
+  int cells_x_ = 0, cells_y_ = 0;
+  int blocks_x_ = 0, blocks_y_ = 0;
+  std::vector<Level> levels_;  // [0]: leaves of kLeaf cells; the last: blocks
+};
+
+}  // namespace drift::render

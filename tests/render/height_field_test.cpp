@@ -1,0 +1,223 @@
+// The compact height-field geometry (render/height_field.h) against Embree's
+// grid geometry over float3 vertices, which it replaces: the same triangles
+// (the same diagonal), the same hit distances and normals on random, grazing,
+// edge-aligned and upward rays, and no ray slipping between triangles.
+#include "render/height_field.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "render/terrain_scene.h"
+#include "terrain/error.h"
+
+using namespace drift::render;
+using drift::terrain::HeightField;
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Rough relief of w x h cells of 2.5 m at UTM-sized coordinates: several
+// wavelengths, steep faces, flat patches (equal heights make degenerate
+// diagonals) and a few spikes.
+HeightField relief(int w, int h) {
+  HeightField dem(w, h, 0.0f, drift::terrain::local_georeference(2.5));
+  dem.geo().geotransform[0] = 600000.0;
+  dem.geo().geotransform[3] = 4000000.0;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> noise(-1.0f, 1.0f);
+  for (int r = 0; r < h; ++r)
+    for (int x = 0; x < w; ++x) {
+      float z = 40.0f * std::sin(x * 0.07f) * std::cos(r * 0.05f) + 6.0f * noise(rng);
+      if (x > w / 2 && r < h / 3) z = 10.0f;                    // a plateau
+      if ((x * 7 + r * 13) % 97 == 0) z += 30.0f;              // spikes
+      dem(x, r) = z;
+    }
+  return dem;
+}
+
+SceneInput input_of(const HeightField& dem) {
+  SceneInput in;
+  in.terrain = dem;
+  in.surround.reach = 0.0;  // the DEM alone
+  return in;
+}
+
+// The height of the triangulated surface at local (x, y): cell (c, r) split
+// along v1 (c + 1, r) - v3 (c, r + 1), as Embree's grid geometry does.
+float surface_z(const TerrainScene& scene, const HeightField& dem, float x, float y) {
+  const Eigen::Vector3f nw = scene.to_local({dem.geo().cell_center(0, 0)[0],
+                                             dem.geo().cell_center(0, 0)[1], 0.0});
+  const float fx = (x - nw.x()) / 2.5f, fr = (nw.y() - y) / 2.5f;
+  const int c = std::clamp(static_cast<int>(fx), 0, dem.width() - 2);
+  const int r = std::clamp(static_cast<int>(fr), 0, dem.height() - 2);
+  const float u = fx - c, v = fr - r;
+  const float base = static_cast<float>(scene.origin().z());
+  const auto z = [&](int cc, int rr) { return dem(cc, rr) - base; };
+  if (u + v <= 1.0f) return z(c, r) + u * (z(c + 1, r) - z(c, r)) + v * (z(c, r + 1) - z(c, r));
+  return z(c + 1, r + 1) + (1 - u) * (z(c, r + 1) - z(c + 1, r + 1)) +
+         (1 - v) * (z(c + 1, r) - z(c + 1, r + 1));
+}
+
+struct Ray {
+  Eigen::Vector3f o, d;
+};
+
+// Compares the two geometries on `rays`: the same hits and misses, hit
+// distances within `rel` of each other, normals within 1e-4 where the ray
+// meets a triangle's interior, and every hit on the triangulated surface.
+// With `leaks`, rays along edges: where the grid's (Moeller-Trumbore) test
+// lets a ray slip between two triangles, the watertight one must find the
+// surface earlier instead; counted in `slipped`. Returns how many hit.
+int compare(const TerrainScene& blocks, const TerrainScene& grid, const HeightField& dem,
+            const std::vector<Ray>& rays, float rel, bool normals, int* slipped = nullptr) {
+  int hits = 0;
+  for (const Ray& ray : rays) {
+    Eigen::Vector3f na, nb;
+    const float a = blocks.hit_distance(ray.o, ray.d, &na);
+    const float b = grid.hit_distance(ray.o, ray.d, &nb);
+    if (a != kInf) {
+      const Eigen::Vector3f p = ray.o + a * ray.d;
+      EXPECT_NEAR(p.z(), surface_z(blocks, dem, p.x(), p.y()), 2e-3f);
+    }
+    if (slipped && a != kInf && (b == kInf || a < b - rel * std::max(1.0f, b))) {
+      ++*slipped;
+      continue;
+    }
+    if (a == kInf || b == kInf) {
+      EXPECT_EQ(a, b) << "o " << ray.o.transpose() << " d " << ray.d.transpose();
+      continue;
+    }
+    ++hits;
+    EXPECT_NEAR(a, b, rel * std::max(1.0f, b)) << "o " << ray.o.transpose() << " d "
+                                               << ray.d.transpose();
+    if (normals) {
+      EXPECT_GT(na.dot(nb), 1.0f - 1e-4f) << na.transpose() << " / " << nb.transpose();
+    }
+  }
+  return hits;
+}
+
+}  // namespace
+
+TEST(HeightField, SameHitsAsGridGeometryOnRandomRays) {
+  const HeightField dem = relief(150, 131);  // blocks and leaves cut at the edges
+  const TerrainScene blocks(input_of(dem), TerrainGeometry::HeightField);
+  const TerrainScene grid(input_of(dem), TerrainGeometry::Grid);
+  const Eigen::Vector2f half = blocks.extent() / 2;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Ray> down, grazing, below;
+  for (int i = 0; i < 4000; ++i) {
+    // From above, any downward direction.
+    const Eigen::Vector3f o(u(rng) * half.x() * 1.2f, u(rng) * half.y() * 1.2f,
+                            blocks.top() + 20.0f + 100.0f * std::abs(u(rng)));
+    down.push_back({o, Eigen::Vector3f(u(rng), u(rng), -0.2f - std::abs(u(rng))).normalized()});
+    // Grazing: just above the ground, 0.05 - 3 degrees down, across the DEM.
+    const float x = u(rng) * half.x(), y = u(rng) * half.y();
+    const float dip = (0.05f + 2.95f * std::abs(u(rng))) * static_cast<float>(M_PI) / 180.0f;
+    const float az = u(rng) * static_cast<float>(M_PI);
+    grazing.push_back({Eigen::Vector3f(x, y, blocks.height_at(x, y) + 3.0f),
+                       Eigen::Vector3f(std::cos(dip) * std::cos(az), std::cos(dip) * std::sin(az),
+                                       -std::sin(dip))});
+    // From below the lowest ground, upwards: the terrain's underside.
+    below.push_back({Eigen::Vector3f(u(rng) * half.x(), u(rng) * half.y(), blocks.bottom() - 50.0f),
+                     Eigen::Vector3f(0.5f * u(rng), 0.5f * u(rng), 1.0f).normalized()});
+  }
+  EXPECT_GT(compare(blocks, grid, dem, down, 1e-5f, true), 1500);
+  // A grazing ray's distance moves by a height's rounding over the sine of
+  // its dip: 1e-4 of the distance at 0.05 degrees.
+  EXPECT_GT(compare(blocks, grid, dem, grazing, 1e-4f, true), 2000);
+  EXPECT_GT(compare(blocks, grid, dem, below, 1e-5f, true), 3300);
+}
+
+TEST(HeightField, SameHitsAlongCellEdgesAndDiagonals) {
+  const HeightField dem = relief(70, 66);
+  const TerrainScene blocks(input_of(dem), TerrainGeometry::HeightField);
+  const TerrainScene grid(input_of(dem), TerrainGeometry::Grid);
+  // Vertex (c, r) in local coordinates, from the DEM's own cell centres.
+  const auto vertex = [&](int c, int r) {
+    const auto p = dem.geo().cell_center(c, r);
+    return blocks.to_local({p[0], p[1], 0.0});
+  };
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> col(2, 67), row(2, 63);
+  std::uniform_real_distribution<float> dip(0.02f, 1.2f);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3f v = vertex(col(rng), row(rng));
+    const float s = dip(rng), h = blocks.top() + 5.0f;
+    // In the vertical planes of a column, of a row, of a cell diagonal
+    // (v1 -> v3: west and south at once) and of the other diagonal.
+    for (const Eigen::Vector2f& along : {Eigen::Vector2f(0, 1), Eigen::Vector2f(1, 0),
+                                        Eigen::Vector2f(-1, -1), Eigen::Vector2f(1, -1)}) {
+      const Eigen::Vector2f a = along.normalized();
+      const Eigen::Vector3f d = Eigen::Vector3f(a.x(), a.y(), -s).normalized();
+      rays.push_back({Eigen::Vector3f(v.x(), v.y(), h) - d * (h / std::abs(d.z())) * 0.5f, d});
+    }
+  }
+  // Rays in an edge's plane meet the surface on the edge itself, where both
+  // triangles (and both geometries) may claim it: distances only. Embree's
+  // grid lets some slip through between its triangles (167 of 12000 here).
+  int slipped = 0;
+  EXPECT_GT(compare(blocks, grid, dem, rays, 1e-5f, false, &slipped), 3500);
+  EXPECT_LT(slipped, 400);
+}
+
+TEST(HeightField, NoRaySlipsBetweenTriangles) {
+  // Straight down onto every vertex, every edge's midpoint and every
+  // diagonal's midpoint: each must hit at the surface's height there.
+  const HeightField dem = relief(40, 37);
+  const TerrainScene blocks(input_of(dem), TerrainGeometry::HeightField);
+  const auto local = [&](double c, double r) {
+    const auto p = dem.geo().cell_center(c, r);
+    return blocks.to_local({p[0], p[1], 0.0});
+  };
+  const float base = static_cast<float>(blocks.origin().z());
+  const Eigen::Vector3f down(0, 0, -1);
+  const float h = blocks.top() + 10.0f;
+  int missed = 0;
+  for (int r = 0; r + 1 < dem.height(); ++r)
+    for (int c = 0; c + 1 < dem.width(); ++c) {
+      const std::array<std::pair<Eigen::Vector3f, float>, 4> targets = {{
+          {local(c, r), dem(c, r) - base},
+          {local(c + 0.5, r), 0.5f * (dem(c, r) + dem(c + 1, r)) - base},
+          {local(c, r + 0.5), 0.5f * (dem(c, r) + dem(c, r + 1)) - base},
+          {local(c + 0.5, r + 0.5), 0.5f * (dem(c + 1, r) + dem(c, r + 1)) - base},  // v1-v3
+      }};
+      for (const auto& [p, z] : targets) {
+        const float t = blocks.hit_distance(Eigen::Vector3f(p.x(), p.y(), h), down);
+        if (t == kInf) {
+          if (missed < 6) ADD_FAILURE() << "miss c " << c << " r " << r << " p " << p.transpose() << " z " << z;
+          ++missed;
+          continue;
+        }
+        EXPECT_NEAR(h - t, z, 1e-3f) << "cell " << c << ", " << r;
+      }
+    }
+  EXPECT_EQ(missed, 0);
+}
+
+TEST(HeightField, AdoptedRasterGivesTheSameScene) {
+  const HeightField dem = relief(90, 40);
+  const SceneInput in = input_of(dem);
+  const TerrainScene copied(in);
+  HeightField moved = dem;
+  const TerrainScene adopted(in, std::move(moved));
+  EXPECT_TRUE(moved.empty());
+  EXPECT_EQ(copied.origin(), adopted.origin());
+  EXPECT_EQ(copied.top(), adopted.top());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3f o(u(rng) * 100, u(rng) * 40, 200.0f);
+    const Eigen::Vector3f d = Eigen::Vector3f(u(rng), u(rng), -1.0f).normalized();
+    EXPECT_EQ(copied.hit_distance(o, d), adopted.hit_distance(o, d));
+  }
+  // 4 B of height a cell and the min-max tree, against 12 B of float3 vertex.
+  EXPECT_LT(copied.terrain_bytes(), dem.size() * 5);
+  EXPECT_GE(TerrainScene(in, TerrainGeometry::Grid).terrain_bytes(), dem.size() * 16);
+}
