@@ -16,6 +16,7 @@
 #include "terrain/marks/marks.h"
 #include "terrain/marks/marks_parameters.h"
 #include "terrain/mesh_io.h"
+#include "terrain/height_change.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 
@@ -127,12 +128,8 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
   require_metric_crs(ground, c.ground);
   terrain::HeightField depth;
   if (!c.snow_depth.empty()) depth = read_snow_depth(c, ground);
-  if (c.add_snow) {  // mark the snow surface: ground + depth
-    for (std::size_t i = 0; i < ground.size(); ++i) {
-      const float d = depth.values()[i];
-      if (std::isfinite(d)) ground.values()[i] += d;
-    }
-  }
+  // Mark the snow surface: ground + depth.
+  if (c.add_snow) ground = terrain::lay_on_ground(ground, depth, "the snow depth");
   marks::MaterialField materials = ground_materials(c, track, depth, ground);
   if (!c.frames.empty()) make_frames_directory(c.frames);
   marks::StepFn on_step;

@@ -77,7 +77,7 @@ struct CameraRays {
 };
 CameraRays make_camera_rays(const TerrainScene& scene, const Camera& camera, int width, int height);
 
-// OpenEXR's standard attributes (ImfStandardAttributes.h), as Imath stores
+// OpenEXR's standard attributes (OpenEXR/ImfStandardAttributes.h), as Imath stores
 // them: row vectors, p' = p M, row-major. "World" is the scene's local frame
 // shifted by `local_to_world` (world = local + local_to_world), so the
 // numbers stay small. worldToCamera goes to RenderMan's camera space (x

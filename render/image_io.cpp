@@ -146,8 +146,9 @@ const char* reader_for(const std::filesystem::path& path) {
 }
 
 // OpenImageIO 2.4's OpenEXRCore reader asks its stream for the file's size
-// with tell() (exrinput_c.cpp, oiio_exr_query_size_func), which is 0 at the
-// start: OpenEXRCore then takes the size as unknown and skips every check of
+// with tell() (OpenImageIO's src/openexr.imageio/exrinput_c.cpp,
+// oiio_exr_query_size_func), which is 0 at the start: OpenEXRCore then takes
+// the size as unknown and skips every check of
 // a declared size against it (a 192-byte file had a 1.8 GB string attribute
 // allocated so). This stream answers tell() with the file's size.
 class SizedFile final : public OIIO::Filesystem::IOFile {

@@ -78,8 +78,8 @@ bool solid(const SoilState& s, std::size_t i) { return s.psi[i] >= kFull; }
 // One Jacobi pass of "up one voxel", in place per column: the excess of
 // voxel z is computed from the values before the pass (z is read before it is
 // written, and the carry holds what z - 1 sent up). Excess under a solid
-// body voxel stays where it is (bodies are solid, SPEC 5: soil never passes
-// through them); settle_overflow sends it sideways.
+// body voxel stays where it is (bodies are solid: soil never passes through
+// them, docs/soil.md, Method 4); settle_overflow sends it sideways.
 void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
   for_each_dirty_column(g, dirty, [&](std::size_t c) {

@@ -35,7 +35,7 @@ void resolve_overflow(SoilState& state, OverflowHeuristic heuristic, int passes,
                       const ColumnMask* dirty = nullptr);
 
 // Guarantees eq. 17 after resolve_overflow without moving soil through a
-// body (SPEC 5): soil inside a solid body voxel goes to the nearer face of
+// body (docs/soil.md, Method 4): soil inside a solid body voxel goes to the nearer face of
 // the body in its column; per run of open voxels of a column, bottom to top,
 // any excess is carried up to the next voxel with room and from the run's
 // top back down; what a run cannot hold (soil pressed under a body) goes

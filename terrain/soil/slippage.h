@@ -14,7 +14,8 @@
 // A pile resting on a body with no span beside its bottom gets an edge span
 // of zero height there (fig. 34-35), so its soil slides off and falls.
 //
-// Failure (SPEC 5, decisions where the thesis is silent): Li & Moshell's
+// Failure (docs/soil.md, Method 6, "Failure in metres": a decision where the
+// thesis is silent): Li & Moshell's
 // factor of safety is taken over the pile's real height in metres, not over
 // one voxel's step, so cohesion acts the same at any voxel size. Each pile
 // follows its steepest descent to the toe of its slope (the first pile

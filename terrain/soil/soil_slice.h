@@ -42,7 +42,7 @@ std::optional<double> failure_plane(double h, double dx, double c, double phi, d
 // beta = atan2(sin(phi) + k, cos(phi)) + acos(1 / R), R the norm of
 // (cos(phi), sin(phi) + k). phi for c = 0, pi / 2 once H is below the
 // critical height of a vertical cut. In metres, so the same heap settles the
-// same at any voxel size (SPEC 5, decisions).
+// same at any voxel size (docs/soil.md, Method 6, "Failure in metres").
 double rest_angle(double height, double c, double phi, double gamma);
 
 // Eq. 8: net force on the wedge sliding above the plane at theta (Li &

@@ -1,5 +1,6 @@
 // Surfaces of the voxel soil (paper 004, sec. 3.3): the iso-0.5 surface of
-// rho extracted with OpenVDB's volumeToMesh (one .cpp holds openvdb.h), and
+// rho extracted with OpenVDB's volumeToMesh (one .cpp, surface_vdb.cpp, includes
+// openvdb/openvdb.h), and
 // the density written as an OpenVDB grid for Blender and Houdini.
 //
 // Vertical ridges (thesis 3.3, fig. 42-43; fix suggested in 5.3.2, fig. 59):

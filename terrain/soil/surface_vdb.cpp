@@ -1,4 +1,5 @@
-// The one file that includes OpenVDB (a heavy header: docs/DESIGN.md).
+// The one file that includes OpenVDB (a heavy header: docs/architecture.md,
+// Debian 12 packages).
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/VolumeToMesh.h>

@@ -157,8 +157,8 @@ TEST(ImageIo, BadFilesAreErrorsNamingTheFile) {
 
 // An EXR header attribute declaring more bytes than the file holds is refused
 // before OpenEXR allocates it (a 973-byte file had 1.9 GB allocated; found by
-// fuzz_image, kept in tests/fuzz/regressions/image/; tests/fuzz/
-// image_allocation_test.cpp measures the allocations themselves).
+// fuzz_image, kept in tests/fuzz/regressions/image/;
+// tests/fuzz/reader_allocation_test.cpp measures the allocations themselves).
 TEST(ImageIo, ExrAttributeLargerThanTheFileIsRefusedBeforeAllocating) {
   const fs::path file = temp_dir() / "huge_attribute.exr";
   std::ofstream out(file, std::ios::binary);

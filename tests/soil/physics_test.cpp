@@ -64,8 +64,8 @@ TEST(SoilPhysics, NoSoilInsideRigidBodies) {
   EXPECT_GT(highest, 0.25f * 32 + 2.0f);
 }
 
-// Soil pressed under a body never passes through it (SPEC 5: bodies are
-// solid): a piston as tall as the grid drives into a layer of soil that fills
+// Soil pressed under a body never passes through it (bodies are solid:
+// docs/soil.md, Method 4): a piston as tall as the grid drives into a layer of soil that fills
 // the room under a static lid (the piston runs through it); the excess goes sideways to the open
 // end beyond the lid, none appears on the lid's top (away from that end, where the soil risen there
 // may slide onto it) and none inside any body, at any step. Before, the overflow's up-passes and

@@ -1,4 +1,5 @@
-// Piles that rest (issue 33, SPEC 5's decisions where the thesis is silent):
+// Piles that rest (issue 33; docs/soil.md, Method 6, "Failure in metres" and
+// "Coming to rest", decisions where the thesis is silent):
 // cohesion and friction act in metres over a pile's real height, so a heap
 // settles the same at any voxel size and a column above its critical height
 // collapses; piles stop moving; cones are round.
