@@ -65,7 +65,7 @@ struct HeightHit {
 class HeightFieldBlocks {
  public:
   static constexpr int kLeaf = 4;        // cells a side of a min-max leaf
-  static constexpr int kBlockLevels = 4;  // min-max levels inside a block
+  static constexpr int kBlockLevels = 3;  // min-max levels inside a block
   static constexpr int kBlock = kLeaf << (kBlockLevels - 1);  // cells a side of a block
 
   // Builds the min-max levels over `grid` (kept by pointer: it must outlive this).

@@ -34,6 +34,9 @@ using namespace drift;
 struct Fixture {
   pipeline::SceneFile scene;
   std::unique_ptr<render::TerrainScene> embree;
+  // The same terrain as Embree's grid geometry over float3 vertices (the
+  // geometry before issue 36), for the raw benchmarks' second argument.
+  std::unique_ptr<render::TerrainScene> grid;
   render::Camera camera;
 };
 
@@ -54,6 +57,7 @@ Fixture& fixture() {
     x.scene.terrain_raster = std::filesystem::path(DRIFT_SOURCE_DIR) / "out/yarigatake_utm.tif";
     pipeline::load_scene_terrain(x.scene);
     x.embree = std::make_unique<render::TerrainScene>(x.scene.input);
+    x.grid = std::make_unique<render::TerrainScene>(x.scene.input, render::TerrainGeometry::Grid);
     x.camera = render::default_camera(*x.embree);
     x.scene.settings.width = 1280;
     x.scene.settings.height = 720;
@@ -81,10 +85,13 @@ terrain::HeightField synthetic_dem(int n) {
 
 // Building the Embree scene of a large DEM: seconds, and bytes per DEM vertex
 // resident after the build and at its peak (the DEM itself, 4 B a vertex,
-// held by the caller, is not counted). The aim is <= 32 B a vertex: 12 B of
-// float3 vertices plus Embree's grid data.
+// held by the caller, is not counted). Second argument 0: the height-field
+// geometry (4 B of heights and the min-max tree), 1: Embree's grid geometry
+// (12 B of float3 vertices plus Embree's grid data, ~32 B).
 void BM_TerrainSceneBuild(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
+  const auto geometry =
+      state.range(1) ? render::TerrainGeometry::Grid : render::TerrainGeometry::HeightField;
   render::SceneInput input;
   input.terrain = synthetic_dem(n);
   const double vertices = static_cast<double>(n) * n;
@@ -93,7 +100,7 @@ void BM_TerrainSceneBuild(benchmark::State& state) {
     const std::uint64_t before = bench::resident_bytes();
     bench::reset_peak_resident();
     const auto start = std::chrono::steady_clock::now();
-    render::TerrainScene scene(input);
+    render::TerrainScene scene(input, geometry);
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     resident = static_cast<double>(bench::resident_bytes() - before);
     peak = static_cast<double>(bench::peak_resident_bytes() - before);
@@ -105,8 +112,10 @@ void BM_TerrainSceneBuild(benchmark::State& state) {
   state.counters["Mvertices/s"] = vertices / seconds / 1e6;
 }
 BENCHMARK(BM_TerrainSceneBuild)
-    ->Arg(4096)
-    ->Arg(8192)
+    ->Args({4096, 0})
+    ->Args({4096, 1})
+    ->Args({8192, 0})
+    ->Args({8192, 1})
     ->Iterations(1)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();
@@ -147,6 +156,7 @@ BENCHMARK(BM_PathTracerLightShafts)->Unit(benchmark::kSecond)->UseRealTime()->It
 // TBB threads: the most coherent rays of the frame.
 void BM_RawEmbreeCameraRays(benchmark::State& state) {
   Fixture& f = fixture();
+  const render::TerrainScene& scene = state.range(0) ? *f.grid : *f.embree;
   const auto& rs = f.scene.settings;
   const render::CameraRays pinhole =
       render::make_camera_rays(*f.embree, f.camera, rs.width, rs.height);
@@ -165,7 +175,7 @@ void BM_RawEmbreeCameraRays(benchmark::State& state) {
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         std::uint64_t local = 0;
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          local += f.embree->hits(pinhole.eye, dirs[i]);
+                          local += scene.hits(pinhole.eye, dirs[i]);
                         }
                         hits += local;
                       });
@@ -178,7 +188,13 @@ void BM_RawEmbreeCameraRays(benchmark::State& state) {
       static_cast<double>(hits) / (static_cast<double>(dirs.size()) * state.iterations());
   state.counters["peak_MiB"] = bench::peak_resident_mib();
 }
-BENCHMARK(BM_RawEmbreeCameraRays)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+// Argument 0: the height-field geometry; 1: Embree's grid geometry.
+BENCHMARK(BM_RawEmbreeCameraRays)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 // The path tracer's own rays (camera, bounce, shadow and cloud rays, in the
 // order each thread traced them), recorded once from the default frame at
@@ -224,8 +240,8 @@ std::vector<RecordedRay> record_path_tracer_rays() {
 // threads. BM_PathTracer's rays/s over this one's is how much of the frame's
 // time goes to Embree's traversal.
 void BM_RawEmbreeSameRays(benchmark::State& state) {
-  const std::vector<RecordedRay> rays = record_path_tracer_rays();
-  const render::TerrainScene& scene = *fixture().embree;
+  static const std::vector<RecordedRay> rays = record_path_tracer_rays();
+  const render::TerrainScene& scene = state.range(0) ? *fixture().grid : *fixture().embree;
   std::atomic<std::uint64_t> hits{0};
   double cpu = 0.0;
   for (auto _ : state) {
@@ -254,7 +270,13 @@ void BM_RawEmbreeSameRays(benchmark::State& state) {
   state.counters["hit_fraction"] =
       static_cast<double>(hits) / (static_cast<double>(rays.size()) * state.iterations());
 }
-BENCHMARK(BM_RawEmbreeSameRays)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
+// Argument 0: the height-field geometry; 1: Embree's grid geometry.
+BENCHMARK(BM_RawEmbreeSameRays)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime()
+    ->Iterations(3);
 
 }  // namespace
 

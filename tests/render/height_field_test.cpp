@@ -172,9 +172,14 @@ TEST(HeightField, NoRaySlipsBetweenTriangles) {
   // diagonal's midpoint: each must hit at the surface's height there.
   const HeightField dem = relief(40, 37);
   const TerrainScene blocks(input_of(dem), TerrainGeometry::HeightField);
+  // Vertices on the very floats the scene places them at (x0 + c dx,
+  // y0 - r dy), so that rays through them lie exactly on edges; midpoints
+  // as near as floats get.
+  const auto nw = dem.geo().cell_center(0, 0);
+  const Eigen::Vector3f x0 = blocks.to_local({nw[0], nw[1], 0.0});
   const auto local = [&](double c, double r) {
-    const auto p = dem.geo().cell_center(c, r);
-    return blocks.to_local({p[0], p[1], 0.0});
+    return Eigen::Vector3f(x0.x() + static_cast<float>(c) * 2.5f,
+                           x0.y() - static_cast<float>(r) * 2.5f, 0.0f);
   };
   const float base = static_cast<float>(blocks.origin().z());
   const Eigen::Vector3f down(0, 0, -1);
