@@ -112,7 +112,7 @@ TEST(MapRender, BoxAndCellChooseTheGridAndBadValuesAreRefused) {
   put(d / "view.toml", "[terrain]\nraster = \"dem.tif\"\n[render]\nspp = 1\n");
   EXPECT_EQ(run_drift("render " + (d / "view.toml").string() + " -o " + (d / "v.tif").string(), d),
             1);
-  EXPECT_NE(drift_log(d).find(".png or .exr"), std::string::npos) << drift_log(d);
+  EXPECT_NE(drift_log(d).find("use a .png, .exr or .json"), std::string::npos) << drift_log(d);
   EXPECT_EQ(run_drift("render " + (d / "view.toml").string() + " --map --size 8x8 -o " +
                           (d / "v.png").string(),
                       d),
