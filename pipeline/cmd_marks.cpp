@@ -13,10 +13,10 @@
 #include "pipeline/progress_bar.h"
 #include "pipeline/track_file.h"
 #include "terrain/error.h"
+#include "terrain/height_change.h"
 #include "terrain/marks/marks.h"
 #include "terrain/marks/marks_parameters.h"
 #include "terrain/mesh_io.h"
-#include "terrain/height_change.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 

@@ -14,6 +14,7 @@
 #include "pipeline/scene_file.h"
 #include "pipeline/scene_products.h"
 #include "pipeline/scene_variables.h"
+#include "render/camera_setup.h"
 #include "render/frame_sidecar.h"
 #include "render/image_io.h"
 #include "render/map_output.h"

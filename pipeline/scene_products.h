@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/scene_file.h"
+#include "pipeline/scene.h"
 #include "pipeline/toml_section.h"
 
 namespace drift::pipeline {

@@ -14,8 +14,6 @@
 
 namespace drift::render {
 
-class TerrainScene;
-
 enum class Projection {
   Perspective,  // a pinhole, or a thin lens with depth of field
   Map,          // orthographic, straight down over `map_box`: a georeferenced map
@@ -41,10 +39,6 @@ struct Camera {
   Projection projection = Projection::Perspective;
   std::array<double, 4> map_box{0, 0, 1, 1};
 };
-
-// The camera used when a scene names none: from above the DEM's southern edge,
-// looking north at its highest point.
-Camera default_camera(const TerrainScene& scene);
 
 // The primary rays of a camera in the scene's local frame (z up; straight up
 // or down keeps north as "up" in the image): a pinhole, or a thin lens with
@@ -75,7 +69,6 @@ struct CameraRays {
   // eye) to local point p: the EXR's Z.
   float view_depth(const Eigen::Vector3f& p) const;
 };
-CameraRays make_camera_rays(const TerrainScene& scene, const Camera& camera, int width, int height);
 
 // OpenEXR's standard attributes (OpenEXR/ImfStandardAttributes.h), as Imath stores
 // them: row vectors, p' = p M, row-major. "World" is the scene's local frame

@@ -27,8 +27,6 @@ inline void cover(Coverage& shares, int slot, float w) {
   shares[slot] += w;
 }
 
-struct TerrainSurface;
-
 // The channels of a surface's stack: its distinct names in stack order (the
 // base first), then those of the object layers, and the channel of every
 // entry. On objects only their object layers' channels are set.
@@ -38,7 +36,6 @@ struct CoverageChannels {
   std::vector<int> rules, layers, object_layers;
 };
 
-// Throws drift::Error if the stack has more than kMaxCoverage distinct names.
-CoverageChannels coverage_channels(const TerrainSurface& surface);
+// A surface's channels: coverage_channels() in render/surface.h.
 
 }  // namespace drift::render

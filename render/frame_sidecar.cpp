@@ -1,3 +1,4 @@
+#include "render/camera_setup.h"
 #include "render/frame_sidecar.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+#include "render/camera_setup.h"
 #include "render/renderer.h"
 
 #include <tbb/parallel_for.h>

@@ -148,4 +148,8 @@ SurfacePoint shade_terrain(const TerrainSurface& surface, double x, double y,
                            const Eigen::Vector3f& normal, double footprint,
                            const Relief& relief = {}, const CoverageChannels* channels = nullptr);
 
+// The coverage channels of a surface's stack (render/coverage.h). Throws
+// drift::Error if the stack has more than kMaxCoverage distinct names.
+CoverageChannels coverage_channels(const TerrainSurface& surface);
+
 }  // namespace drift::render

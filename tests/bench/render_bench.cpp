@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "pipeline/scene_file.h"
+#include "render/camera_setup.h"
 #include "render/renderer.h"
 #include "tests/bench/peak_memory.h"
 

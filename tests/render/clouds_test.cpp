@@ -3,6 +3,7 @@
 // its shadow darkens the ground under cloud and nowhere else, it appears in
 // the sky seen by rays, and a render with clouds is the same bits whatever
 // the thread count.
+#include "render/camera_setup.h"
 #include "render/clouds.h"
 
 #include <gtest/gtest.h>

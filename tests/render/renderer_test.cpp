@@ -1,6 +1,7 @@
 // Path tracer basics against closed forms: the cosine law under a sun, the white
 // furnace, grid-geometry hits on an analytic plane, and determinism across
 // thread counts.
+#include "render/camera_setup.h"
 #include "render/renderer.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,6 @@
 // Tiles across machines: bands rendered separately and merged are the same
 // bits as one render; a missing or doubled band is an error naming it.
+#include "render/camera_setup.h"
 #include "render/tiles.h"
 
 #include <gtest/gtest.h>
