@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <regex>
 #include <set>
 
@@ -578,11 +577,8 @@ void place_sun(SceneFile& scene) {
   }
   const auto lonlat = terrain::centre_lonlat(dem.geo(), dem.width(), dem.height());
   const render::SolarPosition sun = render::solar_position(*scene.sun_time, lonlat[1], lonlat[0]);
-  // Meridian convergence: the grid direction of true north at the centre.
-  const auto centre = dem.geo().cell_center((dem.width() - 1) / 2.0, (dem.height() - 1) / 2.0);
-  const auto north = terrain::from_lonlat(dem.geo().crs_wkt, lonlat[0], lonlat[1] + 1e-3);
-  const double convergence =
-      std::atan2(north[0] - centre[0], north[1] - centre[1]) * 180.0 / std::numbers::pi;
+  // True north turned to the grid's (meridian convergence at the centre).
+  const double convergence = terrain::grid_convergence_deg(dem.geo(), dem.width(), dem.height());
   scene.input.sun.azimuth_deg = std::fmod(sun.azimuth_deg + convergence + 720.0, 360.0);
   scene.input.sun.elevation_deg = sun.elevation_deg;
 }
