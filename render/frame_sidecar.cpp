@@ -40,7 +40,10 @@ std::string quoted(const std::string& s) {
 }
 
 std::string vec(const Eigen::Vector3d& v) {
-  return "[" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + "]";
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
+  std::string text = "[";
+  text.append(number(v.x())).append(", ").append(number(v.y())).append(", ");
+  return text.append(number(v.z())).append("]");
 }
 
 // Names with their Cryptomatte IDs: {"name": {"id_hex": ..., "id": float}}.
