@@ -94,9 +94,13 @@ marks::Material read_material_value(const toml::node& node, const fs::path& file
     m = *p;
   }
   m.name = s.string("name").value_or(m.name + "*");
-  m.theta_deg = s.number("theta", m.theta_deg, 1e-3, 90.0);
-  m.alpha = s.number("alpha", m.alpha, 0.0, 1.0);
-  m.sigma = s.number("roughness", m.sigma, 1e-3, 0.5);
+  // The ranges are the material's own (terrain/marks/material.h).
+  for (const terrain::Parameter<marks::Material>& p : marks::material_parameters()) {
+    const double v = s.number(p.key, p.get(m), p.lo, p.hi);
+    if (!p.admits(v))
+      s.invalid(p.key, "is " + terrain::refused_value(v) + "; it must lie in " + p.range());
+    p.set(m, v);
+  }
   s.finish();
   return m;
 }

@@ -1,27 +1,42 @@
 #include "terrain/marks/material.h"
 
 #include <cmath>
-#include <numbers>
 
+#include "terrain/angles.h"
 #include "terrain/error.h"
 
 namespace drift::marks {
 
-void Material::validate(const std::string& what) const {
-  auto bad = [&](const char* key, double v, const char* range) {
-    throw Error(what + ": material '" + name + "' has " + key + " = " + std::to_string(v) +
-                "; it must lie in " + range);
+const std::vector<terrain::Parameter<Material>>& material_parameters() {
+  using terrain::Ends;
+  static const std::vector<terrain::Parameter<Material>> table = {
+      {"theta_deg", "", 0.0, 90.0, Ends::OpenLow, false, "degrees",
+       "angle of the slope after slipping (90: never slips)",
+       DRIFT_PARAMETER_FIELD(Material, theta_deg), "theta"},
+      {"alpha", "", 0.0, 1.0, Ends::Closed, false, "",
+       "displaced share of the material an object pushes out (the rest is compressed)",
+       DRIFT_PARAMETER_FIELD(Material, alpha), "alpha"},
+      {"sigma", "", 0.0, 0.5, Ends::OpenLow, false, "",
+       "roughness: share of a slope's excess moved per pass", DRIFT_PARAMETER_FIELD(Material, sigma),
+       "roughness"},
   };
-  if (!(theta_deg > 0.0 && theta_deg <= 90.0)) bad("theta", theta_deg, "(0, 90] degrees");
-  if (!(alpha >= 0.0 && alpha <= 1.0)) bad("alpha", alpha, "[0, 1]");
-  if (!(sigma > 0.0 && sigma <= 0.5)) bad("sigma (roughness)", sigma, "(0, 0.5]");
+  return table;
+}
+
+void Material::validate(const std::string& what) const {
+  for (const terrain::Parameter<Material>& p : material_parameters()) {
+    if (!p.admits(p.get(*this)))
+      throw terrain::ParameterError(
+          what + ": material '" + name + "' " + p.key,
+          "is " + terrain::refused_value(p.get(*this)) + "; it must lie in " + p.range());
+  }
 }
 
 terrain::SlopeRule Material::slope_rule() const {
   terrain::SlopeRule r;
   // 90 degrees: the material stands vertical and never slips (paper: snow).
   r.tan_repose = theta_deg >= 90.0 ? std::numeric_limits<double>::infinity()
-                                   : std::tan(theta_deg * std::numbers::pi / 180.0);
+                                   : terrain::tan_degrees(theta_deg);
   r.fraction = sigma;
   r.rough = true;  // paper 000, 3.5: sigma sets the slumped slope's roughness
   return r;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "terrain/grid.h"
+#include "terrain/parameter.h"
 #include "terrain/slope_relax.h"
 
 namespace drift::marks {
@@ -27,10 +28,16 @@ struct Material {
   double alpha = 1.0;       // displaced share of the material an object pushes out
   double sigma = 0.2;       // roughness: share of a slope's excess moved per pass
 
-  // Throws drift::Error naming `what` and the bad value.
+  // Throws terrain::ParameterError naming `what`, the material, the key and
+  // the bad value (the ranges: material_parameters()).
   void validate(const std::string& what) const;
   terrain::SlopeRule slope_rule() const;
 };
+
+// The ranges of a material's numbers, one row each, as a track file names
+// them (key "theta", "alpha", "roughness"): the one check of Material::validate
+// and of track files' material tables.
+const std::vector<terrain::Parameter<Material>>& material_parameters();
 
 // The paper's preset by name (sand, mud, snow), or nothing.
 std::optional<Material> material_preset(const std::string& name);
