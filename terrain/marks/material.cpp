@@ -17,8 +17,8 @@ const std::vector<terrain::Parameter<Material>>& material_parameters() {
        "displaced share of the material an object pushes out (the rest is compressed)",
        DRIFT_PARAMETER_FIELD(Material, alpha), "alpha"},
       {"sigma", "", 0.0, 0.5, Ends::OpenLow, false, "",
-       "roughness: share of a slope's excess moved per pass", DRIFT_PARAMETER_FIELD(Material, sigma),
-       "roughness"},
+       "roughness: share of a slope's excess moved per pass",
+       DRIFT_PARAMETER_FIELD(Material, sigma), "roughness"},
   };
   return table;
 }
@@ -35,8 +35,8 @@ void Material::validate(const std::string& what) const {
 terrain::SlopeRule Material::slope_rule() const {
   terrain::SlopeRule r;
   // 90 degrees: the material stands vertical and never slips (paper: snow).
-  r.tan_repose = theta_deg >= 90.0 ? std::numeric_limits<double>::infinity()
-                                   : terrain::tan_degrees(theta_deg);
+  r.tan_repose =
+      theta_deg >= 90.0 ? std::numeric_limits<double>::infinity() : terrain::tan_degrees(theta_deg);
   r.fraction = sigma;
   r.rough = true;  // paper 000, 3.5: sigma sets the slumped slope's roughness
   return r;
