@@ -181,10 +181,16 @@ void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
   rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
   embree_->scene = rtcNewScene(embree_->device);
   rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
-  if (geometry == TerrainGeometry::Grid)
+  if (geometry == TerrainGeometry::Auto)
+    geometry = dem.size() < kHeightFieldMinCells ? TerrainGeometry::Grid
+                                                 : TerrainGeometry::HeightField;
+  if (geometry == TerrainGeometry::Grid) {
+    // The float3 vertex a cell and Embree's BVH over the grids.
+    require_memory(dem.size() * 32, "the terrain's grid geometry", "crop or resample the DEM");
     attach_terrain_grids();
-  else
+  } else {
     attach_height_field();
+  }
   attach_surround(input.surround);
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
   rtcCommitScene(embree_->scene);
