@@ -348,7 +348,11 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
   // The scene takes the DEM's storage for its heights: its cells are held once.
+  // The DEM's cells move into the scene (held once); its georeference stays
+  // with the input for the outputs that name it (EXR crsWKT, sidecar, map).
+  const terrain::GeoReference dem_geo = scene.input.terrain.geo();
   const render::TerrainScene embree_scene(scene.input, std::move(scene.input.terrain));
+  scene.input.terrain.geo() = dem_geo;
   const render::Camera camera =
       scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
   render::RenderStats stats;

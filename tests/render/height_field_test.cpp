@@ -209,9 +209,9 @@ TEST(HeightField, NoRaySlipsBetweenTriangles) {
 TEST(HeightField, AdoptedRasterGivesTheSameScene) {
   const HeightField dem = relief(90, 40);
   const SceneInput in = input_of(dem);
-  const TerrainScene copied(in);
+  const TerrainScene copied(in, TerrainGeometry::HeightField);
   HeightField moved = dem;
-  const TerrainScene adopted(in, std::move(moved));
+  const TerrainScene adopted(in, std::move(moved), TerrainGeometry::HeightField);
   EXPECT_TRUE(moved.empty());
   EXPECT_EQ(copied.origin(), adopted.origin());
   EXPECT_EQ(copied.top(), adopted.top());
