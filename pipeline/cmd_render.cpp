@@ -236,7 +236,8 @@ void check_outputs(const RenderOptions& o, SceneFile& scene) {
   } catch (const Error& e) {
     usage_error(std::string("--") + e.what());
   }
-  const render::TileRect rect = render::tile_rect(scene.settings.width, scene.settings.height, tile);
+  const render::TileRect rect =
+      render::tile_rect(scene.settings.width, scene.settings.height, tile);
   scene.settings.row_begin = rect.y.begin;
   scene.settings.row_end = rect.y.end;
   scene.settings.col_begin = rect.x.begin;
@@ -399,7 +400,8 @@ void add_render_command(CLI::App& root) {
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
   sub->add_option("--set", o->variables,
                   "NAME=VALUE: ${NAME} in the scene file's strings becomes VALUE (overrides its "
-                  "[variables]; e.g. --set OUT=build/out for the products it reads)");
+                  "[variables]; e.g. --set OUT=build/out for the products it reads)")
+      ->allow_extra_args(false);  // one NAME=VALUE a flag: a scene after it stays the scene
   whole_in_range(sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)"), 1,
                  render::RenderSettings::kMaxSamplesPerPixel);
   sub->add_option("--noise-target", o->noise_target,

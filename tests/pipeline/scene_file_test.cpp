@@ -242,6 +242,25 @@ TEST(RenderCommand, BadSizeIsAUsageError) {
   EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 2);
 }
 
+// --set before the scene file, as the gallery's Makefile gives it: one
+// NAME=VALUE a flag, so the scene stays the scene; the value reaches the paths.
+TEST(RenderCommand, SetGivesAVariableBeforeOrAfterTheScene) {
+  const fs::path scene = write_scene("vars.toml", "[terrain]\nraster = \"${DIR}/dem.tif\"\n");
+  const fs::path log = scene.parent_path() / "log.txt";
+  const std::string out = (scene.parent_path() / "x.png").string();
+  const std::string drift = std::string(DRIFT_EXECUTABLE) + " render ";
+  for (const std::string& args : {"--set DIR=/no/such " + scene.string() + " -o " + out,
+                                  scene.string() + " --set DIR=/no/such -o " + out}) {
+    const std::string cmd = drift + args + " 2>" + log.string();
+    EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1) << args;
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("/no/such/dem.tif"), std::string::npos) << args << ": " << text;
+  }
+  const std::string bad = drift + "--set 9X=1 " + scene.string() + " -o " + out + " 2>/dev/null";
+  EXPECT_EQ(WEXITSTATUS(std::system(bad.c_str())), 2);
+}
+
 TEST(SceneFile, ObjectsAreLoadedAndPlaced) {
   const fs::path dir = fs::temp_directory_path() / "drift_scene_tests" / "objects";
   fs::create_directories(dir);
