@@ -5,6 +5,8 @@
 #include <cstring>
 #include <numeric>
 
+#include "render/json_text.h"
+
 namespace drift::render {
 
 namespace {
@@ -22,22 +24,6 @@ std::uint32_t fmix32(std::uint32_t h) {
 
 // A JSON string literal of `s` (names are letters, digits, '_' and '-', but
 // object names come from files: escape what JSON requires).
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 }  // namespace
 

@@ -1,11 +1,12 @@
-#include "render/camera_setup.h"
 #include "render/frame_sidecar.h"
 
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
+#include "render/camera_setup.h"
 #include "render/cryptomatte.h"
+#include "render/json_text.h"
 #include "render/mattes.h"
 #include "render/terrain_scene.h"
 #include "terrain/direction.h"
@@ -20,25 +21,6 @@ std::string number(double v) {
   return buf;
 }
 
-std::string quoted(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (c == '\n') {
-      out += "\\n";
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
 std::string vec(const Eigen::Vector3d& v) {
   // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
   std::string text = "[";
@@ -51,8 +33,8 @@ std::string ids(const CryptomatteLayer& layer) {
   std::string out = "{";
   for (std::size_t i = 0; i < layer.names.size(); ++i) {
     const float id = cryptomatte_id(layer.names[i]);
-    out += (i ? ", " : "") + quoted(layer.names[i]) +
-           ": {\"id_hex\": " + quoted(cryptomatte_hex(id)) + ", \"id\": " + number(id) + "}";
+    out += (i ? ", " : "") + json_string(layer.names[i]) +
+           ": {\"id_hex\": " + json_string(cryptomatte_hex(id)) + ", \"id\": " + number(id) + "}";
   }
   return out + "}";
 }
@@ -109,7 +91,7 @@ std::string frame_sidecar_json(const TerrainScene& scene, const SceneInput& inpu
   j << "  \"sun\": {\"azimuth_deg\": " << number(input.sun.azimuth_deg)
     << ", \"elevation_deg\": " << number(input.sun.elevation_deg) << ", \"direction\": " << vec(sun)
     << "},\n";
-  j << "  \"crs_wkt\": " << quoted(input.terrain.geo().crs_wkt) << ",\n";
+  j << "  \"crs_wkt\": " << json_string(input.terrain.geo().crs_wkt) << ",\n";
   j << "  \"origin\": " << vec(world_origin)
     << ",\n  \"origin_note\": \"the EXR's P.X/Y/Z plus origin is the point in the CRS\",\n";
   const FrameMattes mattes(scene, input);

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "render/embree_ray.h"
 #include "render/ground_detail.h"
 #include "render/snow_flakes.h"
 #include "terrain/bilinear.h"
@@ -108,8 +109,7 @@ void height_intersect(const RTCIntersectFunctionNArguments* args) {
     const HeightRay& ray = own ? *own : *ctx->ray;
     float tfar = RTCRayN_tfar(rays, args->N, i);
     HeightHit hit;
-    if (!blocks->intersect(args->primID, ray, RTCRayN_tnear(rays, args->N, i), tfar, hit))
-      continue;
+    if (!blocks->intersect(args->primID, ray, RTCRayN_tnear(rays, args->N, i), tfar, hit)) continue;
     RTCRayN_tfar(rays, args->N, i) = tfar;
     RTCHitN_Ng_x(hits, args->N, i) = hit.ng.x();
     RTCHitN_Ng_y(hits, args->N, i) = hit.ng.y();
@@ -182,8 +182,8 @@ void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
   embree_->scene = rtcNewScene(embree_->device);
   rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
   if (geometry == TerrainGeometry::Auto)
-    geometry = dem.size() < kHeightFieldMinCells ? TerrainGeometry::Grid
-                                                 : TerrainGeometry::HeightField;
+    geometry =
+        dem.size() < kHeightFieldMinCells ? TerrainGeometry::Grid : TerrainGeometry::HeightField;
   if (geometry == TerrainGeometry::Grid) {
     // The float3 vertex a cell and Embree's BVH over the grids.
     require_memory(dem.size() * 32, "the terrain's grid geometry", "crop or resample the DEM");
@@ -426,13 +426,7 @@ RTCRayHit nearest_hit(RTCScene scene, const Eigen::Vector3f& o, const Eigen::Vec
   HeightContext context;
   rtcInitIntersectContext(&context.context);
   context.ray = &ray;
-  RTCRayHit rh{};
-  rh.ray.org_x = o.x(), rh.ray.org_y = o.y(), rh.ray.org_z = o.z();
-  rh.ray.dir_x = d.x(), rh.ray.dir_y = d.y(), rh.ray.dir_z = d.z();
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = std::numeric_limits<float>::infinity();
-  rh.ray.mask = 0xffffffffu;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = nearest_ray_hit(o, d);
   rtcIntersect1(scene, &context.context, &rh);
   return rh;
 }
