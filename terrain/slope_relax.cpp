@@ -210,6 +210,8 @@ class SlopeRelaxer {
   }
 
   bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < w_ && y < hgt_; }
+  // All 8 neighbours of (x, y) lie in the grid.
+  bool interior(int x, int y) const { return x > 0 && y > 0 && x < w_ - 1 && y < hgt_ - 1; }
   // Neighbour k of cell (x, y) lies in the grid.
   bool has(int x, int y, int k) const {
     return inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy);
@@ -265,7 +267,18 @@ class SlopeRelaxer {
     const SlopeRule& r = rule_at(i);
     const double hi = surface(i), t = tan_of(i, r);
     double* e = &ws_.excess_[8 * s];
-    for (int k = 0; k < 8; ++k) e[k] = has(x, y, k) ? pair_excess(hi, i + offset_[k], t, k) : -kInf;
+    if (interior(x, y) && !cells_.base) {
+      // The common case in a register-friendly form: the same sums as
+      // pair_excess, with the height field's data read once, not after every
+      // store to e (the compiler cannot tell e does not alias the vector).
+      const double* h = h_.data() + i;
+      for (int k = 0; k < 8; ++k) e[k] = hi - h[offset_[k]] - t * distance_[k];
+    } else if (interior(x, y)) {
+      for (int k = 0; k < 8; ++k) e[k] = pair_excess(hi, i + offset_[k], t, k);
+    } else {
+      for (int k = 0; k < 8; ++k)
+        e[k] = has(x, y, k) ? pair_excess(hi, i + offset_[k], t, k) : -kInf;
+    }
     const double room = std::max(h_[i] - floor(i), 0.0);
     double sum = 0.0, largest = 0.0;
     const double share = r.share == SlopeShare::Fraction ? r.fraction : 1.0;
@@ -292,12 +305,17 @@ class SlopeRelaxer {
   // towards it.
   template <class Fn>
   void for_offers(std::size_t i, int x, int y, const Fn& fn) const {
+    // The vectors' data once (the compiler cannot tell they do not alias h_).
+    const int* slot = ws_.slot_.data();
+    const double* excess = ws_.excess_.data();
+    const double tolerance = o_.tolerance;
+    const bool all = interior(x, y);
     for (int k = 0; k < 8; ++k) {
-      if (!has(x, y, k)) continue;
-      const int s = ws_.slot_[i + offset_[k]];
+      if (!all && !has(x, y, k)) continue;
+      const int s = slot[static_cast<std::ptrdiff_t>(i) + offset_[k]];
       if (s < 0) continue;
-      const double e = ws_.excess_[8 * static_cast<std::size_t>(s) + (7 - k)];
-      if (e > o_.tolerance) fn(static_cast<std::size_t>(s), e);
+      const double e = excess[8 * static_cast<std::size_t>(s) + (7 - k)];
+      if (e > tolerance) fn(static_cast<std::size_t>(s), e);
     }
   }
   // Phase 2: the share of its offers a taker takes (half the largest excess it is
@@ -320,11 +338,14 @@ class SlopeRelaxer {
     bool moved = false;
     float* disturbed = disturbed_ ? &disturbed_->values()[i] : nullptr;
     const int s = ws_.slot_[i];
+    const double* take = ws_.take_.data();
+    const double tolerance = o_.tolerance;
     if (s >= 0 && ws_.factor_[static_cast<std::size_t>(s)] > 0.0) {
       const double* e = &ws_.excess_[8 * static_cast<std::size_t>(s)];
       for (int k = 0; k < 8; ++k) {
-        if (e[k] <= o_.tolerance) continue;
-        const double f = flow(static_cast<std::size_t>(s), e[k], ws_.take_[i + offset_[k]]);
+        if (e[k] <= tolerance) continue;
+        const double f = flow(static_cast<std::size_t>(s), e[k],
+                              take[static_cast<std::ptrdiff_t>(i) + offset_[k]]);
         if (!(f > 0.0)) continue;
         out += f, moved = true;
         if (disturbed) *disturbed += static_cast<float>(f);
