@@ -81,11 +81,13 @@ measure() {
   printf -v "$mib_var" "%s" "$(python3 -c "print(round($k / 1024))")"
 }
 
-# relMSE of an EXR's RGB against a reference's.
+# relMSE of an EXR's RGB against a reference's: the mean squared error over
+# the square of the reference's mean.
 relmse() {
   local rms mean
-  rms=$(oiiotool "$1" --ch R,G,B "$2" --ch R,G,B --diff 2>&1 | sed -n 's/.*RMS error: *\([0-9.eE+-]*\).*/\1/p')
-  mean=$(oiiotool "$2" --ch R,G,B --stats 2>&1 | sed -n 's/.*Stats Avg: *//p' | head -1)
+  rms=$(oiiotool "$1" --ch R,G,B "$2" --ch R,G,B --diff 2>&1 | sed -n 's/.*RMS error = *//p')
+  oiiotool "$2" --ch R,G,B -o "$WORK/rgb.exr"
+  mean=$(oiiotool --stats "$WORK/rgb.exr" 2>&1 | sed -n 's/.*Stats Avg: *//p' | cut -d' ' -f1-3)
   python3 -c "m = sum(map(float, '$mean'.split())) / 3; print('%.4g' % ($rms ** 2 / m ** 2))"
 }
 
