@@ -3,7 +3,6 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -104,7 +103,7 @@ void HeightFieldBlocks::block_bounds(unsigned block, Eigen::Vector3f& lower,
 }
 
 bool HeightFieldBlocks::node_entry(int level, int ix, int iy, const HeightRay& ray, float tnear,
-                                   float tfar, float& entry) const {
+                                   float tfar, float& entry, float& exit) const {
   const Level& l = levels_[level];
   const int c0 = ix * l.size, c1 = std::min(c0 + l.size, cells_x_);
   const int r0 = iy * l.size, r1 = std::min(r0 + l.size, cells_y_);
@@ -124,51 +123,107 @@ bool HeightFieldBlocks::node_entry(int level, int ix, int iy, const HeightRay& r
     t1 = std::min(t1, v + std::fabs(v) * kSlabSlack);
   }
   entry = t0;
+  exit = t1;
   return t0 <= t1;
 }
 
-template <bool kAnyHit>
+namespace {
+
+// A vertex in the ray's sheared frame (Woop et al. 2013, eq. 1-2), computed
+// by one expression whatever the cell, row, leaf or block that asks for it,
+// so that the cells either side of an edge see the same floats.
+struct Sheared {
+  float x, y, z;
+};
+
+Sheared shear(const HeightRay& ray, float x, float y, float z) {
+  const float p[3] = {x - ray.origin.x(), y - ray.origin.y(), z - ray.origin.z()};
+  return {p[ray.kx] - ray.sx * p[ray.kz], p[ray.ky] - ray.sy * p[ray.kz], ray.sz * p[ray.kz]};
+}
+
+// Edge function e(P, Q) = Px Qy - Py Qx, in double: the products of floats
+// are exact there and the difference keeps its sign, and e(Q, P) = -e(P, Q)
+// exactly, so the two triangles on either side of an edge agree on it.
+double edge(const Sheared& p, const Sheared& q) {
+  return static_cast<double>(p.x) * q.y - static_cast<double>(p.y) * q.x;
+}
+
+// Widening of the cells a ray crosses in a row, in cells: far more than the
+// rounding of the ray's x there (a few ulps of the coordinates, 1e-3 of a
+// 10 m cell at 100 km), so that every cell whose triangles the exact test
+// could accept is tested.
+constexpr float kRowPad = 0.25f;
+constexpr float kCoordinateUlps = 1e-5f;
+
+}  // namespace
+
+template <bool kAnyHit, bool kAllCells>
 bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray, float tnear,
-                                   float& tfar, HeightHit& hit) const {
+                                   float& tfar, float enter, float exit, HeightHit& hit) const {
   constexpr int kV = kLeaf + 1;
   const int c0 = leaf_x * kLeaf, nc = std::min(kLeaf, cells_x_ - c0);
   const int r0 = leaf_y * kLeaf, nr = std::min(kLeaf, cells_y_ - r0);
-  // The leaf's vertices in the ray's sheared frame (Woop et al. 2013, eq. 1-2),
-  // each computed by one expression whatever the cell, leaf or block.
-  float px[kV][kV], py[kV][kV], pz[kV][kV];
-  for (int j = 0; j <= nr; ++j) {
-    const float y = grid_->y(r0 + j);
-    for (int i = 0; i <= nc; ++i) {
-      const float p[3] = {grid_->x(c0 + i) - ray.origin.x(), y - ray.origin.y(),
-                          grid_->at(c0 + i, r0 + j) - ray.origin.z()};
-      px[j][i] = p[ray.kx] - ray.sx * p[ray.kz];
-      py[j][i] = p[ray.ky] - ray.sy * p[ray.kz];
-      pz[j][i] = ray.sz * p[ray.kz];
-    }
-  }
-  // Edge functions e(P, Q) = Px Qy - Py Qx, in double: the products of floats
-  // are exact there and the difference keeps its sign, and e(Q, P) = -e(P, Q)
-  // exactly, so the two triangles on either side of an edge agree on it.
-  const auto e = [&](int i, int j, int k, int l) {
-    return static_cast<double>(px[j][i]) * py[l][k] - static_cast<double>(py[j][i]) * px[l][k];
-  };
+  const HeightGrid& g = *grid_;
+  const float xw = g.x(c0);
+  Sheared north[kV], south[kV];  // the row's vertices (rows j and j + 1)
+  double vertical[kV];           // e(v(i, j), v(i, j + 1)): west edge of cell i, east of i - 1
   bool found = false;
   for (int j = 0; j < nr; ++j) {
-    for (int i = 0; i < nc; ++i) {
-      const double top = e(i, j, i + 1, j);         // v0 -> v1
-      const double bottom = e(i, j + 1, i + 1, j + 1);  // v3 -> v2
-      const double west = e(i, j, i, j + 1);        // v0 -> v3
-      const double east = e(i + 1, j, i + 1, j + 1);  // v1 -> v2
-      const double diagonal = e(i + 1, j, i, j + 1);  // v1 -> v3
+    // The part of [enter, exit] where the ray is over this row of cells
+    // (y from y(r + 1) to y(r)), widened by a quarter cell.
+    const float yn = g.y(r0 + j), ys = g.y(r0 + j + 1);
+    const float pad_y = kRowPad * g.dy + kCoordinateUlps * (std::fabs(yn) + std::fabs(ys));
+    float ta = enter, tb = exit;
+    int lo = 0, hi = nc - 1;
+    if constexpr (kAllCells) {
+      // every cell of the row: the reference the walk must match
+    } else if (ray.parallel[1]) {
+      if (ray.origin.y() < ys - pad_y || ray.origin.y() > yn + pad_y) continue;
+    } else {
+      float u = (ys - pad_y - ray.origin.y()) * ray.inv_dir[1];
+      float v = (yn + pad_y - ray.origin.y()) * ray.inv_dir[1];
+      if (u > v) std::swap(u, v);
+      ta = std::max(ta, u - std::fabs(u) * kSlabSlack);
+      tb = std::min(tb, v + std::fabs(v) * kSlabSlack);
+      if (ta > tb) continue;
+    }
+    if constexpr (!kAllCells) {
+      // The columns under the ray there.
+      float xa = ray.origin.x(), xb = xa;
+      if (!ray.parallel[0]) {
+        xa = ray.origin.x() + ta * ray.dir.x();
+        xb = ray.origin.x() + tb * ray.dir.x();
+        if (xa > xb) std::swap(xa, xb);
+      }
+      const float slack = kRowPad + kCoordinateUlps * (std::fabs(xa) + std::fabs(xb)) / g.dx;
+      const float fa = std::max((xa - xw) / g.dx - slack, -1.0f);
+      const float fb = std::min((xb - xw) / g.dx + slack, static_cast<float>(nc));
+      if (!(fa <= fb)) continue;
+      lo = std::max(0, static_cast<int>(std::floor(fa)));
+      hi = std::min(nc - 1, static_cast<int>(std::floor(fb)));
+      if (lo > hi) continue;
+    }
+    for (int i = lo; i <= hi + 1; ++i) {
+      north[i] = shear(ray, g.x(c0 + i), yn, g.at(c0 + i, r0 + j));
+      south[i] = shear(ray, g.x(c0 + i), ys, g.at(c0 + i, r0 + j + 1));
+      vertical[i] = edge(north[i], south[i]);
+    }
+    for (int i = lo; i <= hi; ++i) {
+      const Sheared &p0 = north[i], &p1 = north[i + 1], &p2 = south[i + 1], &p3 = south[i];
+      const double top = edge(p0, p1);       // v0 -> v1
+      const double bottom = edge(p3, p2);    // v3 -> v2
+      const double west = vertical[i];       // v0 -> v3
+      const double east = vertical[i + 1];   // v1 -> v2
+      const double diagonal = edge(p1, p3);  // v1 -> v3
       // Triangle (A, B, C) has U = -e(B, C), V = -e(C, A), W = -e(A, B).
       for (int tri = 0; tri < 2; ++tri) {
         double u, v, w, az, bz, cz;
         if (tri == 0) {  // v0 v1 v3
           u = -diagonal, v = west, w = -top;
-          az = pz[j][i], bz = pz[j][i + 1], cz = pz[j + 1][i];
+          az = p0.z, bz = p1.z, cz = p3.z;
         } else {  // v2 v3 v1
           u = diagonal, v = -east, w = bottom;
-          az = pz[j + 1][i + 1], bz = pz[j + 1][i], cz = pz[j][i + 1];
+          az = p2.z, bz = p3.z, cz = p1.z;
         }
         if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) continue;
         const double det = u + v + w;
@@ -192,22 +247,22 @@ bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear,
                               HeightHit& hit) const {
   struct Entry {
     int level, ix, iy;
-    float t;
+    float t, exit;
   };
   // Depth-first, nearest child first: at most 3 siblings wait per level.
   Entry stack[4 * kBlockLevels];
   int n = 0;
   const int top = kBlockLevels - 1;
   const int bx = static_cast<int>(block % blocks_x_), by = static_cast<int>(block / blocks_x_);
-  float t = 0;
-  if (!node_entry(top, bx, by, ray, tnear, tfar, t)) return false;
-  stack[n++] = {top, bx, by, t};
+  float t = 0, exit = 0;
+  if (!node_entry(top, bx, by, ray, tnear, tfar, t, exit)) return false;
+  stack[n++] = {top, bx, by, t, exit};
   bool found = false;
   while (n > 0) {
     const Entry node = stack[--n];
     if (node.t > tfar) continue;  // a nearer hit was found meanwhile
     if (node.level == 0) {
-      if (trace_leaf<kAnyHit>(node.ix, node.iy, ray, tnear, tfar, hit)) {
+      if (trace_leaf<kAnyHit, false>(node.ix, node.iy, ray, tnear, tfar, node.t, node.exit, hit)) {
         found = true;
         if constexpr (kAnyHit) return true;
       }
@@ -218,8 +273,8 @@ bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear,
     int m = 0;
     for (int cy = 2 * node.iy; cy < std::min(2 * node.iy + 2, below.ny); ++cy)
       for (int cx = 2 * node.ix; cx < std::min(2 * node.ix + 2, below.nx); ++cx)
-        if (node_entry(node.level - 1, cx, cy, ray, tnear, tfar, t))
-          children[m++] = {node.level - 1, cx, cy, t};
+        if (node_entry(node.level - 1, cx, cy, ray, tnear, tfar, t, exit))
+          children[m++] = {node.level - 1, cx, cy, t, exit};
     // Farthest pushed first, so the nearest is taken next.
     for (int a = 1; a < m; ++a)  // insertion sort of at most 4, farthest first
       for (int b = a; b > 0 && children[b - 1].t < children[b].t; --b)
@@ -238,6 +293,15 @@ bool HeightFieldBlocks::intersect(unsigned block, const HeightRay& ray, float tn
   hit.ng = hit.triangle == 0 ? Eigen::Vector3f((v1 - v0).cross(v3 - v0))
                              : Eigen::Vector3f((v3 - v2).cross(v1 - v2));
   return true;
+}
+
+bool HeightFieldBlocks::intersect_every_cell(const HeightRay& ray, float tnear, float& tfar,
+                                             HeightHit& hit) const {
+  bool found = false;
+  for (int ly = 0; ly < levels_[0].ny; ++ly)
+    for (int lx = 0; lx < levels_[0].nx; ++lx)
+      found |= trace_leaf<false, true>(lx, ly, ray, tnear, tfar, tnear, tfar, hit);
+  return found;
 }
 
 bool HeightFieldBlocks::occluded(unsigned block, const HeightRay& ray, float tnear,

@@ -47,7 +47,7 @@ struct HeightGrid {
 // box tests and the shear of Woop et al.'s watertight triangle test.
 struct HeightRay {
   Eigen::Vector3f origin, dir, inv_dir;
-  bool parallel[3];  // dir[a] is 0: the ray stays in one plane of that axis
+  bool parallel[3];            // dir[a] is 0: the ray stays in one plane of that axis
   int kx = 0, ky = 1, kz = 2;  // dir's largest component is kz
   float sx = 0, sy = 0, sz = 1;
   HeightRay(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir);
@@ -64,8 +64,8 @@ struct HeightHit {
 
 class HeightFieldBlocks {
  public:
-  static constexpr int kLeaf = 4;        // cells a side of a min-max leaf
-  static constexpr int kBlockLevels = 3;  // min-max levels inside a block
+  static constexpr int kLeaf = 4;                             // cells a side of a min-max leaf
+  static constexpr int kBlockLevels = 3;                      // min-max levels inside a block
   static constexpr int kBlock = kLeaf << (kBlockLevels - 1);  // cells a side of a block
 
   // Builds the min-max levels over `grid` (kept by pointer: it must outlive this).
@@ -80,6 +80,10 @@ class HeightFieldBlocks {
   // distance and `hit` its cell and triangle. False if none.
   bool intersect(unsigned block, const HeightRay& ray, float tnear, float& tfar,
                  HeightHit& hit) const;
+  // The same as intersect() over the whole field without the tree and the
+  // rows' cell ranges: every cell's two triangles, leaf by leaf, row by row.
+  // For tests: the walk must give the same hit, bit for bit.
+  bool intersect_every_cell(const HeightRay& ray, float tnear, float& tfar, HeightHit& hit) const;
   // True if the ray meets the block's triangles with tnear < t <= tfar.
   bool occluded(unsigned block, const HeightRay& ray, float tnear, float tfar) const;
 
@@ -96,13 +100,17 @@ class HeightFieldBlocks {
   };
   template <bool kAnyHit>
   bool trace(unsigned block, const HeightRay& ray, float tnear, float& tfar, HeightHit& hit) const;
-  template <bool kAnyHit>
+  // The leaf's triangles the ray can meet while inside the leaf's box, which
+  // it enters at `enter` and leaves at `exit` (node_entry's distances): only
+  // the cells under the ray's path across each row of cells, found from the
+  // ray's x at the row's edges, widened by a quarter cell either side.
+  template <bool kAnyHit, bool kAllCells>
   bool trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray, float tnear, float& tfar,
-                  HeightHit& hit) const;
-  // The ray's entry distance into node (level, ix, iy) within [tnear, tfar],
-  // or a negative number if it misses.
+                  float enter, float exit, HeightHit& hit) const;
+  // The ray's entry and exit distances of node (level, ix, iy) within
+  // [tnear, tfar] (widened by the slab slack); false if it misses.
   bool node_entry(int level, int ix, int iy, const HeightRay& ray, float tnear, float tfar,
-                  float& entry) const;
+                  float& entry, float& exit) const;
 
   const HeightGrid* grid_;
   int cells_x_ = 0, cells_y_ = 0;
