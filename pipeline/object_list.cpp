@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pipeline/toml_section.h"
+#include "terrain/angles.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/mesh_io.h"
@@ -54,7 +55,7 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs:
       if (extra) extra(obj, out.size());
       obj.finish();
       placed.mesh = mesh_file(mesh_path(file, *mesh), y_up);
-      const double a = rotate * M_PI / 180.0;
+      const double a = terrain::radians(rotate);
       placed.position = position ? *position : Eigen::Vector3d::Zero();
       for (auto& p : placed.mesh.positions) {
         const double x = p.x() * scale, y = p.y() * scale, z = p.z() * scale;

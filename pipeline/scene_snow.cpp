@@ -39,10 +39,8 @@ void place_snowy_objects(SceneFile& scene, const std::filesystem::path& file) {
 struct SnowLook {
   render::Material material = *render::material_preset("snow");
   // Kubelka-Munk scattering coefficient of the snowpack, per metre
-  // (render::LayerThickness): 400/m is fresh snow of about 0.1 mm grains at
-  // 300 kg/m^3 (reduced scattering ~500/m, Wiscombe & Warren 1980); 1 cm over
-  // black rock then reflects 0.79 where deep snow reflects 0.90.
-  float scattering = 400.0f;
+  // (render::LayerThickness); [snow] scattering overrides fresh snow's.
+  float scattering = render::kFreshSnowScattering;
   float cover_outside = 0.0f;  // the cover beyond its raster (a cropped snowfall)
 };
 

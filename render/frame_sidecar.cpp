@@ -9,6 +9,7 @@
 #include "render/json_text.h"
 #include "render/mattes.h"
 #include "render/terrain_scene.h"
+#include "terrain/angles.h"
 #include "terrain/direction.h"
 
 namespace drift::render {
@@ -70,7 +71,7 @@ std::string frame_sidecar_json(const TerrainScene& scene, const SceneInput& inpu
       << ", \"cx\": " << number(0.5 * w - 0.5) << ", \"cy\": " << number(0.5 * h - 0.5)
       << ", \"K\": [[" << number(f) << ", 0, " << number(0.5 * w - 0.5) << "], [0, " << number(f)
       << ", " << number(0.5 * h - 0.5) << "], [0, 0, 1]]"
-      << ", \"vertical_fov_deg\": " << number(2.0 * std::atan(rays.tan_half) * 180.0 / M_PI)
+      << ", \"vertical_fov_deg\": " << number(terrain::degrees(2.0 * std::atan(rays.tan_half)))
       << ", \"lens_radius_m\": " << number(rays.lens_radius)
       << ", \"focus_distance_m\": " << number(rays.focus_distance) << "},\n";
   }

@@ -2,16 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <regex>
 
+#include "terrain/angles.h"
 #include "terrain/error.h"
 
 namespace drift::render {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kDeg = terrain::kRadiansPerDegree<double>;
 
 bool leap(int y) { return (y % 4 == 0 && y % 100 != 0) || y % 400 == 0; }
 

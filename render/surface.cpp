@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <string>
 
 #include "render/ground_detail.h"
 #include "render/land_form.h"
 #include "render/snow_flakes.h"
 #include "render/tonemap.h"
+#include "terrain/angles.h"
 #include "terrain/bilinear.h"
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
@@ -157,12 +157,12 @@ void apply_normal_detail(const NormalDetail& r, double x, double y, const Eigen:
                          double footprint, SurfacePoint& p) {
   // Ripples live on sand: not under snow, not on slip faces.
   const float slope_deg =
-      std::acos(std::clamp(normal.z(), -1.0f, 1.0f)) * static_cast<float>(180.0 / std::numbers::pi);
+      std::acos(std::clamp(normal.z(), -1.0f, 1.0f)) * terrain::kDegreesPerRadian<float>;
   const float keep =
       (1.0f - p.buried) * (1.0f - smoothstep(r.fade_start_deg, r.fade_end_deg, slope_deg));
   if (keep <= 0.0f) return;
   // Ground (x, y) -> tile (u, v): turn by -rotation (the tile is turned clockwise).
-  const double a = r.rotation_deg * std::numbers::pi / 180.0;
+  const double a = terrain::radians(r.rotation_deg);
   const double c = std::cos(a), s = std::sin(a);
   const double u = c * x - s * y, v = s * x + c * y;
   const SlopePyramid::Moments m = r.slopes.sample_moments(u, v, footprint);

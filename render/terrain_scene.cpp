@@ -6,13 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <optional>
 #include <string>
 
 #include "render/embree_ray.h"
 #include "render/ground_detail.h"
 #include "render/snow_flakes.h"
+#include "terrain/angles.h"
 #include "terrain/bilinear.h"
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
@@ -487,7 +487,7 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
   Relief relief;
   relief.altitude = static_cast<float>(world.z() / exaggeration_);
   relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
-                     static_cast<float>(180.0 / std::numbers::pi);
+                     terrain::kDegreesPerRadian<float>;
   relief.z = world.z();
   relief.ray = hit.direction;
   const SurfacePoint surface =

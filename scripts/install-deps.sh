@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config make
+  build-essential cmake pkg-config make ccache
   libembree-dev libeigen3-dev libtbb-dev
   libopenimageio-dev libopenexr-dev
   libgdal-dev gdal-bin python3-gdal python3-numpy

@@ -19,6 +19,13 @@ constexpr T degrees(T radians) {
   return radians * T(180) / std::numbers::pi_v<T>;
 }
 
+// The factors themselves, for code that multiplies by one rounded constant
+// (a float shading path, a table of formulas in degrees).
+template <class T>
+inline constexpr T kRadiansPerDegree = static_cast<T>(std::numbers::pi / 180.0);
+template <class T>
+inline constexpr T kDegreesPerRadian = static_cast<T>(180.0 / std::numbers::pi);
+
 // The tangent of an angle given in degrees (slopes from repose angles).
 template <class T>
 T tan_degrees(T degrees_) {

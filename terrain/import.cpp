@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "terrain/angles.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
@@ -33,7 +34,7 @@ std::string fmt(double v) {
 // Metres per degree of latitude and longitude at `lat_deg` on WGS 84 (the
 // standard series expansion, accurate to centimetres).
 std::array<double, 2> metres_per_degree(double lat_deg) {
-  const double lat = lat_deg * M_PI / 180.0;
+  const double lat = terrain::radians(lat_deg);
   return {111412.84 * std::cos(lat) - 93.5 * std::cos(3 * lat),
           111132.92 - 559.82 * std::cos(2 * lat) + 1.175 * std::cos(4 * lat)};
 }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "terrain/marks/material.h"
@@ -31,5 +32,38 @@ TEST(MarksParameters, MaterialRangesHoldAtBothEndsWithTheStagesErrorType) {
       EXPECT_NO_THROW(m.validate("test")) << p.key;
     p.set(m, std::nan(""));
     EXPECT_THROW(m.validate("test"), drift::terrain::ParameterError) << p.key;
+  }
+}
+
+// docs/marks.md's two materials tables are the code's: the presets' numbers
+// (material_preset) and each track-file key's range and meaning
+// (material_parameters()), row by row, and nothing else.
+TEST(MarksParameters, DocsMaterialsTablesAgreeWithThePresetsAndTheRows) {
+  using drift::testing::markdown_table;
+  using drift::terrain::format_value;
+  const auto presets =
+      markdown_table("docs/marks.md", "| preset | theta (deg) | alpha | sigma |");
+  std::size_t listed = 0;
+  for (const std::string name : {"sand", "mud", "snow"}) {
+    const Material m = *material_preset(name);
+    const auto row = std::find_if(presets.begin(), presets.end(),
+                                  [&](const auto& cells) { return cells.at(0) == name; });
+    ASSERT_NE(row, presets.end()) << name << " is not in docs/marks.md's presets table";
+    ++listed;
+    EXPECT_EQ(row->at(1), format_value(m.theta_deg)) << name;
+    EXPECT_EQ(row->at(2), format_value(m.alpha)) << name;
+    EXPECT_EQ(row->at(3), format_value(m.sigma)) << name;
+  }
+  EXPECT_EQ(presets.size(), listed) << "docs/marks.md lists other presets";
+
+  const auto keys = markdown_table("docs/marks.md", "| material key | range | meaning |");
+  ASSERT_EQ(keys.size(), material_parameters().size()) << "docs/marks.md's material keys";
+  for (const auto& p : material_parameters()) {
+    const std::string label = std::string("`") + p.key + "`";
+    const auto row = std::find_if(keys.begin(), keys.end(),
+                                  [&](const auto& cells) { return cells.at(0) == label; });
+    ASSERT_NE(row, keys.end()) << label << " is not in docs/marks.md's material keys";
+    EXPECT_EQ(row->at(1), p.range()) << label;
+    EXPECT_EQ(row->at(2), p.meaning) << label;
   }
 }
