@@ -3,10 +3,10 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 
 namespace drift::render {
@@ -40,9 +40,9 @@ HeightRay::HeightRay(const Eigen::Vector3f& o, const Eigen::Vector3f& d) : origi
   sz = 1.0f / d[kz];
 }
 
-HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
-  cells_x_ = grid.width - 1;
-  cells_y_ = grid.height - 1;
+void HeightFieldBlocks::size_levels() {
+  cells_x_ = grid_->width - 1;
+  cells_y_ = grid_->height - 1;
   blocks_x_ = (cells_x_ + kBlock - 1) / kBlock;
   blocks_y_ = (cells_y_ + kBlock - 1) / kBlock;
   levels_.resize(kBlockLevels);
@@ -53,6 +53,10 @@ HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
     level.ny = (cells_y_ + level.size - 1) / level.size;
     level.nodes.resize(static_cast<std::size_t>(level.nx) * level.ny);
   }
+}
+
+HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
+  size_levels();
   // Leaves from the heights (every vertex of their cells, edges included),
   // each level above from the one below.
   Level& leaves = levels_[0];
@@ -69,6 +73,20 @@ HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
       leaves.nodes[static_cast<std::size_t>(iy) * leaves.nx + ix] = m;
     }
   });
+  build_upper_levels();
+}
+
+HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid, const HeightSource& source,
+                                     std::vector<MinMax> leaves)
+    : grid_(&grid), source_(&source) {
+  size_levels();
+  if (leaves.size() != levels_[0].nodes.size() || source.page_cells() % kBlock != 0)
+    throw std::invalid_argument("HeightFieldBlocks: leaves or pages do not fit the grid");
+  levels_[0].nodes = std::move(leaves);
+  build_upper_levels();
+}
+
+void HeightFieldBlocks::build_upper_levels() {
   for (int l = 1; l < kBlockLevels; ++l) {
     const Level& below = levels_[l - 1];
     Level& level = levels_[l];
@@ -84,6 +102,13 @@ HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
       }
     });
   }
+}
+
+HeightPage HeightFieldBlocks::heights_of(unsigned block, std::shared_ptr<const void>& pin) const {
+  if (!source_) return {0, 0, static_cast<std::size_t>(grid_->width), grid_->z.data()};
+  const int blocks_a_page = source_->page_cells() / kBlock;
+  const int bx = static_cast<int>(block % blocks_x_), by = static_cast<int>(block / blocks_x_);
+  return source_->page(bx / blocks_a_page, by / blocks_a_page, pin);
 }
 
 std::size_t HeightFieldBlocks::bytes() const {
@@ -128,8 +153,9 @@ bool HeightFieldBlocks::node_entry(int level, int ix, int iy, const HeightRay& r
 }
 
 template <bool kAnyHit>
-bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray, float tnear,
-                                   float& tfar, HeightHit& hit) const {
+bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightPage& page,
+                                   const HeightRay& ray, float tnear, float& tfar,
+                                   HeightHit& hit) const {
   constexpr int kV = kLeaf + 1;
   const int c0 = leaf_x * kLeaf, nc = std::min(kLeaf, cells_x_ - c0);
   const int r0 = leaf_y * kLeaf, nr = std::min(kLeaf, cells_y_ - r0);
@@ -140,7 +166,7 @@ bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray,
     const float y = grid_->y(r0 + j);
     for (int i = 0; i <= nc; ++i) {
       const float p[3] = {grid_->x(c0 + i) - ray.origin.x(), y - ray.origin.y(),
-                          grid_->at(c0 + i, r0 + j) - ray.origin.z()};
+                          page.at(c0 + i, r0 + j) - ray.origin.z()};
       px[j][i] = p[ray.kx] - ray.sx * p[ray.kz];
       py[j][i] = p[ray.ky] - ray.sy * p[ray.kz];
       pz[j][i] = ray.sz * p[ray.kz];
@@ -155,11 +181,11 @@ bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray,
   bool found = false;
   for (int j = 0; j < nr; ++j) {
     for (int i = 0; i < nc; ++i) {
-      const double top = e(i, j, i + 1, j);         // v0 -> v1
+      const double top = e(i, j, i + 1, j);             // v0 -> v1
       const double bottom = e(i, j + 1, i + 1, j + 1);  // v3 -> v2
-      const double west = e(i, j, i, j + 1);        // v0 -> v3
-      const double east = e(i + 1, j, i + 1, j + 1);  // v1 -> v2
-      const double diagonal = e(i + 1, j, i, j + 1);  // v1 -> v3
+      const double west = e(i, j, i, j + 1);            // v0 -> v3
+      const double east = e(i + 1, j, i + 1, j + 1);    // v1 -> v2
+      const double diagonal = e(i + 1, j, i, j + 1);    // v1 -> v3
       // Triangle (A, B, C) has U = -e(B, C), V = -e(C, A), W = -e(A, B).
       for (int tri = 0; tri < 2; ++tri) {
         double u, v, w, az, bz, cz;
@@ -188,8 +214,8 @@ bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray,
 }
 
 template <bool kAnyHit>
-bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear, float& tfar,
-                              HeightHit& hit) const {
+bool HeightFieldBlocks::trace(unsigned block, const HeightPage& page, const HeightRay& ray,
+                              float tnear, float& tfar, HeightHit& hit) const {
   struct Entry {
     int level, ix, iy;
     float t;
@@ -207,7 +233,7 @@ bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear,
     const Entry node = stack[--n];
     if (node.t > tfar) continue;  // a nearer hit was found meanwhile
     if (node.level == 0) {
-      if (trace_leaf<kAnyHit>(node.ix, node.iy, ray, tnear, tfar, hit)) {
+      if (trace_leaf<kAnyHit>(node.ix, node.iy, page, ray, tnear, tfar, hit)) {
         found = true;
         if constexpr (kAnyHit) return true;
       }
@@ -231,10 +257,15 @@ bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear,
 
 bool HeightFieldBlocks::intersect(unsigned block, const HeightRay& ray, float tnear, float& tfar,
                                   HeightHit& hit) const {
-  if (!trace<false>(block, ray, tnear, tfar, hit)) return false;
+  std::shared_ptr<const void> pin;
+  const HeightPage page = heights_of(block, pin);
+  if (!trace<false>(block, page, ray, tnear, tfar, hit)) return false;
   const int c = hit.cell_x, r = hit.cell_row;
-  const Eigen::Vector3f v0 = grid_->vertex(c, r), v1 = grid_->vertex(c + 1, r);
-  const Eigen::Vector3f v2 = grid_->vertex(c + 1, r + 1), v3 = grid_->vertex(c, r + 1);
+  const auto vertex = [&](int cc, int rr) {
+    return Eigen::Vector3f(grid_->x(cc), grid_->y(rr), page.at(cc, rr));
+  };
+  const Eigen::Vector3f v0 = vertex(c, r), v1 = vertex(c + 1, r);
+  const Eigen::Vector3f v2 = vertex(c + 1, r + 1), v3 = vertex(c, r + 1);
   hit.ng = hit.triangle == 0 ? Eigen::Vector3f((v1 - v0).cross(v3 - v0))
                              : Eigen::Vector3f((v3 - v2).cross(v1 - v2));
   return true;
@@ -243,7 +274,9 @@ bool HeightFieldBlocks::intersect(unsigned block, const HeightRay& ray, float tn
 bool HeightFieldBlocks::occluded(unsigned block, const HeightRay& ray, float tnear,
                                  float tfar) const {
   HeightHit hit;
-  return trace<true>(block, ray, tnear, tfar, hit);
+  std::shared_ptr<const void> pin;
+  const HeightPage page = heights_of(block, pin);
+  return trace<true>(block, page, ray, tnear, tfar, hit);
 }
 
 }  // namespace drift::render
