@@ -181,11 +181,11 @@ bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightPage& pag
   bool found = false;
   for (int j = 0; j < nr; ++j) {
     for (int i = 0; i < nc; ++i) {
-      const double top = e(i, j, i + 1, j);             // v0 -> v1
+      const double top = e(i, j, i + 1, j);         // v0 -> v1
       const double bottom = e(i, j + 1, i + 1, j + 1);  // v3 -> v2
-      const double west = e(i, j, i, j + 1);            // v0 -> v3
-      const double east = e(i + 1, j, i + 1, j + 1);    // v1 -> v2
-      const double diagonal = e(i + 1, j, i, j + 1);    // v1 -> v3
+      const double west = e(i, j, i, j + 1);        // v0 -> v3
+      const double east = e(i + 1, j, i + 1, j + 1);  // v1 -> v2
+      const double diagonal = e(i + 1, j, i, j + 1);  // v1 -> v3
       // Triangle (A, B, C) has U = -e(B, C), V = -e(C, A), W = -e(A, B).
       for (int tri = 0; tri < 2; ++tri) {
         double u, v, w, az, bz, cz;
