@@ -39,8 +39,12 @@ PagedTerrain::PagedTerrain(const std::filesystem::path& dem, std::uint64_t memor
   if (page_cells_ < HeightFieldBlocks::kBlock || page_cells_ % HeightFieldBlocks::kBlock != 0)
     throw Error("page size " + std::to_string(page_cells_) + " is not a multiple of " +
                 std::to_string(HeightFieldBlocks::kBlock) + " cells");
-  cache_ = std::make_unique<BlockCache>(memory_budget, page_bytes(),
-                                        [this](std::uint64_t key) { return load(key); });
+  try {
+    cache_ = std::make_unique<BlockCache>(memory_budget, page_bytes(),
+                                          [this](std::uint64_t key) { return load(key); });
+  } catch (const Error& e) {
+    throw Error(name + ": " + e.what());  // which render's budget, for which DEM
+  }
   pages_x_ = (w - 2) / page_cells_ + 1;
   pages_y_ = (h - 2) / page_cells_ + 1;
   frame_.width = w;

@@ -155,7 +155,10 @@ TEST(PagedTerrain, RefusesABudgetBelowOnePage) {
     PagedTerrain paged(dem, 1000, 1.0f, kPage);
     FAIL() << "a budget of 1000 B was taken for pages of 4356 B";
   } catch (const drift::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("cannot hold one block"), std::string::npos) << e.what();
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cannot hold one block"), std::string::npos) << what;
+    EXPECT_NE(what.find(dem.string()), std::string::npos) << what;  // which DEM
+    EXPECT_NE(what.find("4356 B"), std::string::npos) << what;      // a page's size
   }
 }
 
