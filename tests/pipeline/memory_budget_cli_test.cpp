@@ -24,7 +24,7 @@ struct Result {
   std::string log;
 };
 
-Result drift(const std::string& args, const fs::path& d) {
+Result run_drift(const std::string& args, const fs::path& d) {
   const fs::path log = d / "log.txt";
   const std::string cmd =
       std::string("timeout 300 ") + DRIFT_EXECUTABLE + " " + args + " > " + log.string() + " 2>&1";
@@ -55,12 +55,12 @@ TEST(MemoryBudgetCli, TheSamePngAtAnyBudget) {
   const std::string s = scene(d).string();
   const std::string frame = " --size 40x24 --exposure 0 -o ";
   const Result small =
-      drift("render " + s + frame + (d / "small.png").string() + " --memory-budget 300K", d);
+      run_drift("render " + s + frame + (d / "small.png").string() + " --memory-budget 300K", d);
   ASSERT_EQ(small.status, 0) << small.log;
   EXPECT_NE(small.log.find("terrain cache: "), std::string::npos) << small.log;
   EXPECT_NE(small.log.find("of a 300.0 KiB budget"), std::string::npos) << small.log;
   const Result large =
-      drift("render " + s + frame + (d / "large.png").string() + " --memory-budget 64M", d);
+      run_drift("render " + s + frame + (d / "large.png").string() + " --memory-budget 64M", d);
   ASSERT_EQ(large.status, 0) << large.log;
   EXPECT_EQ(slurp(d / "small.png"), slurp(d / "large.png"));
 }
@@ -69,11 +69,11 @@ TEST(MemoryBudgetCli, RefusesABadBudgetAndWritesNothing) {
   const fs::path d = drift::testing::test_dir("drift_memory_budget_bad");
   const std::string s = scene(d).string();
   const std::string out = " --size 40x24 -o " + (d / "out.png").string();
-  const Result not_a_size = drift("render " + s + out + " --memory-budget 4X", d);
+  const Result not_a_size = run_drift("render " + s + out + " --memory-budget 4X", d);
   EXPECT_EQ(not_a_size.status, 2) << not_a_size.log;
   EXPECT_NE(not_a_size.log.find("--memory-budget '4X' is not a size"), std::string::npos)
       << not_a_size.log;
-  const Result too_small = drift("render " + s + out + " --memory-budget 100K", d);
+  const Result too_small = run_drift("render " + s + out + " --memory-budget 100K", d);
   EXPECT_EQ(too_small.status, 1) << too_small.log;
   EXPECT_NE(too_small.log.find("dem.tif"), std::string::npos) << too_small.log;
   EXPECT_NE(too_small.log.find("cannot hold one block"), std::string::npos) << too_small.log;
