@@ -18,10 +18,12 @@
 #include "render/frame_sidecar.h"
 #include "render/image_io.h"
 #include "render/map_output.h"
+#include "render/paged_terrain.h"
 #include "render/renderer.h"
 #include "render/tiles.h"
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 #include "terrain/output_set.h"
 
 namespace drift::pipeline {
@@ -56,6 +58,7 @@ struct RenderOptions {
   std::string from, to;  // --from/--to X,Y,Z in the CRS
   std::string map_box;
   double cell = 0.0;
+  std::string memory_budget;  // --memory-budget BYTES: the terrain out of core
 };
 
 // X,Y,Z (CRS metres) of --from or --to.
@@ -319,6 +322,17 @@ void print_summary(const SceneFile& scene, const render::Image& image,
   std::printf("\n");
 }
 
+// The out-of-core terrain's page cache over the render (render/block_cache.h).
+void print_cache(const render::PagedTerrain& paged) {
+  const render::BlockCacheStats c = paged.cache_stats();
+  std::printf(
+      "terrain cache: %llu hits, %llu misses, %s read in pages (%s in the opening scan), "
+      "peak resident %s of a %s budget\n",
+      static_cast<unsigned long long>(c.hits), static_cast<unsigned long long>(c.misses),
+      human_bytes(c.bytes_read).c_str(), human_bytes(paged.scan_bytes()).c_str(),
+      human_bytes(c.peak_resident).c_str(), human_bytes(paged.budget()).c_str());
+}
+
 // --set NAME=VALUE, each a usage error unless NAME can name a variable.
 SceneVariables scene_variables(const std::vector<std::string>& settings) {
   SceneVariables variables;
@@ -345,15 +359,38 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       if (f.extension() == ".png")
         for (const auto& side : render::map_png_sidecars(f)) written.push_back(side);
   }
+  std::optional<std::uint64_t> budget;
+  if (!o.memory_budget.empty()) {
+    budget = parse_byte_size(o.memory_budget);
+    if (!budget)
+      usage_error("--memory-budget '" + o.memory_budget +
+                  "' is not a size; give bytes with an optional K, M, G or T (e.g. 4G, 512M)");
+    // Out of core: what needs the relief before the scene (placing the
+    // camera, the sun) sees it at most 1024 cells a side; the scene reads
+    // the full raster in pages.
+    scene.coarse_terrain_side = 1024;
+  }
   OutputSet outputs(written, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
-  // The scene takes the DEM's storage for its heights: its cells are held once.
-  // The DEM's cells move into the scene (held once); its georeference stays
-  // with the input for the outputs that name it (EXR crsWKT, sidecar, map).
-  const terrain::GeoReference dem_geo = scene.input.terrain.geo();
-  const render::TerrainScene embree_scene(scene.input, std::move(scene.input.terrain));
-  scene.input.terrain.geo() = dem_geo;
+  // The DEM's cells move into the scene (held once), or stay on disk and are
+  // read in pages (--memory-budget); its georeference stays with the input
+  // for the outputs that name it (EXR crsWKT, sidecar, map).
+  std::unique_ptr<render::PagedTerrain> paged;
+  std::unique_ptr<render::TerrainScene> scene_holder;
+  if (budget) {
+    paged = std::make_unique<render::PagedTerrain>(
+        scene.terrain_raster, *budget, static_cast<float>(scene.input.vertical_exaggeration));
+    scene.input.terrain = terrain::HeightField();
+    scene.input.terrain.geo() = paged->geo();
+    scene_holder = std::make_unique<render::TerrainScene>(scene.input, *paged);
+  } else {
+    const terrain::GeoReference dem_geo = scene.input.terrain.geo();
+    scene_holder =
+        std::make_unique<render::TerrainScene>(scene.input, std::move(scene.input.terrain));
+    scene.input.terrain.geo() = dem_geo;
+  }
+  const render::TerrainScene& embree_scene = *scene_holder;
   const render::Camera camera =
       scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
   render::RenderStats stats;
@@ -374,6 +411,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   write_outputs(scene, image, embree_scene, camera);
   outputs.commit();
   print_summary(scene, image, stats, seconds);
+  if (paged) print_cache(*paged);
   print_exposure(image, scene.display, o.tile.empty());
 }
 
@@ -451,6 +489,10 @@ void add_render_command(CLI::App& root) {
                   "the map's cell size in metres (implies --map; default the "
                   "DEM's)")
       ->check(CLI::Range(1e-3, 1e6));
+  sub->add_option("--memory-budget", o->memory_budget,
+                  "render the terrain out of core: read its full-resolution heights in pages "
+                  "(e.g. from a VRT or tiled GeoTIFF of any size) through a cache of at most "
+                  "BYTES (e.g. 4G, 512M; docs/rendering.md)");
   add_seed_option(*sub, o->seed);
 }
 

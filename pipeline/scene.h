@@ -59,6 +59,9 @@ struct SceneFile {
   std::vector<std::pair<std::string, Loader>> product_loaders;
   double position_radius = 150.0;  // [terrain] position_radius: metres (render/land_form.h)
   int terrain_repeat = 1;          // [terrain] repeat: a tileable terrain laid out n x n (odd)
+  // > 0: load_scene_terrain reads the DEM resampled to at most this many
+  // cells a side (an out-of-core render reads the full one in pages).
+  int coarse_terrain_side = 0;
   // [camera] from_lonlat / to_lonlat: resolved into input.camera by
   // load_scene_terrain.
   std::optional<GeoPoint> camera_from_lonlat, camera_to_lonlat;

@@ -20,6 +20,7 @@
 #include "render/surface.h"
 #include "terrain/error.h"
 #include "terrain/geodesy.h"
+#include "terrain/raster_blocks.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -663,7 +664,15 @@ void place_map(SceneFile& scene) {
 
 void load_scene_terrain(SceneFile& scene) {
   render::TerrainSurface& surface = scene.input.surface;
-  scene.input.terrain = read_metric_raster(scene.terrain_raster);
+  if (scene.coarse_terrain_side > 0) {
+    if (scene.terrain_repeat > 1)
+      throw Error("[terrain] repeat cannot be used out of core (--memory-budget); remove one");
+    scene.input.terrain =
+        terrain::RasterBlockReader(scene.terrain_raster).read_coarse(scene.coarse_terrain_side);
+    require_metric_crs(scene.input.terrain, scene.terrain_raster);
+  } else {
+    scene.input.terrain = read_metric_raster(scene.terrain_raster);
+  }
   if (scene.terrain_repeat > 1) {
     scene.input.terrain = terrain::repeat_periodic(scene.input.terrain, scene.terrain_repeat);
   }

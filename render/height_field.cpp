@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 
 namespace drift::render {
@@ -39,9 +40,9 @@ HeightRay::HeightRay(const Eigen::Vector3f& o, const Eigen::Vector3f& d) : origi
   sz = 1.0f / d[kz];
 }
 
-HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
-  cells_x_ = grid.width - 1;
-  cells_y_ = grid.height - 1;
+void HeightFieldBlocks::size_levels() {
+  cells_x_ = grid_->width - 1;
+  cells_y_ = grid_->height - 1;
   blocks_x_ = (cells_x_ + kBlock - 1) / kBlock;
   blocks_y_ = (cells_y_ + kBlock - 1) / kBlock;
   levels_.resize(kBlockLevels);
@@ -52,6 +53,10 @@ HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
     level.ny = (cells_y_ + level.size - 1) / level.size;
     level.nodes.resize(static_cast<std::size_t>(level.nx) * level.ny);
   }
+}
+
+HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
+  size_levels();
   // Leaves from the heights (every vertex of their cells, edges included),
   // each level above from the one below.
   Level& leaves = levels_[0];
@@ -68,6 +73,20 @@ HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
       leaves.nodes[static_cast<std::size_t>(iy) * leaves.nx + ix] = m;
     }
   });
+  build_upper_levels();
+}
+
+HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid, const HeightSource& source,
+                                     std::vector<MinMax> leaves)
+    : grid_(&grid), source_(&source) {
+  size_levels();
+  if (leaves.size() != levels_[0].nodes.size() || source.page_cells() % kBlock != 0)
+    throw std::invalid_argument("HeightFieldBlocks: leaves or pages do not fit the grid");
+  levels_[0].nodes = std::move(leaves);
+  build_upper_levels();
+}
+
+void HeightFieldBlocks::build_upper_levels() {
   for (int l = 1; l < kBlockLevels; ++l) {
     const Level& below = levels_[l - 1];
     Level& level = levels_[l];
@@ -83,6 +102,13 @@ HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
       }
     });
   }
+}
+
+HeightPage HeightFieldBlocks::heights_of(unsigned block, std::shared_ptr<const void>& pin) const {
+  if (!source_) return {0, 0, static_cast<std::size_t>(grid_->width), grid_->z.data()};
+  const int blocks_a_page = source_->page_cells() / kBlock;
+  const int bx = static_cast<int>(block % blocks_x_), by = static_cast<int>(block / blocks_x_);
+  return source_->page(bx / blocks_a_page, by / blocks_a_page, pin);
 }
 
 std::size_t HeightFieldBlocks::bytes() const {
@@ -158,8 +184,9 @@ constexpr float kCoordinateUlps = 1e-5f;
 }  // namespace
 
 template <bool kAnyHit, bool kAllCells>
-bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray, float tnear,
-                                   float& tfar, float enter, float exit, HeightHit& hit) const {
+bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightPage& page,
+                                   const HeightRay& ray, float tnear, float& tfar, float enter,
+                                   float exit, HeightHit& hit) const {
   constexpr int kV = kLeaf + 1;
   const int c0 = leaf_x * kLeaf, nc = std::min(kLeaf, cells_x_ - c0);
   const int r0 = leaf_y * kLeaf, nr = std::min(kLeaf, cells_y_ - r0);
@@ -204,8 +231,8 @@ bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray,
       if (lo > hi) continue;
     }
     for (int i = lo; i <= hi + 1; ++i) {
-      north[i] = shear(ray, g.x(c0 + i), yn, g.at(c0 + i, r0 + j));
-      south[i] = shear(ray, g.x(c0 + i), ys, g.at(c0 + i, r0 + j + 1));
+      north[i] = shear(ray, g.x(c0 + i), yn, page.at(c0 + i, r0 + j));
+      south[i] = shear(ray, g.x(c0 + i), ys, page.at(c0 + i, r0 + j + 1));
       vertical[i] = edge(north[i], south[i]);
     }
     for (int i = lo; i <= hi; ++i) {
@@ -243,8 +270,8 @@ bool HeightFieldBlocks::trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray,
 }
 
 template <bool kAnyHit>
-bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear, float& tfar,
-                              HeightHit& hit) const {
+bool HeightFieldBlocks::trace(unsigned block, const HeightPage& page, const HeightRay& ray,
+                              float tnear, float& tfar, HeightHit& hit) const {
   struct Entry {
     int level, ix, iy;
     float t, exit;
@@ -262,7 +289,8 @@ bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear,
     const Entry node = stack[--n];
     if (node.t > tfar) continue;  // a nearer hit was found meanwhile
     if (node.level == 0) {
-      if (trace_leaf<kAnyHit, false>(node.ix, node.iy, ray, tnear, tfar, node.t, node.exit, hit)) {
+      if (trace_leaf<kAnyHit, false>(node.ix, node.iy, page, ray, tnear, tfar, node.t, node.exit,
+                                     hit)) {
         found = true;
         if constexpr (kAnyHit) return true;
       }
@@ -286,10 +314,15 @@ bool HeightFieldBlocks::trace(unsigned block, const HeightRay& ray, float tnear,
 
 bool HeightFieldBlocks::intersect(unsigned block, const HeightRay& ray, float tnear, float& tfar,
                                   HeightHit& hit) const {
-  if (!trace<false>(block, ray, tnear, tfar, hit)) return false;
+  std::shared_ptr<const void> pin;
+  const HeightPage page = heights_of(block, pin);
+  if (!trace<false>(block, page, ray, tnear, tfar, hit)) return false;
   const int c = hit.cell_x, r = hit.cell_row;
-  const Eigen::Vector3f v0 = grid_->vertex(c, r), v1 = grid_->vertex(c + 1, r);
-  const Eigen::Vector3f v2 = grid_->vertex(c + 1, r + 1), v3 = grid_->vertex(c, r + 1);
+  const auto vertex = [&](int cc, int rr) {
+    return Eigen::Vector3f(grid_->x(cc), grid_->y(rr), page.at(cc, rr));
+  };
+  const Eigen::Vector3f v0 = vertex(c, r), v1 = vertex(c + 1, r);
+  const Eigen::Vector3f v2 = vertex(c + 1, r + 1), v3 = vertex(c, r + 1);
   hit.ng = hit.triangle == 0 ? Eigen::Vector3f((v1 - v0).cross(v3 - v0))
                              : Eigen::Vector3f((v3 - v2).cross(v1 - v2));
   return true;
@@ -298,16 +331,24 @@ bool HeightFieldBlocks::intersect(unsigned block, const HeightRay& ray, float tn
 bool HeightFieldBlocks::intersect_every_cell(const HeightRay& ray, float tnear, float& tfar,
                                              HeightHit& hit) const {
   bool found = false;
+  constexpr int kLeavesABlock = kBlock / kLeaf;
   for (int ly = 0; ly < levels_[0].ny; ++ly)
-    for (int lx = 0; lx < levels_[0].nx; ++lx)
-      found |= trace_leaf<false, true>(lx, ly, ray, tnear, tfar, tnear, tfar, hit);
+    for (int lx = 0; lx < levels_[0].nx; ++lx) {
+      const auto block =
+          static_cast<unsigned>((ly / kLeavesABlock) * blocks_x_ + lx / kLeavesABlock);
+      std::shared_ptr<const void> pin;
+      const HeightPage page = heights_of(block, pin);
+      found |= trace_leaf<false, true>(lx, ly, page, ray, tnear, tfar, tnear, tfar, hit);
+    }
   return found;
 }
 
 bool HeightFieldBlocks::occluded(unsigned block, const HeightRay& ray, float tnear,
                                  float tfar) const {
   HeightHit hit;
-  return trace<true>(block, ray, tnear, tfar, hit);
+  std::shared_ptr<const void> pin;
+  const HeightPage page = heights_of(block, pin);
+  return trace<true>(block, page, ray, tnear, tfar, hit);
 }
 
 }  // namespace drift::render

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace drift::render {
@@ -62,14 +63,41 @@ struct HeightHit {
   Eigen::Vector3f ng{0, 0, -1};
 };
 
+// Where the heights of a block come from when they are not all in memory
+// (render/paged_terrain.h reads them on demand; issue 36 item 2): square pages
+// of page_cells() cells, a multiple of HeightFieldBlocks::kBlock, each holding
+// its (page_cells() + 1)^2 vertices (one shared row and column with the next
+// page), so every block lies in one page.
+struct HeightPage {
+  int c0 = 0, r0 = 0;      // the page's first vertex
+  std::size_t stride = 0;  // floats a row
+  const float* z = nullptr;
+  float at(int c, int r) const { return z[static_cast<std::size_t>(r - r0) * stride + (c - c0)]; }
+};
+class HeightSource {
+ public:
+  virtual ~HeightSource() = default;
+  virtual int page_cells() const = 0;
+  // Page (page_x, page_y); `pin` keeps its heights alive while they are read.
+  virtual HeightPage page(int page_x, int page_y, std::shared_ptr<const void>& pin) const = 0;
+};
+
 class HeightFieldBlocks {
  public:
+  struct MinMax {
+    float lo, hi;
+  };
   static constexpr int kLeaf = 4;                             // cells a side of a min-max leaf
   static constexpr int kBlockLevels = 3;                      // min-max levels inside a block
   static constexpr int kBlock = kLeaf << (kBlockLevels - 1);  // cells a side of a block
 
   // Builds the min-max levels over `grid` (kept by pointer: it must outlive this).
   explicit HeightFieldBlocks(const HeightGrid& grid);
+  // Heights read from `source` instead (`grid` gives the frame; its z stays
+  // empty), over leaves min-max computed beforehand (kLeaf x kLeaf cells
+  // each, row-major, every vertex of their cells included). Both must
+  // outlive this.
+  HeightFieldBlocks(const HeightGrid& grid, const HeightSource& source, std::vector<MinMax> leaves);
 
   // Embree's primitives: blocks of kBlock x kBlock cells (fewer at the east
   // and south edges).
@@ -91,28 +119,31 @@ class HeightFieldBlocks {
   std::size_t bytes() const;
 
  private:
-  struct MinMax {
-    float lo, hi;
-  };
   struct Level {
     int nx = 0, ny = 0, size = 0;  // nodes a side, cells a node side
     std::vector<MinMax> nodes;
   };
+  void size_levels();
+  void build_upper_levels();
+  // The heights of `block`: the grid's, or its page of the source.
+  HeightPage heights_of(unsigned block, std::shared_ptr<const void>& pin) const;
   template <bool kAnyHit>
-  bool trace(unsigned block, const HeightRay& ray, float tnear, float& tfar, HeightHit& hit) const;
+  bool trace(unsigned block, const HeightPage& page, const HeightRay& ray, float tnear, float& tfar,
+             HeightHit& hit) const;
   // The leaf's triangles the ray can meet while inside the leaf's box, which
   // it enters at `enter` and leaves at `exit` (node_entry's distances): only
   // the cells under the ray's path across each row of cells, found from the
   // ray's x at the row's edges, widened by a quarter cell either side.
   template <bool kAnyHit, bool kAllCells>
-  bool trace_leaf(int leaf_x, int leaf_y, const HeightRay& ray, float tnear, float& tfar,
-                  float enter, float exit, HeightHit& hit) const;
+  bool trace_leaf(int leaf_x, int leaf_y, const HeightPage& page, const HeightRay& ray, float tnear,
+                  float& tfar, float enter, float exit, HeightHit& hit) const;
   // The ray's entry and exit distances of node (level, ix, iy) within
   // [tnear, tfar] (widened by the slab slack); false if it misses.
   bool node_entry(int level, int ix, int iy, const HeightRay& ray, float tnear, float tfar,
                   float& entry, float& exit) const;
 
   const HeightGrid* grid_;
+  const HeightSource* source_ = nullptr;  // none: the heights are grid_->z
   int cells_x_ = 0, cells_y_ = 0;
   int blocks_x_ = 0, blocks_y_ = 0;
   std::vector<Level> levels_;  // [0]: leaves of kLeaf cells; the last: blocks

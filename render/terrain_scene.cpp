@@ -11,6 +11,7 @@
 
 #include "render/embree_ray.h"
 #include "render/ground_detail.h"
+#include "render/paged_terrain.h"
 #include "render/snow_flakes.h"
 #include "terrain/angles.h"
 #include "terrain/bilinear.h"
@@ -163,6 +164,47 @@ TerrainScene::TerrainScene(const SceneInput& input, terrain::HeightField&& terra
   build(input, &terrain, geometry);
 }
 
+TerrainScene::TerrainScene(const SceneInput& input, PagedTerrain& paged)
+    : embree_(std::make_unique<Embree>()) {
+  build_paged(input, paged);
+}
+
+void TerrainScene::build_paged(const SceneInput& input, PagedTerrain& paged) {
+  if (!input.height_changes.empty())
+    throw Error("an out-of-core terrain (--memory-budget) cannot have height changes (snow depth) "
+                "laid on it; render without --memory-budget or lay them on the DEM first");
+  paged_ = &paged;
+  heights_ = paged.frame();
+  width_ = heights_.width;
+  height_ = heights_.height;
+  dx_ = heights_.dx;
+  dy_ = heights_.dy;
+  exaggeration_ = paged.exaggeration();
+  origin_ = paged.origin();
+  highest_ = paged.highest();
+  lowest_ = paged.lowest();
+  extent_ = {(width_ - 1) * dx_, (height_ - 1) * dy_};
+  surface_ = input.surface;
+  surface_.cell = std::min(std::abs(static_cast<float>(paged.geo().cell_size_x())),
+                           std::abs(static_cast<float>(paged.geo().cell_size_y())));
+  coverage_ = coverage_channels(surface_);
+  embree_->device = rtcNewDevice("threads=0");
+  if (!embree_->device) throw Error("cannot create an Embree device");
+  rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
+  embree_->scene = rtcNewScene(embree_->device);
+  rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
+  blocks_ = std::make_unique<HeightFieldBlocks>(heights_, paged, paged.take_leaves());
+  attach_blocks();
+  // The surround ring reads the DEM's whole edge from memory: not built here.
+  for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
+  rtcCommitScene(embree_->scene);
+  check_device(embree_->device, "build the scene");
+  RTCBounds bounds;
+  rtcGetSceneBounds(embree_->scene, &bounds);
+  bottom_ = bounds.lower_z;
+  top_ = bounds.upper_z;
+}
+
 void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
                          TerrainGeometry geometry) {
   const terrain::HeightField& ground = adopt ? *adopt : input.terrain;
@@ -273,6 +315,10 @@ void TerrainScene::fill_heights(const terrain::HeightField& dem, terrain::Height
 
 void TerrainScene::attach_height_field() {
   blocks_ = std::make_unique<HeightFieldBlocks>(heights_);
+  attach_blocks();
+}
+
+void TerrainScene::attach_blocks() {
   RTCGeometry g = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(g, blocks_->block_count());
   rtcSetGeometryUserData(g, blocks_.get());
@@ -390,8 +436,12 @@ void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
 
 TerrainScene::~TerrainScene() = default;
 
+float TerrainScene::z_at(int c, int r) const {
+  return paged_ ? paged_->at(c, r) : heights_.at(c, r);
+}
+
 float TerrainScene::height_at(float x, float y) const {
-  auto h = [&](int xx, int rr) { return heights_.at(xx, rr); };
+  auto h = [&](int xx, int rr) { return z_at(xx, rr); };
   return terrain::bilinear_clamped(h, width_, height_, (x - heights_.x0) / dx_,
                                    (heights_.y0 - y) / dy_);
 }
@@ -399,7 +449,7 @@ float TerrainScene::height_at(float x, float y) const {
 Eigen::Vector3f TerrainScene::vertex_normal(int x, int row) const {
   // Horn's gradient of the exaggerated heights, as the slope and aspect
   // rasters compute it (terrain/derivatives.h), edges included.
-  const auto z = [&](int xx, int rr) { return heights_.at(xx, rr); };
+  const auto z = [&](int xx, int rr) { return z_at(xx, rr); };
   const terrain::Gradient g = terrain::horn_gradient(z, width_, height_, dx_, dy_, x, row);
   return Eigen::Vector3f(-g.dzdx, -g.dzdy, 1.0f).normalized();
 }

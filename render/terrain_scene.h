@@ -18,6 +18,8 @@
 
 namespace drift::render {
 
+class PagedTerrain;
+
 struct Hit {
   float distance = 0.0f;
   Eigen::Vector3f position{0, 0, 0};   // local (origin-shifted) coordinates
@@ -70,6 +72,11 @@ class TerrainScene {
   // once; `terrain` is left empty.
   TerrainScene(const SceneInput& input, terrain::HeightField&& terrain,
                TerrainGeometry geometry = TerrainGeometry::Auto);
+  // The terrain read on demand from `paged` (render/paged_terrain.h), which
+  // must outlive the scene; input.terrain is not read. Throws drift::Error
+  // for what needs the whole DEM in memory (height changes laid on it, the
+  // surround ring).
+  TerrainScene(const SceneInput& input, PagedTerrain& paged);
   ~TerrainScene();
   TerrainScene(const TerrainScene&) = delete;
   TerrainScene& operator=(const TerrainScene&) = delete;
@@ -124,6 +131,10 @@ class TerrainScene {
                     float vertical_exaggeration);
   void attach_terrain_grids();
   void attach_height_field();
+  void attach_blocks();
+  void build_paged(const SceneInput& input, PagedTerrain& paged);
+  // Vertex (c, r)'s height, local frame: from heights_ or the pages.
+  float z_at(int c, int r) const;
   void attach_mesh(const terrain::PlacedMesh& placed);
 
   // The hit's material and coverage on the terrain (a footprint from
@@ -150,6 +161,7 @@ class TerrainScene {
   // float3 vertex buffer (TerrainGeometry::Grid).
   HeightGrid heights_;
   std::unique_ptr<HeightFieldBlocks> blocks_;
+  const PagedTerrain* paged_ = nullptr;  // out of core: heights_.z is empty
   std::vector<Eigen::Vector3f> vertices_;
   TerrainSurface surface_;
   CoverageChannels coverage_;

@@ -9,7 +9,9 @@
 #   tests/bench/render_scale_bench.sh BUILD_DIR DATA_DIR [SIZE...]   (default 4096 16384)
 #
 # DRIFT=path overrides BUILD_DIR/pipeline/drift (e.g. an older binary to
-# compare); RENDER_SIZE (320x180) and SPP (4) set the frame. The data stays in
+# compare); RENDER_SIZE (320x180) and SPP (4) set the frame; MEMORY_BUDGET
+# (e.g. 2G) renders out of core (drift render --memory-budget) and prints the
+# page cache's line. The data stays in
 # DATA_DIR for reruns (16384^2: 16 tiles, ~1.1 GB; made in ~5 min of CPU).
 set -euo pipefail
 build=${1:?usage: render_scale_bench.sh BUILD_DIR DATA_DIR [SIZE...]}
@@ -36,11 +38,13 @@ spp = ${SPP:-4}
 EOF
   log="$data/scale_$n.log"
   /usr/bin/time -v "$drift" render "$scene" --size "${RENDER_SIZE:-320x180}" \
-    -o "$data/scale_$n.png" --exposure 0 > "$log" 2>&1
+    -o "$data/scale_$n.png" --exposure 0 ${MEMORY_BUDGET:+--memory-budget "$MEMORY_BUDGET"} \
+    > "$log" 2>&1
   peak_kib=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
   wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
   render_s=$(sed -n 's/^rendered .* in \([0-9.]*\) s.*/\1/p' "$log")
   total_s=$(echo "$wall" | awk -F: '{ s = 0; for (i = 1; i <= NF; i++) s = s * 60 + $i; print s }')
   awk -v n="$n" -v kib="$peak_kib" -v r="$render_s" -v t="$total_s" 'BEGIN {
     printf "%-7s %12.0f %10.2f %10.1f %16.1f\n", n "^2", kib / 1024, kib * 1024 / (n * n), t - r, r }'
+  grep '^terrain cache:' "$log" || true
 done
