@@ -67,7 +67,7 @@ std::vector<std::string> write_products(const SoilCommand& c, const soil::SoilSc
                                         const soil::SoilState& state,
                                         const soil::SurfaceOptions& surface) {
   std::vector<std::string> wrote;
-  const terrain::Mesh mesh = soil::soil_surface(state, surface, sc.options.soil.moisture);
+  const terrain::Mesh mesh = soil::soil_surface(state, surface);
   if (mesh.triangles.empty()) throw Error("scenario '" + c.scenario + "' left no soil surface");
   write_mesh(mesh, c.output);
   wrote.push_back(c.output + " (" + std::to_string(mesh.triangle_count()) + " triangles)");
@@ -78,7 +78,7 @@ std::vector<std::string> write_products(const SoilCommand& c, const soil::SoilSc
     wrote.push_back(c.collision + " (" + std::to_string(bodies.triangle_count()) + " triangles)");
   }
   if (!c.vdb.empty()) {
-    soil::write_density_vdb(state, c.vdb, sc.options.soil.moisture);
+    soil::write_density_vdb(state, c.vdb);
     wrote.push_back(c.vdb + " (grids density, collision, wetness, velocity)");
   }
   if (!c.surface.empty()) {
@@ -134,12 +134,11 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
       char name[32];
       if (!c.frames.empty()) {
         std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-        write_mesh(soil::soil_surface(s.state(), surface, sc.options.soil.moisture),
-                   fs::path(c.frames) / name);
+        write_mesh(soil::soil_surface(s.state(), surface), fs::path(c.frames) / name);
       }
       if (!c.vdb_frames.empty()) {  // soil_00010.vdb, ...: a volume sequence
         std::snprintf(name, sizeof name, "soil_%05d.vdb", step);
-        soil::write_density_vdb(s.state(), fs::path(c.vdb_frames) / name, sc.options.soil.moisture);
+        soil::write_density_vdb(s.state(), fs::path(c.vdb_frames) / name);
       }
     };
   }

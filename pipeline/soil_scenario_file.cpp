@@ -6,8 +6,10 @@
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
 #include "terrain/bilinear.h"
+#include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
 #include "terrain/soil/soil_parameters.h"
+#include "terrain/soil/solid_mesh.h"
 
 namespace drift::pipeline {
 
@@ -130,6 +132,14 @@ WindowWithApron with_apron(const terrain::RasterWindow& w, const terrain::Raster
   return a;
 }
 
+// Degrees about x, then y, then z (world axes) as a rotation.
+Eigen::Quaterniond rotation_from_degrees(const Eigen::Vector3d& deg) {
+  const Eigen::Vector3d r = deg * (M_PI / 180.0);
+  return Eigen::Quaterniond(Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
+                            Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
+                            Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()));
+}
+
 std::string list(const Eigen::Vector4d& v) {
   std::ostringstream os;
   os << v[0] << ", " << v[1] << ", " << v[2] << ", " << v[3];
@@ -249,6 +259,9 @@ void read_bodies(const toml::table& root, const std::filesystem::path& file,
     b.name = s.string("name").value_or("soil");
     b.position = s.vector<3>("position", -kBig, kBig).value_or(Eigen::Vector3d::Zero());
     b.on_ground = s.boolean("on_ground", false);
+    // Its own moisture (thesis 5.3.4), over [soil] moisture: a wet layer
+    // or region beside dry soil.
+    if (const double m = s.number("moisture", -1, 0, 1); m >= 0) b.moisture = m;
     b.primitives = read_primitives(s, file, "soil_body");
     s.finish();
     sc.soil.push_back(std::move(b));
@@ -257,7 +270,25 @@ void read_bodies(const toml::table& root, const std::filesystem::path& file,
     Section s(t, "body", file, kDoc);
     soil::RigidObject b;
     b.name = s.string("name").value_or("body");
-    b.primitives = read_primitives(s, file, "body");
+    // A closed triangle mesh (OBJ, in the body's frame, z up unless
+    // mesh_y_up), voxelised at half a voxel; with or without primitives.
+    if (const auto mesh = s.string("mesh")) {
+      const terrain::Mesh m =
+          terrain::read_obj(file.parent_path() / *mesh, s.boolean("mesh_y_up", false));
+      try {
+        b.mesh = std::make_shared<soil::SolidMesh>(m, 0.5 * sc.shape.voxel_size, b.name);
+      } catch (const Error& e) {
+        s.invalid("mesh", std::string("'") + *mesh + "': " + e.what());
+      }
+    }
+    if (b.mesh) {
+      for (const toml::table* p : s.tables("primitive"))
+        b.primitives.push_back(read_primitive(p, file, "body"));
+    } else {
+      b.primitives = read_primitives(s, file, "body");
+    }
+    // Turning: degrees a second about x, y, z (world axes) about the body's position.
+    b.spin = s.vector<3>("spin", -1e5, 1e5).value_or(Eigen::Vector3d::Zero()) * (M_PI / 180.0);
     for (const toml::table* k : s.tables("keyframe")) {
       Section ks(k, "body.keyframe", file, kDoc);
       soil::Keyframe f;
@@ -265,14 +296,22 @@ void read_bodies(const toml::table& root, const std::filesystem::path& file,
       const auto p = ks.vector<3>("position", -kBig, kBig);
       if (!p) ks.invalid_table("needs position = [x, y, z] (m)");
       f.position = *p;
+      // Degrees about x, then y, then z (world axes); slerped between keyframes.
+      f.orientation = rotation_from_degrees(
+          ks.vector<3>("rotation", -1e5, 1e5).value_or(Eigen::Vector3d::Zero()));
       ks.finish();
       b.path.push_back(f);
     }
     if (b.path.empty()) {
-      b.path.push_back(
-          {0.0, s.vector<3>("position", -kBig, kBig).value_or(Eigen::Vector3d::Zero())});
-    } else if (s.vector<3>("position", -kBig, kBig)) {
-      s.invalid("position", "and [[body.keyframe]] both place the body; use one");
+      b.path.push_back({0.0, s.vector<3>("position", -kBig, kBig).value_or(Eigen::Vector3d::Zero()),
+                        rotation_from_degrees(
+                            s.vector<3>("rotation", -1e5, 1e5).value_or(Eigen::Vector3d::Zero()))});
+    } else {
+      if (s.vector<3>("position", -kBig, kBig))
+        s.invalid("position", "and [[body.keyframe]] both place the body; use one");
+      if (s.vector<3>("rotation", -1e5, 1e5))
+        s.invalid("rotation",
+                  "and [[body.keyframe]] both turn the body; give each keyframe a rotation");
     }
     s.finish();
     soil::validate(b, file.string() + ": body");

@@ -22,6 +22,7 @@ void copy_back(SoilState& s, std::size_t i) {
   s.fx[i] = s.back.fx[i];
   s.fy[i] = s.back.fy[i];
   s.fz[i] = s.back.fz[i];
+  s.wet[i] = s.back.wet[i];
 }
 
 detail::Ranges advect(SoilState& s, double dt) {
@@ -36,7 +37,8 @@ detail::Ranges advect(SoilState& s, double dt) {
   };
   // Eq. 24: a voxel full of soil and body is locked (rho is only read here).
   auto unlocked = [=](std::size_t i) { return rho[i] + psi[i] < kFull; };
-  const detail::Carried carried{{ux, uy, uz}, {s.fx.data(), s.fy.data(), s.fz.data()}};
+  const detail::Carried carried{
+      {ux, uy, uz}, {s.fx.data(), s.fy.data(), s.fz.data()}, s.wet.data()};
   return detail::transport(
       g, s.rho.data(), detail::sender_ranges(g, s.rho.data(), unlocked, disp), unlocked, disp,
       carried, false,
@@ -49,6 +51,7 @@ detail::Ranges advect(SoilState& s, double dt) {
         s.back.fx[i] = r.f[0] * inv;
         s.back.fy[i] = r.f[1] * inv;
         s.back.fz[i] = r.f[2] * inv;
+        s.back.wet[i] = r.amount > 0 ? std::clamp(r.m * inv, 0.0f, 1.0f) : s.wet[i];
       },
       true,
       [&](std::size_t i, float self) {  // backflow came back with zero velocity (eq. 28)
@@ -83,7 +86,7 @@ bool solid(const SoilState& s, std::size_t i) { return s.psi[i] >= kFull; }
 void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
   const terrain::Grid3Shape& g = s.shape;
   for_each_dirty_column(g, dirty, [&](std::size_t c) {
-    float carry = 0, cu[3] = {0, 0, 0};
+    float carry = 0, cu[3] = {0, 0, 0}, cm = 0;
     for (int z = 0; z < g.nz; ++z) {
       const std::size_t i = c + z;
       const float r = s.rho[i];
@@ -96,8 +99,11 @@ void overflow_up_pass(SoilState& s, const ColumnMask* dirty) {
       s.ux[i] = (kept * u[0] + carry * cu[0]) * inv;
       s.uy[i] = (kept * u[1] + carry * cu[1]) * inv;
       s.uz[i] = (kept * u[2] + carry * cu[2]) * inv;
+      const float m = s.wet[i];
+      s.wet[i] = mix_moisture(kept, m, carry, cm);
       s.rho[i] = now;
       carry = ex;
+      cm = m;
       std::copy(u, u + 3, cu);
     }
   });
@@ -143,7 +149,7 @@ void overflow_weighted_pass(SoilState& s, const std::array<float, 27>& w) {
     for (int x = 0; x < g.nx; ++x)
       for (int z = 0; z < g.nz; ++z) {
         const std::size_t i = g.index(x, y, z);
-        float in = 0, iu[3] = {0, 0, 0};
+        float in = 0, iu[3] = {0, 0, 0}, im = 0;
         if (valid(x, y, z))
           for (int k = 0; k < 27; ++k) {
             if (w[k] <= 0) continue;
@@ -156,6 +162,7 @@ void overflow_weighted_pass(SoilState& s, const std::array<float, 27>& w) {
             iu[0] += q * s.ux[j];
             iu[1] += q * s.uy[j];
             iu[2] += q * s.uz[j];
+            im += q * s.wet[j];
           }
         const float kept = s.rho[i] - excess[i], now = kept + in;
         const float inv = detail::weight_inverse(now);
@@ -163,8 +170,10 @@ void overflow_weighted_pass(SoilState& s, const std::array<float, 27>& w) {
         s.back.uy[i] = (kept * s.uy[i] + iu[1]) * inv;
         s.back.uz[i] = (kept * s.uz[i] + iu[2]) * inv;
         s.back.fx[i] = now;  // the new density, until the swap below
+        s.back.wet[i] = now > 1e-30f ? (kept * s.wet[i] + im) * inv : s.wet[i];
       }
   });
+  s.wet.swap(s.back.wet);
   s.rho.swap(s.back.fx);
   s.ux.swap(s.back.ux);
   s.uy.swap(s.back.uy);
@@ -194,6 +203,7 @@ namespace {
 // Without downward steps it never passes under a body's cutting edge into
 // the room behind it.
 float route_excess(SoilState& s, std::size_t i, float carry, bool down) {
+  const float m = s.wet[i];  // the excess keeps the moisture of the soil it left
   const terrain::Grid3Shape& g = s.shape;
   constexpr int kOff[6][3] = {{0, 0, 1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}};
   constexpr std::size_t kMaxVisits = 1 << 16;
@@ -213,6 +223,7 @@ float route_excess(SoilState& s, std::size_t i, float carry, bool down) {
       seen[n] = 1;
       queue.push_back(n);
       const float take = std::min(carry, std::max(0.0f, room(s, n) - s.rho[n]));
+      if (take > 0) s.wet[n] = mix_moisture(s.rho[n], s.wet[n], take, m);
       s.rho[n] += take;
       carry -= take;
     }
@@ -249,6 +260,7 @@ bool expel_from_body(SoilState& s, std::size_t c, int nz) {
       continue;
     }
     const int to = !has_down || (has_up && up - z <= z - down) ? up : down;
+    s.wet[c + to] = mix_moisture(s.rho[c + to], s.wet[c + to], s.rho[c + z], s.wet[c + z]);
     s.rho[c + to] += s.rho[c + z];
     s.rho[c + z] = 0;
   }

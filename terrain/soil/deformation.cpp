@@ -30,6 +30,11 @@ void apply_forces(SoilState& s, const std::vector<BodyMotion>& bodies) {
           if (x >= b.box.lo.x() && x < b.box.hi.x() && y >= b.box.lo.y() && y < b.box.hi.y() &&
               z >= b.box.lo.z() && z < b.box.hi.z()) {
             v = b.velocity;
+            if (b.spin != Eigen::Vector3d::Zero()) {
+              const Eigen::Vector3d p =
+                  g.origin + g.voxel_size * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5);
+              v += b.spin.cross(p - b.pivot);
+            }
             break;
           }
         const double len = v.norm();
@@ -71,7 +76,8 @@ detail::Ranges propagate_forces(SoilState& s) {
     return m > 0 ? detail::D3{fx[i] / m, fy[i] / m, fz[i] / m} : detail::D3{};
   };
   auto open = [=](std::size_t i) { return psi[i] < kSolid; };
-  const detail::Carried carried{{s.ux.data(), s.uy.data(), s.uz.data()}, {fx, fy, fz}};
+  const detail::Carried carried{
+      {s.ux.data(), s.uy.data(), s.uz.data()}, {fx, fy, fz}, s.wet.data()};
   return detail::transport(
       g, moving.data(), senders, open, disp, carried, true,
       [&](std::size_t i, const detail::Gathered& r) {
@@ -81,6 +87,8 @@ detail::Ranges propagate_forces(SoilState& s) {
         s.back.ux[i] = (kept * s.ux[i] + r.u[0]) * inv;
         s.back.uy[i] = (kept * s.uy[i] + r.u[1]) * inv;
         s.back.uz[i] = (kept * s.uz[i] + r.u[2]) * inv;
+        s.back.wet[i] =
+            now > 1e-30f ? std::clamp((kept * s.wet[i] + r.m) * inv, 0.0f, 1.0f) : s.wet[i];
         const bool collided = now + s.psi[i] > 1.0f + kCollided && r.amount > 0;
         const float fin = collided ? detail::weight_inverse(r.amount) : 0.0f;  // eq. 35
         s.back.fx[i] = r.f[0] * fin;

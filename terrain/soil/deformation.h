@@ -11,14 +11,18 @@
 
 namespace drift::soil {
 
-// A moving body's voxel box and velocity (m/s) this step.
+// A moving body's voxel box and motion this step: the velocity (m/s) of its
+// pivot, its angular velocity (rad/s) about it; a point p moves at
+// velocity + spin x (p - pivot).
 struct BodyMotion {
   VoxelBox box;
   Eigen::Vector3d velocity{0, 0, 0};
+  Eigen::Vector3d spin{0, 0, 0};
+  Eigen::Vector3d pivot{0, 0, 0};
 };
 
 // Force application, eq. 33: in a collided voxel (rho + psi > 1) holding
-// rigid body, f = the body's direction of motion (the first of `bodies`
+// rigid body, f = the body's direction of motion at the voxel (the first of `bodies`
 // whose box holds the voxel; straight up for a body at rest, which can only
 // lift what it overlaps); a collided voxel with no body keeps f; elsewhere f = 0.
 void apply_forces(SoilState& state, const std::vector<BodyMotion>& bodies);

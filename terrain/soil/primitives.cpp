@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "terrain/error.h"
+#include "terrain/soil/solid_mesh.h"
 
 namespace drift::soil {
 
@@ -112,6 +113,55 @@ Vector3d RigidObject::position(double t) const {
   return a.position + s * (b.position - a.position);
 }
 
+bool RigidObject::moves() const { return path.size() > 1 || spin != Vector3d::Zero(); }
+
+namespace {
+// The keyframe segment holding t: (a, b, s in [0, 1]); a == b at the ends.
+struct Segment {
+  const Keyframe *a, *b;
+  double s;
+};
+Segment segment_at(const std::vector<Keyframe>& path, double t) {
+  if (t <= path.front().time) return {&path.front(), &path.front(), 0.0};
+  if (t >= path.back().time) return {&path.back(), &path.back(), 0.0};
+  auto it = std::upper_bound(path.begin(), path.end(), t,
+                             [](double v, const Keyframe& k) { return v < k.time; });
+  return {&*(it - 1), &*it, (t - (it - 1)->time) / (it->time - (it - 1)->time)};
+}
+
+Eigen::Quaterniond spun(const Vector3d& spin, double t) {
+  const double angle = spin.norm() * t;
+  return angle == 0 ? Eigen::Quaterniond::Identity()
+                    : Eigen::Quaterniond(Eigen::AngleAxisd(angle, spin.normalized()));
+}
+}  // namespace
+
+Eigen::Quaterniond RigidObject::orientation(double t) const {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  if (!path.empty()) {
+    const Segment g = segment_at(path, t);
+    q = g.a->orientation.slerp(g.s, g.b->orientation);
+  }
+  return (spun(spin, t) * q).normalized();
+}
+
+Vector3d RigidObject::angular_velocity(double t) const {
+  Vector3d w(0, 0, 0);
+  if (path.size() >= 2 && t >= path.front().time && t < path.back().time) {
+    const Segment g = segment_at(path, t);
+    // R_b = dq R_a: dq's axis (world) times its angle over the segment's time.
+    const Eigen::AngleAxisd dq(g.b->orientation * g.a->orientation.inverse());
+    w = spun(spin, t) * (dq.axis() * dq.angle() / (g.b->time - g.a->time));
+  }
+  return w + spin;
+}
+
+Pose RigidObject::pose(double t) const { return {position(t), orientation(t).toRotationMatrix()}; }
+
+PlacedSolid placed(const RigidObject& b, double t) {
+  return {&b.primitives, b.mesh.get(), b.pose(t)};
+}
+
 Vector3d RigidObject::velocity(double t) const {
   if (path.size() < 2 || t < path.front().time || t >= path.back().time) return Vector3d::Zero();
   auto it = std::upper_bound(path.begin(), path.end(), t,
@@ -122,7 +172,9 @@ Vector3d RigidObject::velocity(double t) const {
 }
 
 void validate(const RigidObject& o, const std::string& what) {
-  if (o.primitives.empty()) throw Error(what + " '" + o.name + "' has no primitives");
+  if (o.primitives.empty() && !o.mesh)
+    throw Error(what + " '" + o.name + "' has no primitives and no mesh");
+  if (!o.spin.allFinite()) throw Error(what + " '" + o.name + "' has a non-finite spin");
   for (std::size_t i = 0; i < o.primitives.size(); ++i) {
     const Primitive& p = o.primitives[i];
     const std::string where = what + " '" + o.name + "' primitive " + std::to_string(i + 1) + " (" +
@@ -134,7 +186,8 @@ void validate(const RigidObject& o, const std::string& what) {
                     "; sizes must be positive finite metres");
   }
   for (std::size_t i = 0; i < o.path.size(); ++i) {
-    if (!o.path[i].position.allFinite() || !std::isfinite(o.path[i].time))
+    if (!o.path[i].position.allFinite() || !std::isfinite(o.path[i].time) ||
+        !o.path[i].orientation.coeffs().allFinite())
       throw Error(what + " '" + o.name + "' keyframe " + std::to_string(i + 1) + " is not finite");
     if (i > 0 && !(o.path[i].time > o.path[i - 1].time))
       throw Error(what + " '" + o.name + "' keyframe " + std::to_string(i + 1) +
@@ -214,6 +267,99 @@ void add_coverage(const std::vector<Primitive>& prims, const Vector3d& pos,
   for_each_covered_voxel(prims, pos, shape, [&field](std::size_t i, float c) {
     field[i] = std::min(1.0f, field[i] + c);
   });
+}
+
+namespace {
+// World bounding box of the body-frame box [lo, hi] at `pose`.
+void placed_bounds(const Pose& pose, const Vector3d& lo, const Vector3d& hi, Vector3d& wlo,
+                   Vector3d& whi) {
+  for (int c = 0; c < 8; ++c) {
+    const Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
+                          (c & 4) ? hi.z() : lo.z());
+    const Vector3d w = pose.position + pose.rotation * corner;
+    wlo = wlo.cwiseMin(w);
+    whi = whi.cwiseMax(w);
+  }
+}
+
+bool plain(const PlacedSolid& s) { return !s.mesh && !s.pose.rotated(); }
+}  // namespace
+
+VoxelBox voxel_box(const PlacedSolid& solid, const terrain::Grid3Shape& shape) {
+  if (plain(solid)) return voxel_box(*solid.primitives, solid.pose.position, shape);
+  Vector3d lo = Vector3d::Constant(1e300), hi = Vector3d::Constant(-1e300);
+  for (const Primitive& p : *solid.primitives)
+    placed_bounds(solid.pose, p.lower(), p.upper(), lo, hi);
+  if (solid.mesh) placed_bounds(solid.pose, solid.mesh->lower(), solid.mesh->upper(), lo, hi);
+  VoxelBox box;
+  const Eigen::Vector3i n(shape.nx, shape.ny, shape.nz);
+  for (int a = 0; a < 3; ++a) {
+    const double l = std::floor((lo[a] - shape.origin[a]) / shape.voxel_size);
+    const double h = std::ceil((hi[a] - shape.origin[a]) / shape.voxel_size);
+    box.lo[a] = static_cast<int>(std::clamp(l, 0.0, static_cast<double>(n[a])));
+    box.hi[a] = static_cast<int>(std::clamp(h, 0.0, static_cast<double>(n[a])));
+  }
+  return box;
+}
+
+double coverage(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi) {
+  if (plain(solid)) return coverage(*solid.primitives, solid.pose.position, lo, hi);
+  // The box's corners in the body frame: a convex primitive holding all of
+  // them holds the (rotated) box.
+  Vector3d corners[8], blo = Vector3d::Constant(1e300), bhi = Vector3d::Constant(-1e300);
+  for (int c = 0; c < 8; ++c) {
+    corners[c] = solid.pose.to_body(
+        Vector3d((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z()));
+    blo = blo.cwiseMin(corners[c]);
+    bhi = bhi.cwiseMax(corners[c]);
+  }
+  bool touches = solid.mesh && (solid.mesh->lower().array() < bhi.array()).all() &&
+                 (solid.mesh->upper().array() > blo.array()).all();
+  for (const Primitive& p : *solid.primitives) {
+    if (!box_touches(p, blo, bhi)) continue;
+    touches = true;
+    bool all = true;
+    for (const Vector3d& c : corners) all = all && p.inside(c);
+    if (all) return 1.0;
+  }
+  if (!touches) return 0.0;
+  constexpr int n = 4;
+  int in = 0;
+  const Vector3d step = (hi - lo) / n;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const Vector3d q =
+            solid.pose.to_body(lo + step.cwiseProduct(Vector3d(i + 0.5, j + 0.5, k + 0.5)));
+        bool inside = solid.mesh && solid.mesh->inside(q);
+        for (const Primitive& p : *solid.primitives)
+          if (inside || (inside = p.inside(q))) break;
+        in += inside;
+      }
+  return static_cast<double>(in) / (n * n * n);
+}
+
+void for_each_covered_voxel(const PlacedSolid& solid, const terrain::Grid3Shape& shape,
+                            const std::function<void(std::size_t, float)>& fill) {
+  if (plain(solid))
+    return for_each_covered_voxel(*solid.primitives, solid.pose.position, shape, fill);
+  const VoxelBox box = voxel_box(solid, shape);
+  if (box.empty()) return;
+  const double h = shape.voxel_size;
+  tbb::parallel_for(box.lo.y(), box.hi.y(), [&](int y) {
+    for (int x = box.lo.x(); x < box.hi.x(); ++x)
+      for (int z = box.lo.z(); z < box.hi.z(); ++z) {
+        const Vector3d lo = shape.origin + h * Vector3d(x, y, z);
+        const double c = coverage(solid, lo, lo + Vector3d::Constant(h));
+        if (c > 0.0) fill(shape.index(x, y, z), static_cast<float>(c));
+      }
+  });
+}
+
+void add_coverage(const PlacedSolid& solid, const terrain::Grid3Shape& shape,
+                  std::vector<float>& field) {
+  for_each_covered_voxel(
+      solid, shape, [&field](std::size_t i, float c) { field[i] = std::min(1.0f, field[i] + c); });
 }
 
 }  // namespace drift::soil

@@ -2,13 +2,19 @@
 // sec. 3.2.4 and fig. 37, after Laprairie's volume sampling functions), and
 // their voxelisation with partial coverage at the boundary.
 //
-// Primitives are axis-aligned (cylinders and cones stand along z); an object
-// moves by translation along keyframes, linearly between them.
+// Primitives are axis-aligned in their body's frame (cylinders and cones
+// stand along its z). A body moves along keyframes, linearly between them,
+// and turns about its position: keyframed orientations (slerp between them)
+// and a constant spin (a rotating blade, a tilting bucket; issue 33, item 5).
+// A body may also be a closed triangle mesh (solid_mesh.h), voxelised in its
+// own frame once and placed at its pose every step.
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,22 +43,54 @@ struct Primitive {
 struct Keyframe {
   double time = 0.0;  // seconds
   Eigen::Vector3d position{0, 0, 0};
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  // body to world
 };
+
+// A body's placement at one time: its frame's origin (the pivot it turns
+// about) and its rotation, body to world.
+struct Pose {
+  Eigen::Vector3d position{0, 0, 0};
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  bool rotated() const { return rotation != Eigen::Matrix3d::Identity(); }
+  Eigen::Vector3d to_body(const Eigen::Vector3d& w) const {
+    return rotation.transpose() * (w - position);
+  }
+};
+
+class SolidMesh;  // terrain/soil/solid_mesh.h
 
 struct RigidObject {
   std::string name;
   std::vector<Primitive> primitives;
   std::vector<Keyframe> path;  // sorted by time; one keyframe (or none) = static
+  // Constant angular velocity (rad/s, world axes) about the body's position,
+  // on top of the keyframes' orientation.
+  Eigen::Vector3d spin{0, 0, 0};
+  // A closed triangle mesh in the body's frame, part of the solid with the
+  // primitives (either may be empty, not both).
+  std::shared_ptr<const SolidMesh> mesh;
 
-  bool moves() const { return path.size() > 1; }
+  bool moves() const;
   Eigen::Vector3d position(double t) const;  // held at the ends
   Eigen::Vector3d velocity(double t) const;  // m/s, of the segment holding t
+  Eigen::Quaterniond orientation(double t) const;
+  Eigen::Vector3d angular_velocity(double t) const;  // rad/s, world axes
+  Pose pose(double t) const;
 };
 
 // Throws drift::Error naming `what`, the primitive and the value for a
-// non-finite or non-positive size, non-finite centre or keyframe, or
+// non-finite or non-positive size, non-finite centre, keyframe or spin, or
 // keyframes out of time order.
 void validate(const RigidObject& object, const std::string& what);
+
+// A solid at a pose: the union of `primitives` and `mesh` (may be null),
+// both in the body's frame.
+struct PlacedSolid {
+  const std::vector<Primitive>* primitives = nullptr;
+  const SolidMesh* mesh = nullptr;
+  Pose pose;
+};
+PlacedSolid placed(const RigidObject& body, double t);
 
 // Fraction of the box [lo, hi] (metres, world) inside the union of
 // `primitives` placed at `position`: 1 if one primitive holds all corners
@@ -68,6 +106,11 @@ struct VoxelBox {
 };
 VoxelBox voxel_box(const std::vector<Primitive>& primitives, const Eigen::Vector3d& position,
                    const terrain::Grid3Shape& shape);
+VoxelBox voxel_box(const PlacedSolid& solid, const terrain::Grid3Shape& shape);
+// Fraction of the world box [lo, hi] inside a placed solid: as above when it
+// is not rotated and has no mesh, else 4 x 4 x 4 samples (1 if one convex
+// primitive holds all eight corners).
+double coverage(const PlacedSolid& solid, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
 // Calls fill(i, c) for each voxel i (an index of `shape`) in the voxel box of
 // `primitives` at `position` that they cover by a fraction c > 0. Parallel
@@ -75,10 +118,14 @@ VoxelBox voxel_box(const std::vector<Primitive>& primitives, const Eigen::Vector
 void for_each_covered_voxel(const std::vector<Primitive>& primitives,
                             const Eigen::Vector3d& position, const terrain::Grid3Shape& shape,
                             const std::function<void(std::size_t, float)>& fill);
+void for_each_covered_voxel(const PlacedSolid& solid, const terrain::Grid3Shape& shape,
+                            const std::function<void(std::size_t, float)>& fill);
 
 // Adds the coverage of the object at `position` to `field` (saturating at
 // 1) over its voxel box. Parallel over rows; the same bits on any thread count.
 void add_coverage(const std::vector<Primitive>& primitives, const Eigen::Vector3d& position,
                   const terrain::Grid3Shape& shape, std::vector<float>& field);
+void add_coverage(const PlacedSolid& solid, const terrain::Grid3Shape& shape,
+                  std::vector<float>& field);
 
 }  // namespace drift::soil

@@ -103,14 +103,16 @@ SoilSimulation make_simulation(const SoilScenario& sc) {
   if (sc.terrain.kind == TerrainSource::Kind::Voxel) voxelise_density(sc, state);
   for (const RigidObject& b : sc.bodies) {
     validate(b, "body");
-    if (!b.moves()) add_coverage(b.primitives, b.position(0.0), g, state.psi_static);
+    if (!b.moves()) add_coverage(placed(b, 0.0), g, state.psi_static);
   }
   // Moving bodies at time 0 take their room before the soil is poured in.
   state.psi = state.psi_static;
   for (const RigidObject& b : sc.bodies)
-    if (b.moves()) add_coverage(b.primitives, b.position(0.0), g, state.psi);
+    if (b.moves()) add_coverage(placed(b, 0.0), g, state.psi);
   for (const SoilBody& s : sc.soil) {
-    RigidObject probe{s.name, s.primitives, {}};
+    RigidObject probe;
+    probe.name = s.name;
+    probe.primitives = s.primitives;
     validate(probe, "soil body");
     Eigen::Vector3d at = s.position;
     if (s.on_ground && sc.terrain.kind == TerrainSource::Kind::HeightField) {
@@ -119,7 +121,11 @@ SoilSimulation make_simulation(const SoilScenario& sc) {
       const double row = hf.height() - (at.y() - g.origin.y()) / g.voxel_size - 0.5;
       at.z() += terrain::bilinear_clamped(hf, col, row);
     }
-    add_soil(state, s.primitives, at);
+    const double m = s.moisture.value_or(sc.options.soil.moisture);
+    if (!(m >= 0 && m <= 1))
+      throw Error("scenario '" + sc.name + "': soil body '" + s.name + "' moisture " +
+                  std::to_string(m) + " must lie in [0, 1] (0 dry .. 1 damp)");
+    add_soil(state, s.primitives, at, m);
   }
   std::vector<RigidObject> moving;
   for (const RigidObject& b : sc.bodies)

@@ -34,6 +34,8 @@ struct SoilBody {
   // With a height-field terrain: position.z is above the ground under
   // (position.x, position.y) rather than above the grid's origin.
   bool on_ground = false;
+  // Its moisture in [0, 1] (thesis 5.3.4); unset: the soil's `moisture`.
+  std::optional<double> moisture;
 };
 
 struct SoilScenario {

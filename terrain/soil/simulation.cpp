@@ -34,7 +34,7 @@ SoilSimulation::SoilSimulation(SoilState state, std::vector<RigidObject> bodies,
     if (b.moves()) {
       bodies_.push_back(std::move(b));
     } else {
-      add_coverage(b.primitives, b.position(0.0), state_.shape, state_.psi_static);
+      add_coverage(placed(b, 0.0), state_.shape, state_.psi_static);
     }
   }
   rebuild_collision_field();
@@ -42,17 +42,19 @@ SoilSimulation::SoilSimulation(SoilState state, std::vector<RigidObject> bodies,
 
 void SoilSimulation::rebuild_collision_field() {
   state_.psi = state_.psi_static;
-  for (const RigidObject& b : bodies_)
-    add_coverage(b.primitives, b.position(time_), state_.shape, state_.psi);
+  for (const RigidObject& b : bodies_) add_coverage(placed(b, time_), state_.shape, state_.psi);
 }
 
 void SoilSimulation::step() {
   const double dt = options_.dt;
-  // Move the bodies to the end of the step; their velocity over it drives eq. 33.
+  // Move the bodies to the end of the step; their velocity over it (a
+  // turning body's differs point by point) drives eq. 33.
   std::vector<BodyMotion> motion;
-  for (const RigidObject& b : bodies_)
-    motion.push_back({voxel_box(b.primitives, b.position(time_ + dt), state_.shape),
-                      b.velocity(time_ + 0.5 * dt)});
+  for (const RigidObject& b : bodies_) {
+    const double mid = time_ + 0.5 * dt;
+    motion.push_back({voxel_box(placed(b, time_ + dt), state_.shape), b.velocity(mid),
+                      b.angular_velocity(mid), b.position(mid)});
+  }
   time_ += dt;
   rebuild_collision_field();
 
@@ -71,13 +73,18 @@ void SoilSimulation::step() {
   if (options_.settle) settle_overflow(state_, &dirty);
 
   apply_gravity(state_, options_.gravity, dt);
-  if (options_.slippage) slippage_.step(state_, options_.soil, options_.gravity, dt);
+  if (options_.slippage) {
+    slippage_.step(state_, options_.soil, options_.gravity, dt);
+    if (options_.settle && slippage_.any_overfilled())
+      settle_overflow(state_, &slippage_.overfilled());
+  }
   ++steps_;
 }
 
 SoilRunStats run_soil(SoilSimulation& sim, const SoilRunOptions& o, const ProgressFn& progress) {
   SoilRunStats stats;
   stats.mass_before = sim.state().mass();
+  stats.water_before = sim.state().water();
   const auto t0 = std::chrono::steady_clock::now();
   if (!progress(0.0, "simulating")) throw Cancelled();
   for (int step = 1; step <= o.steps; ++step) {
@@ -89,14 +96,20 @@ SoilRunStats run_soil(SoilSimulation& sim, const SoilRunOptions& o, const Progre
   stats.steps = o.steps;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   stats.mass_after = sim.state().mass();
+  stats.water_after = sim.state().water();
   if (!progress(1.0, "done")) throw Cancelled();
   return stats;
 }
 
-void add_soil(SoilState& s, const std::vector<Primitive>& prims, const Eigen::Vector3d& pos) {
-  for_each_covered_voxel(prims, pos, s.shape, [&s](std::size_t i, float c) {
+void add_soil(SoilState& s, const std::vector<Primitive>& prims, const Eigen::Vector3d& pos,
+              double moisture) {
+  const float m = static_cast<float>(std::clamp(moisture, 0.0, 1.0));
+  for_each_covered_voxel(prims, pos, s.shape, [&s, m](std::size_t i, float c) {
     const float room = std::max(0.0f, 1.0f - std::max(s.psi_static[i], s.psi[i]) - s.rho[i]);
-    s.rho[i] += std::min(room, c);
+    const float put = std::min(room, c);
+    if (put <= 0) return;
+    s.wet[i] = mix_moisture(s.rho[i], s.wet[i], put, m);
+    s.rho[i] += put;
   });
 }
 

@@ -72,16 +72,18 @@ struct SoilRunOptions {
 
 struct SoilRunStats {
   int steps = 0;
-  double seconds = 0;                      // wall time of the steps (frames included)
-  double mass_before = 0, mass_after = 0;  // sum of rho, voxels
+  double seconds = 0;                        // wall time of the steps (frames included)
+  double mass_before = 0, mass_after = 0;    // sum of rho, voxels
+  double water_before = 0, water_after = 0;  // sum of rho x moisture, voxels
 };
 
 SoilRunStats run_soil(SoilSimulation& sim, const SoilRunOptions& options,
                       const ProgressFn& progress = no_progress);
 
 // Adds soil where the union of `primitives` (at `position`) covers voxels,
-// up to the room the collision field leaves (rho + psi <= 1).
+// up to the room the collision field leaves (rho + psi <= 1), with moisture
+// `moisture` in [0, 1] (mixed by mass with soil already there).
 void add_soil(SoilState& state, const std::vector<Primitive>& primitives,
-              const Eigen::Vector3d& position);
+              const Eigen::Vector3d& position, double moisture = 0.0);
 
 }  // namespace drift::soil

@@ -73,29 +73,42 @@ float ceiling_above(const HeightSpan* n, int count, float h, float grid_top) {
   return grid_top;
 }
 
-// Removes `amount` of soil from voxel `top` downwards (not below `floor`).
-void remove_down(float* rho, int top, int floor, float amount) {
+// Removes `amount` of soil from voxel `top` downwards (not below `floor`);
+// the soil leaves with its voxel's moisture. Returns the water (soil times
+// moisture) removed; `lowest` is the lowest voxel it took from.
+double remove_down(float* rho, const float* wet, int top, int floor, float amount, int& lowest) {
+  double water = 0;
+  lowest = top;
   for (int z = top; z >= floor && amount > 0; --z) {
     const float take = std::min(rho[z], amount);
     rho[z] -= take;
     amount -= take;
+    water += static_cast<double>(take) * wet[z];
+    lowest = z;
   }
+  return water;
 }
 
-// Adds `amount` of soil from voxel `from` upwards into the room left by soil
-// and body, up to the first solid body voxel (soil never passes through a
-// body); what finds no room stays in the last open voxel (mass is kept; the
-// next step's settle sends it sideways).
-void add_up(float* rho, const float* psi, int from, int nz, float amount) {
+// Adds `amount` of soil of moisture `m` from voxel `from` upwards into the
+// room left by soil and body, up to the first solid body voxel (soil never
+// passes through a body); what finds no room stays in the last open voxel
+// (mass is kept; the settle after the slippage sends it sideways: returns
+// true then). Each voxel's moisture becomes the mass-weighted mean of what
+// it held and what came.
+bool add_up(float* rho, float* wet, const float* psi, int from, int nz, float amount, float m) {
   int last = std::clamp(from, 0, nz - 1);
   for (int z = last; z < nz && amount > 0; ++z) {
     if (psi[z] >= kSolid && z > from) break;
     last = z;
     const float put = std::min(amount, std::max(0.0f, 1.0f - psi[z] - rho[z]));
+    if (put > 0) wet[z] = mix_moisture(rho[z], wet[z], put, m);
     rho[z] += put;
     amount -= put;
   }
-  if (amount > 0) rho[last] += amount;
+  if (amount <= 0) return false;
+  wet[last] = mix_moisture(rho[last], wet[last], amount, m);
+  rho[last] += amount;
+  return true;
 }
 
 }  // namespace
@@ -110,11 +123,16 @@ Slippage::Slippage(const terrain::Grid3Shape& shape)
       toe_(shape.columns() * kMaxPiles),
       crest_(shape.columns() * kMaxPiles),
       hop_(shape.columns() * kMaxPiles),
-      rest_(shape.columns() * kMaxPiles, 0.0f) {}
+      rest_(shape.columns() * kMaxPiles, 0.0f),
+      pile_wet_(shape.columns() * kMaxPiles, 0.0f),
+      out_wet_(shape.columns() * kMaxPiles, 0.0f),
+      out_from_(shape.columns() * kMaxPiles, -1),
+      overfilled_(shape.columns(), 0) {}
 
 void Slippage::step(SoilState& state, const SoilType& soil, double gravity, double dt) {
   build_height_spans(shape_, state.rho, state.psi, spans_);
   link_piles();
+  pile_moisture(state);
   rest_angles(soil);
   compute_slices(soil, gravity, dt);
   apply(state);
@@ -123,6 +141,24 @@ void Slippage::step(SoilState& state, const SoilType& soil, double gravity, doub
 double Slippage::rest_angle_of(std::size_t column, int pile) const {
   const std::size_t node = column * kMaxPiles + pile;
   return pile_span_[node] < 0 ? -1.0 : rest_[node];
+}
+
+void Slippage::pile_moisture(const SoilState& state) {
+  const int nz = shape_.nz;
+  tbb::parallel_for(std::size_t{0}, pile_wet_.size(), [&](std::size_t node) {
+    pile_wet_[node] = 0;
+    if (pile_span_[node] < 0) return;
+    const std::size_t col = node / kMaxPiles;
+    const HeightSpan& p = spans_.column(col)[pile_span_[node]];
+    const float* rho = state.rho.data() + col * nz;
+    const float* wet = state.wet.data() + col * nz;
+    double soil = 0, water = 0;
+    for (int z = std::max(0, static_cast<int>(p.bottom)); z <= p.top_voxel; ++z) {
+      soil += rho[z];
+      water += static_cast<double>(rho[z]) * wet[z];
+    }
+    pile_wet_[node] = soil > 0 ? static_cast<float>(water / soil) : 0.0f;
+  });
 }
 
 void Slippage::link_piles() {
@@ -211,7 +247,6 @@ void Slippage::rest_angles(const SoilType& soil) {
   chain_ends(down_, toe_, scratch);
   chain_ends(up_, crest_, scratch);
   const double h = shape_.voxel_size, phi = soil.phi_deg * M_PI / 180.0;
-  const double c = soil.effective_cohesion();
   auto top = [&](std::size_t node) {
     return spans_.column(node / kMaxPiles)[pile_span_[node]].top;
   };
@@ -220,7 +255,9 @@ void Slippage::rest_angles(const SoilType& soil) {
     const HeightSpan& p = spans_.column(i / kMaxPiles)[pile_span_[i]];
     // The slope's real height: crest to toe, at least the pile's own height.
     const double rise = std::max(top(crest_[i]) - top(toe_[i]), p.top - p.bottom) * h;
-    rest_[i] = static_cast<float>(rest_angle(rise, c, phi, soil.gamma));
+    // The pile's own moisture gives its apparent cohesion (thesis 5.3.4).
+    rest_[i] = static_cast<float>(
+        rest_angle(rise, soil.effective_cohesion(pile_wet_[i]), phi, soil.gamma));
   });
 }
 
@@ -355,23 +392,45 @@ double Slippage::slice_rise(const HeightSpan& p, const HeightSpan* n, int ncount
   return std::min(p.top, ceiling) - low_top;  // eq. 32, voxels
 }
 
-void Slippage::apply(SoilState& state) const {
+void Slippage::apply(SoilState& state) {
   const int nz = shape_.nz;
+  // First every pile gives what its slices carry away, from its top down,
+  // and notes the moisture of the soil that left (what it sends carries it).
   tbb::parallel_for(0, shape_.ny, [&](int y) {
     for (int x = 0; x < shape_.nx; ++x) {
       const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
       float* rho = state.rho.data() + col * nz;
+      const float* wet = state.wet.data() + col * nz;
+      const HeightSpan* spans = spans_.column(col);
+      for (int pile = 0; pile < kMaxPiles; ++pile) {
+        const std::size_t node = col * kMaxPiles + pile;
+        out_from_[node] = -1;
+        const int s = pile_span_[node];
+        if (s < 0) continue;
+        float out = 0;
+        for (int d = 0; d < kDirections; ++d) out += out_[slot(col, pile, d)].dh;
+        if (out <= 0) continue;
+        const HeightSpan& p = spans[s];
+        const double water = remove_down(
+            rho, wet, p.top_voxel, std::max(0, static_cast<int>(p.bottom)), out, out_from_[node]);
+        out_wet_[node] = static_cast<float>(water / out);
+      }
+    }
+  });
+  // Then every pile gathers what its 16 neighbours send, in a fixed order,
+  // and lays it on from the lowest voxel it gave from.
+  tbb::parallel_for(0, shape_.ny, [&](int y) {
+    for (int x = 0; x < shape_.nx; ++x) {
+      const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
+      float* rho = state.rho.data() + col * nz;
+      float* wet = state.wet.data() + col * nz;
       const float* psi = state.psi.data() + col * nz;
       const HeightSpan* spans = spans_.column(col);
       const int count = spans_.count[col];
-      float net[HeightSpans::kMaxSpans] = {};
-      for (int pile = 0; pile < kMaxPiles; ++pile) {
-        const int s = pile_span_[col * kMaxPiles + pile];
-        if (s < 0) continue;
-        for (int d = 0; d < kDirections; ++d) net[s] -= out_[slot(col, pile, d)].dh;
-      }
-      // What the 16 neighbours send here, in a fixed order.
-      float edge[kDirections * kMaxPiles];
+      bool over = false;
+      float in[HeightSpans::kMaxSpans] = {};
+      double in_water[HeightSpans::kMaxSpans] = {};
+      float edge[kDirections * kMaxPiles], edge_wet[kDirections * kMaxPiles];
       int edge_voxel[kDirections * kMaxPiles];
       int edges = 0;
       for (int d = 0; d < kDirections; ++d) {
@@ -381,26 +440,32 @@ void Slippage::apply(SoilState& state) const {
         for (int p = 0; p < kMaxPiles; ++p) {
           const Out& o = out_[slot(scol, p, d)];
           if (o.dh <= 0) continue;
+          const float m = out_wet_[scol * kMaxPiles + p];
           if (o.target >= 0) {
-            net[o.target] += o.dh;
+            in[o.target] += o.dh;
+            in_water[o.target] += static_cast<double>(o.dh) * m;
           } else {
             edge[edges] = o.dh;
+            edge_wet[edges] = m;
             edge_voxel[edges++] = o.edge_voxel;
           }
         }
       }
       for (int s = 0; s < count; ++s) {
-        const HeightSpan& p = spans[s];
-        if (net[s] < 0) {
-          const int floor = std::max(0, static_cast<int>(p.bottom));
-          remove_down(rho, p.top_voxel, floor, -net[s]);
-        } else if (net[s] > 0) {
-          add_up(rho, psi, p.top_voxel, nz, net[s]);
-        }
+        if (in[s] <= 0) continue;
+        int from = spans[s].top_voxel;
+        for (int pile = 0; pile < kMaxPiles; ++pile)
+          if (pile_span_[col * kMaxPiles + pile] == s && out_from_[col * kMaxPiles + pile] >= 0)
+            from = out_from_[col * kMaxPiles + pile];
+        over |= add_up(rho, wet, psi, from, nz, in[s],
+                       std::clamp(static_cast<float>(in_water[s] / in[s]), 0.0f, 1.0f));
       }
-      for (int e = 0; e < edges; ++e) add_up(rho, psi, edge_voxel[e], nz, edge[e]);
+      for (int e = 0; e < edges; ++e)
+        over |= add_up(rho, wet, psi, edge_voxel[e], nz, edge[e], edge_wet[e]);
+      overfilled_[col] = over;
     }
   });
+  any_overfilled_ = std::find(overfilled_.begin(), overfilled_.end(), 1) != overfilled_.end();
 }
 
 }  // namespace drift::soil

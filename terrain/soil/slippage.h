@@ -38,15 +38,18 @@
 // once its slope is within kStopDeg of the rest angle (or its wedge is under
 // kStopHeight thick); a pile at rest starts again only kStaticDeg above it
 // (static friction), so piles come to rest instead of creeping for ever.
-// Each pile's net change is applied to its density column from its top voxel
-// (fig. 36): removed downwards, added upwards into open voxels (never through
-// a body).
+// Each pile's change is applied to its density column from its top voxel
+// (fig. 36): what it gives is removed downwards first, then what it receives
+// is added upwards from there into open voxels (never through a body). The
+// soil keeps its moisture: what leaves a pile carries the moisture of the
+// voxels it left, and the pile's own moisture sets its apparent cohesion.
 //
 // Each slice is computed once, by its higher column, and the lower column
 // gathers what it receives, so the same bits come out on any thread count and
 // the soil taken equals the soil given (mass is conserved).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "terrain/soil/height_spans.h"
@@ -82,6 +85,11 @@ class Slippage {
   void step(SoilState& state, const SoilType& soil, double gravity, double dt);
 
   const HeightSpans& spans() const { return spans_; }
+  // Per column, non-zero where the last step laid soil that found no room
+  // (a pile capped by a body that turned over it): the simulation settles
+  // those columns so eq. 17 holds after every step.
+  const std::vector<std::uint8_t>& overfilled() const { return overfilled_; }
+  bool any_overfilled() const { return any_overfilled_; }
   // Rest angle (radians) of pile `pile` of column `column` from the last step
   // (-1 if the column has no such pile).
   double rest_angle_of(std::size_t column, int pile) const;
@@ -112,7 +120,9 @@ class Slippage {
   // A knight's slice from (x, y) along d crosses two columns: both must hold
   // a pile below p's top with nothing solid between it and p's top.
   bool open_path(int x, int y, int d, const HeightSpan& p) const;
-  void apply(SoilState& state) const;
+  // Per pile the mass-weighted moisture of its span (its apparent cohesion).
+  void pile_moisture(const SoilState& state);
+  void apply(SoilState& state);
 
   terrain::Grid3Shape shape_;
   HeightSpans spans_;
@@ -121,6 +131,11 @@ class Slippage {
   std::vector<std::int8_t> pile_span_;              // per node: span index, -1 none
   std::vector<int> down_, up_, toe_, crest_, hop_;  // per node
   std::vector<float> rest_;                         // per node: rest angle, rad
+  std::vector<float> pile_wet_;                     // per node: moisture of the pile
+  std::vector<float> out_wet_;                      // per node: moisture of what it gave
+  std::vector<int> out_from_;                       // per node: lowest voxel it gave from
+  std::vector<std::uint8_t> overfilled_;            // per column
+  bool any_overfilled_ = false;
 };
 
 }  // namespace drift::soil

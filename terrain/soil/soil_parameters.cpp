@@ -17,7 +17,8 @@ const std::vector<SoilParameter>& soil_parameters() {
        "specific weight gamma, over the scenario's soil",
        DRIFT_PARAMETER_FIELD(SoilOptions, soil.gamma), "[soil] gamma"},
       {"soil.moisture", "--moisture", 0, 1, Ends::Closed, false, "",
-       "moisture (0 dry .. 1 damp): adds cohesion, wets the surface",
+       "moisture (0 dry .. 1 damp) the soil starts with where a soil body gives none: "
+       "adds cohesion, wets the surface",
        DRIFT_PARAMETER_FIELD(SoilOptions, soil.moisture), "[soil] moisture"},
       // The time stepping (section 4.2 of the thesis).
       {"dt", "", 0, 1, Ends::OpenLow, false, "s", "time step (soil moves at most a voxel a step)",

@@ -4,9 +4,9 @@
 
 namespace drift::soil {
 
-// 9 fields in the state, 8 back buffers for the passes, one byte the settle's walks mark.
+// 10 fields in the state, 9 back buffers for the passes, one byte the settle's walks mark.
 std::uint64_t soil_state_bytes(const terrain::Grid3Shape& shape) {
-  return static_cast<std::uint64_t>(shape.count()) * (17 * sizeof(float) + 1);
+  return static_cast<std::uint64_t>(shape.count()) * (19 * sizeof(float) + 1);
 }
 
 SoilState::SoilState(const terrain::Grid3Shape& s) : shape(s) {
@@ -20,8 +20,8 @@ SoilState::SoilState(const terrain::Grid3Shape& s) : shape(s) {
                      std::to_string(s.nz),
                  "use a smaller grid or larger voxels");
   const std::size_t n = s.count();
-  for (auto* f : {&rho, &ux, &uy, &uz, &fx, &fy, &fz, &psi, &psi_static, &back.rho, &back.ux,
-                  &back.uy, &back.uz, &back.fx, &back.fy, &back.fz, &back.moving})
+  for (auto* f : {&rho, &ux, &uy, &uz, &fx, &fy, &fz, &psi, &psi_static, &wet, &back.rho, &back.ux,
+                  &back.uy, &back.uz, &back.fx, &back.fy, &back.fz, &back.wet, &back.moving})
     f->assign(n, 0.0f);
   back.visited.assign(n, 0);
 }
@@ -34,6 +34,7 @@ void SoilState::swap_back() {
   fx.swap(back.fx);
   fy.swap(back.fy);
   fz.swap(back.fz);
+  wet.swap(back.wet);
 }
 
 double SoilState::mass() const {
@@ -43,6 +44,22 @@ double SoilState::mass() const {
     double column = 0.0;
     const float* r = rho.data() + c * shape.nz;
     for (int z = 0; z < shape.nz; ++z) column += r[z];
+    total += column;
+  }
+  return total;
+}
+
+}  // namespace drift::soil
+
+namespace drift::soil {
+
+double SoilState::water() const {
+  double total = 0.0;
+  for (std::size_t c = 0; c < shape.columns(); ++c) {
+    double column = 0.0;
+    const float* r = rho.data() + c * shape.nz;
+    const float* m = wet.data() + c * shape.nz;
+    for (int z = 0; z < shape.nz; ++z) column += static_cast<double>(r[z]) * m[z];
     total += column;
   }
   return total;

@@ -14,9 +14,11 @@
 // this holds at any voxel size.
 //
 // Moisture (thesis 5.3.4): wet sand holds steeper slopes through capillary
-// cohesion. moisture in [0, 1] (0 dry, 1 damp through) adds
-// kMoistCohesion * moisture to c; the renderer's wet coat reads it as
-// wetness.
+// cohesion. Moisture in [0, 1] (0 dry, 1 damp through) is a per-voxel field
+// carried with the soil (SoilState::wet); a pile's moisture m adds
+// kMoistCohesion * m to c; the renderer's wet coat reads it as wetness.
+// `moisture` here is the moisture soil starts with where the scenario gives
+// none of its own.
 #pragma once
 
 #include <string>
@@ -30,14 +32,14 @@ struct SoilType {
   double phi_deg = 30.0;  // angle of internal friction, degrees
   double cohesion = 0.0;  // c, t/m
   double gamma = 1.95;    // specific weight, t/m^2
-  double moisture = 0.0;  // 0 dry .. 1 wet
+  double moisture = 0.0;  // initial moisture, 0 dry .. 1 wet
 
   // Apparent cohesion of moist sand, t/m at moisture 1 (about 3 kPa: the
   // order of the apparent cohesion suction gives damp sands, a few kPa; Lu &
   // Likos 2004, Unsaturated Soil Mechanics). Acting over the pile's height it
   // holds damp sand vertical up to about 1 m (a sand castle).
   static constexpr double kMoistCohesion = 0.3;
-  double effective_cohesion() const { return cohesion + kMoistCohesion * moisture; }
+  double effective_cohesion(double m) const { return cohesion + kMoistCohesion * m; }
 };
 
 // The presets of table 6 ("dry_sand", "sandy_loam", "loam"); throws

@@ -145,14 +145,46 @@ terrain::Mesh floor_padded_surface(const SoilState& s, const std::vector<float>&
 
 }  // namespace
 
-terrain::Mesh soil_surface(const SoilState& s, const SurfaceOptions& o, double moisture) {
+float moisture_at(const SoilState& s, const Eigen::Vector3f& p) {
+  const terrain::Grid3Shape& g = s.shape;
+  // Voxel coordinates with voxel centres at whole numbers.
+  const double gx = (p.x() - g.origin.x()) / g.voxel_size - 0.5;
+  const double gy = (p.y() - g.origin.y()) / g.voxel_size - 0.5;
+  const double gz = (p.z() - g.origin.z()) / g.voxel_size - 0.5;
+  const int x0 = static_cast<int>(std::floor(gx)), y0 = static_cast<int>(std::floor(gy)),
+            z0 = static_cast<int>(std::floor(gz));
+  // Trilinear weights times the soil each voxel holds: the surface lies
+  // where rho crosses 0.5, so half its corner voxels are (nearly) empty and
+  // must not dilute the moisture; a second ring covers a vertex whose corners
+  // hold no soil at all (the ridge fix and the floor pad move the surface).
+  for (int ring = 0; ring <= 1; ++ring) {
+    double w = 0, wm = 0;
+    for (int z = z0 - ring; z <= z0 + 1 + ring; ++z)
+      for (int y = y0 - ring; y <= y0 + 1 + ring; ++y)
+        for (int x = x0 - ring; x <= x0 + 1 + ring; ++x) {
+          if (!g.contains(x, y, z)) continue;
+          const std::size_t i = g.index(x, y, z);
+          if (s.rho[i] <= 0) continue;
+          const double t = std::max(0.0, 1 - std::abs(gx - x) / (1 + ring)) *
+                           std::max(0.0, 1 - std::abs(gy - y) / (1 + ring)) *
+                           std::max(0.0, 1 - std::abs(gz - z) / (1 + ring)) * s.rho[i];
+          w += t;
+          wm += t * s.wet[i];
+        }
+    if (w > 0) return static_cast<float>(wm / w);
+  }
+  return 0.0f;
+}
+
+terrain::Mesh soil_surface(const SoilState& s, const SurfaceOptions& o) {
   terrain::Mesh mesh =
       o.ridges == RidgeFix::Off
           ? iso_surface(s.shape, surface_density(s, o))
           : floor_padded_surface(s, surface_density(s, o), std::clamp(o.ramp_voxels, 1, 16));
-  mesh.vertex_attributes.push_back(
-      {terrain::products::kWetness,
-       std::vector<float>(mesh.positions.size(), static_cast<float>(moisture))});
+  std::vector<float> wetness(mesh.positions.size());
+  tbb::parallel_for(std::size_t{0}, wetness.size(),
+                    [&](std::size_t v) { wetness[v] = moisture_at(s, mesh.positions[v]); });
+  mesh.vertex_attributes.push_back({terrain::products::kWetness, std::move(wetness)});
   return mesh;
 }
 

@@ -55,16 +55,19 @@ enum class IsoGrid { Band, Full };
 terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<float>& field,
                           IsoGrid kind = IsoGrid::Band);
 
-// The soil's surface, with a per-vertex "wetness" = moisture (for the
-// renderer's wet coat).
-terrain::Mesh soil_surface(const SoilState& state, const SurfaceOptions& options,
-                           double moisture = 0.0);
+// The soil's surface, with a per-vertex "wetness" (for the renderer's wet
+// coat): the moisture field at the vertex (moisture_at).
+terrain::Mesh soil_surface(const SoilState& state, const SurfaceOptions& options);
 
-// Writes grids "density" (rho), "collision" (psi) and "wetness" (`moisture`
-// where there is soil) as fog volumes and "velocity" (m/s, a vector grid),
+// The moisture of the soil at p (metres): the field's trilinear mean over the
+// voxels around p weighted by the soil they hold (a surface vertex lies
+// between full and empty voxels); 0 where no soil is near.
+float moisture_at(const SoilState& state, const Eigen::Vector3f& p);
+
+// Writes grids "density" (rho), "collision" (psi) and "wetness" (the
+// moisture field where there is soil) as fog volumes and "velocity" (m/s, a vector grid),
 // voxel size and origin in metres, atomically; the same state gives the same
 // bytes. Throws drift::Error naming the file.
-void write_density_vdb(const SoilState& state, const std::filesystem::path& path,
-                       double moisture = 0.0);
+void write_density_vdb(const SoilState& state, const std::filesystem::path& path);
 
 }  // namespace drift::soil

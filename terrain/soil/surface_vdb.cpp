@@ -159,7 +159,7 @@ terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>
   return mesh;
 }
 
-void write_density_vdb(const SoilState& s, const std::filesystem::path& path, double moisture) {
+void write_density_vdb(const SoilState& s, const std::filesystem::path& path) {
   init_openvdb();
   const terrain::Grid3Shape& g = s.shape;
   auto transform = openvdb::math::Transform::createLinearTransform(g.voxel_size);
@@ -167,10 +167,10 @@ void write_density_vdb(const SoilState& s, const std::filesystem::path& path, do
                                           g.origin.y() + 0.5 * g.voxel_size,
                                           g.origin.z() + 0.5 * g.voxel_size));
   // The wetness of the soil (thesis 5.3.4, for a renderer's wet coat): the
-  // scenario's moisture wherever there is soil.
+  // moisture field wherever there is soil.
   std::vector<float> wetness(s.size(), 0.0f);
   for (std::size_t i = 0; i < s.size(); ++i)
-    if (s.rho[i] > 0) wetness[i] = static_cast<float>(moisture);
+    if (s.rho[i] > 0) wetness[i] = s.wet[i];
   openvdb::GridPtrVec grids;
   for (auto [name, field] :
        {std::pair{"density", &s.rho}, std::pair{"collision", &s.psi},

@@ -42,16 +42,20 @@ inline int sign_of(float d) { return d > 0 ? 1 : (d < 0 ? -1 : 0); }
 inline float weight_inverse(float w) { return w > 1e-30f ? 1.0f / w : 0.0f; }
 
 // What one voxel gathered: the amount (stay + backflow + inflows) and the
-// amount-weighted sums of the carried vectors.
+// amount-weighted sums of the carried vectors and of the moisture (which
+// goes with the soil: the same products a * lambda, so water is conserved as
+// mass is).
 struct Gathered {
   float amount = 0;
   float u[3] = {0, 0, 0};
   float f[3] = {0, 0, 0};
+  float m = 0;
 };
 
 struct Carried {
   const float* u[3];
   const float* f[3];
+  const float* m;
 };
 
 // What voxel (x, y, z) holding `a` sends to other voxels that accept it:
@@ -128,6 +132,7 @@ Gathered gather(const terrain::Grid3Shape& s, const float* amount, const Accept&
       g.u[k] = wu * c.u[k][i];
       g.f[k] = kept * c.f[k][i];
     }
+    g.m = kept * c.m[i];
   }
   if (!accept(i)) return g;
   for (int oy = -1; oy <= 1; ++oy)
@@ -148,6 +153,7 @@ Gathered gather(const terrain::Grid3Shape& s, const float* amount, const Accept&
           g.u[k] += in * c.u[k][n];
           g.f[k] += in * c.f[k][n];
         }
+        g.m += in * c.m[n];
       }
   return g;
 }

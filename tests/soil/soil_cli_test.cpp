@@ -6,10 +6,12 @@
 #include <sys/mount.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -248,3 +250,91 @@ TEST(SoilCli, VdbOnAFullDiskFailsAndKeepsTheOldFile) {
 }
 
 }  // namespace
+
+namespace {
+
+// A closed box as OBJ text (z up), half extents hx, hy, hz about the origin.
+std::string box_obj(double hx, double hy, double hz) {
+  std::ostringstream o;
+  for (int c = 0; c < 8; ++c)
+    o << "v " << ((c & 1) ? hx : -hx) << ' ' << ((c & 2) ? hy : -hy) << ' ' << ((c & 4) ? hz : -hz)
+      << '\n';
+  for (const char* f : {"1 3 2", "2 3 4", "5 6 7", "6 8 7", "1 2 5", "2 6 5", "3 7 4", "4 7 8",
+                        "1 5 3", "3 5 7", "2 4 6", "4 8 6"})
+    o << "f " << f << '\n';
+  return o.str();
+}
+
+// Two soil bodies, one with its own moisture, and a mesh body that turns.
+const char* kTurningScenario = R"([grid]
+size = [24, 24, 16]
+voxel = 0.1
+[soil]
+moisture = 0.1
+[simulation]
+steps = 30
+[[soil_body]]
+name = "dry"
+[[soil_body.primitive]]
+shape = "cuboid"
+center = [0.6, 1.2, 0.25]
+half_extents = [0.6, 1.2, 0.25]
+[[soil_body]]
+name = "wet"
+moisture = 0.7
+[[soil_body.primitive]]
+shape = "cuboid"
+center = [1.8, 1.2, 0.25]
+half_extents = [0.6, 1.2, 0.25]
+[[body]]
+name = "bucket"
+mesh = "box.obj"
+spin = [0, 0, 30]
+[[body.keyframe]]
+time = 0
+position = [1.2, 1.2, 0.6]
+[[body.keyframe]]
+time = 0.5
+position = [1.2, 1.2, 0.4]
+rotation = [0, 20, 0]
+)";
+
+}  // namespace
+
+// The scenario format's moisture per soil body and its turning mesh body:
+// the mesh's wetness holds both moistures (before, one value everywhere);
+// bad values are errors naming the key.
+TEST(SoilCli, SoilBodyMoistureAndATurningMeshBody) {
+  const fs::path d = dir();
+  std::ofstream(d / "box.obj") << box_obj(0.3, 0.5, 0.2);
+  std::ofstream(d / "t.toml") << kTurningScenario;
+  ASSERT_EQ(run((d / "t.toml").string() + " -o " + (d / "soil.ply").string(), d), 0) << output(d);
+  const drift::terrain::Mesh m = drift::terrain::read_ply(d / "soil.ply");
+  const auto* wet = m.attribute("wetness");
+  ASSERT_NE(wet, nullptr);
+  const auto [lo, hi] = std::minmax_element(wet->begin(), wet->end());
+  EXPECT_NEAR(*lo, 0.1f, 0.02f);
+  EXPECT_NEAR(*hi, 0.7f, 0.02f);
+  const std::string base = kTurningScenario;
+  const struct {
+    std::string from, to, expect;
+  } cases[] = {
+      {"moisture = 0.7", "moisture = 1.5", "moisture"},
+      {"mesh = \"box.obj\"", "mesh = \"open.obj\"", "closed"},
+      {"mesh = \"box.obj\"", "mesh = \"none.obj\"", "none.obj"},
+      {"spin = [0, 0, 30]", "spin = [0, nan, 30]", "spin"},
+      {"spin = [0, 0, 30]", "rotation = [0, 0, 30]", "rotation"},
+  };
+  std::string open = box_obj(0.3, 0.5, 0.2);
+  open.erase(open.find("f 1 3 2"), std::string("f 1 3 2\nf 2 3 4\n").size());  // no bottom
+  std::ofstream(d / "open.obj") << open;
+  for (const auto& c : cases) {
+    std::string text = base;
+    text.replace(text.find(c.from), c.from.size(), c.to);
+    std::ofstream(d / "bad.toml") << text;
+    EXPECT_EQ(run((d / "bad.toml").string() + " -o " + (d / "bad.ply").string(), d), 1)
+        << c.to << ": " << output(d);
+    EXPECT_NE(output(d).find(c.expect), std::string::npos) << c.to << ": " << output(d);
+    EXPECT_FALSE(fs::exists(d / "bad.ply"));
+  }
+}
