@@ -18,7 +18,7 @@
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
 #include "terrain/soil/soil_parameters.h"
-#include "terrain/soil/surface.h"
+#include "terrain/soil/soil_surface.h"
 #include "terrain/soil/top_surface.h"
 
 namespace drift::pipeline {

@@ -5,6 +5,7 @@
 
 #include "pipeline/object_list.h"
 #include "pipeline/toml_section.h"
+#include "terrain/angles.h"
 #include "terrain/bilinear.h"
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
@@ -134,7 +135,7 @@ WindowWithApron with_apron(const terrain::RasterWindow& w, const terrain::Raster
 
 // Degrees about x, then y, then z (world axes) as a rotation.
 Eigen::Quaterniond rotation_from_degrees(const Eigen::Vector3d& deg) {
-  const Eigen::Vector3d r = deg * (M_PI / 180.0);
+  const Eigen::Vector3d r = deg * terrain::kRadiansPerDegree<double>;
   return Eigen::Quaterniond(Eigen::AngleAxisd(r.z(), Eigen::Vector3d::UnitZ()) *
                             Eigen::AngleAxisd(r.y(), Eigen::Vector3d::UnitY()) *
                             Eigen::AngleAxisd(r.x(), Eigen::Vector3d::UnitX()));
@@ -288,7 +289,8 @@ void read_bodies(const toml::table& root, const std::filesystem::path& file,
       b.primitives = read_primitives(s, file, "body");
     }
     // Turning: degrees a second about x, y, z (world axes) about the body's position.
-    b.spin = s.vector<3>("spin", -1e5, 1e5).value_or(Eigen::Vector3d::Zero()) * (M_PI / 180.0);
+    b.spin = s.vector<3>("spin", -1e5, 1e5).value_or(Eigen::Vector3d::Zero()) *
+             terrain::kRadiansPerDegree<double>;
     for (const toml::table* k : s.tables("keyframe")) {
       Section ks(k, "body.keyframe", file, kDoc);
       soil::Keyframe f;

@@ -94,7 +94,7 @@ marks::Material read_material_value(const toml::node& node, const fs::path& file
     m = *p;
   }
   m.name = s.string("name").value_or(m.name + "*");
-  // The ranges are the material's own (terrain/marks/material.h).
+  // The ranges are the material's own (terrain/marks/ground_material.h).
   for (const terrain::Parameter<marks::Material>& p : marks::material_parameters()) {
     const double v = s.number(p.key, p.get(m), p.lo, p.hi);
     if (!p.admits(v))

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "render/sampling.h"
+#include "terrain/angles.h"
 #include "terrain/direction.h"
 #include "terrain/error.h"
 
@@ -54,7 +55,7 @@ PathTracer::PathTracer(const TerrainScene& scene, const SceneInput& input, const
       objects_(input.meshes, scene.origin()) {
   const Sun& sun = input.sun;
   sun_dir_ = terrain::direction_from_az_el(sun.azimuth_deg, sun.elevation_deg).cast<float>();
-  sun_cos_max_ = static_cast<float>(std::cos(sun.angular_diameter_deg * std::numbers::pi / 360.0));
+  sun_cos_max_ = static_cast<float>(std::cos(terrain::radians(0.5 * sun.angular_diameter_deg)));
   sun_irradiance_ = sun.color * static_cast<float>(sun.irradiance);
   sun_up_ = sun.irradiance > 0.0 && sun_dir_.z() > -0.2f;
 
@@ -108,7 +109,7 @@ void PathTracer::init_clouds(const SceneInput& input) {
   const float altitude = static_cast<float>(input.clouds.altitude);
   cloud_light_.sun = sun_up_ ? air_->sun_irradiance(altitude) : Vector3f::Zero();
   cloud_light_.sun_dir = sun_dir_;
-  sun_penumbra_ = static_cast<float>(input.sun.angular_diameter_deg * std::numbers::pi / 180.0);
+  sun_penumbra_ = static_cast<float>(terrain::radians(input.sun.angular_diameter_deg));
   const Vector3f level = air_->level_irradiance();
   const float camera_altitude = base_altitude_ + camera_.eye.z();
   cloud_light_.sky_down =

@@ -1,7 +1,5 @@
 #include "snow/stabilise_grid.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -19,6 +17,7 @@
 #include "terrain/error.h"
 #include "terrain/memory.h"
 #include "terrain/neighbours.h"
+#include "terrain/parallel.h"
 #include "terrain/slope_relax.h"
 
 namespace drift::snow {
@@ -51,15 +50,6 @@ constexpr double kTailShare = 0.1;
 constexpr int kCoarsestCells = 32;
 using terrain::kNeighbours8;
 
-template <class Fn>
-void for_list(const std::vector<int>& items, const Fn& fn) {
-  if (items.size() < kParallelTiles) {
-    for (int t : items) fn(t);
-    return;
-  }
-  tbb::parallel_for(std::size_t{0}, items.size(), [&](std::size_t k) { fn(items[k]); });
-}
-
 // A run of consecutive tiles in one row of tiles (tx0 <= tile x < tx1). The
 // phases work on runs, so that their inner loops run along rows of cells and
 // the cells with all 8 neighbours inside take a path without edge tests that
@@ -88,11 +78,8 @@ std::vector<TileRun> runs_of(const std::vector<int>& tiles, int tiles_x) {
 // same result either way: each cell's values are its own).
 template <class Fn>
 void for_runs(const std::vector<TileRun>& runs, std::size_t tiles, const Fn& fn) {
-  if (tiles < kParallelTiles || runs.size() < 2) {
-    for (const TileRun& r : runs) fn(r);
-    return;
-  }
-  tbb::parallel_for(std::size_t{0}, runs.size(), [&](std::size_t k) { fn(runs[k]); });
+  const bool parallel = tiles >= kParallelTiles && runs.size() >= 2;
+  terrain::for_each_item(runs, parallel ? 0 : runs.size() + 1, fn);
 }
 
 // Jacobi passes of terrain/slope_relax's HalfSteepest rule for snow on ground,
@@ -347,7 +334,7 @@ class SnowPasses {
         if (!tile_active_[static_cast<std::size_t>(t)]) fill_tile(give_, t, kNotGiving);
       }
     });
-    for_list(touched, [&](int t) {
+    terrain::for_each_item(touched, kParallelTiles, [&](int t) {
       fill_tile(touched_, t, std::uint8_t{0});
       tile_touched_[static_cast<std::size_t>(t)] = 0;
     });

@@ -1,12 +1,12 @@
 #include "terrain/slope_relax.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "terrain/hash.h"
+#include "terrain/neighbours.h"
+#include "terrain/parallel.h"
 
 namespace drift::terrain {
 
@@ -17,31 +17,6 @@ constexpr int kTile = 16;
 // Tiles in a phase below which it runs on the calling thread (marks' small
 // windows): the result is the same either way.
 constexpr std::size_t kParallelTiles = 32;
-
-struct Neighbour {
-  int dx, dy;
-};
-// Neighbour k and neighbour 7 - k are opposite.
-constexpr std::array<Neighbour, 8> kNeighbours{
-    {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}}};
-
-template <class Fn>
-void for_tiles(const std::vector<int>& tiles, const Fn& fn) {
-  if (tiles.size() < kParallelTiles) {
-    for (int t : tiles) fn(t);
-    return;
-  }
-  tbb::parallel_for(std::size_t{0}, tiles.size(), [&](std::size_t k) { fn(tiles[k]); });
-}
-
-template <class Fn>
-void for_each_index(std::size_t count, const Fn& fn, std::size_t serial_below = kParallelTiles) {
-  if (count < serial_below) {
-    for (std::size_t k = 0; k < count; ++k) fn(k);
-    return;
-  }
-  tbb::parallel_for(std::size_t{0}, count, fn);
-}
 
 // Cells in a list below which a phase of run_cells runs on the calling thread.
 constexpr std::size_t kParallelCells = 8192;
@@ -76,8 +51,8 @@ class SlopeRelaxer {
         w_(heights.width()),
         hgt_(heights.height()) {
     for (int k = 0; k < 8; ++k) {
-      distance_[k] = std::hypot(kNeighbours[k].dx * o_.dx, kNeighbours[k].dy * o_.dy);
-      offset_[k] = static_cast<std::ptrdiff_t>(kNeighbours[k].dy) * w_ + kNeighbours[k].dx;
+      distance_[k] = std::hypot(kNeighbours8[k].dx * o_.dx, kNeighbours8[k].dy * o_.dy);
+      offset_[k] = static_cast<std::ptrdiff_t>(kNeighbours8[k].dy) * w_ + kNeighbours8[k].dx;
     }
   }
 
@@ -108,7 +83,7 @@ class SlopeRelaxer {
       for (int t : near_)
         for_cells(t, [&](std::size_t i, int, int) { near_cells_.push_back(static_cast<int>(i)); });
       report.moved += pass(givers_, near_cells_);
-      for_tiles(near_, [&](int t) {
+      for_each_item(near_, kParallelTiles, [&](int t) {
         bool any = false;
         for_cells(t, [&](std::size_t i, int, int) { any = any || ws_.touched_[i]; });
         ws_.tile_touched_[static_cast<std::size_t>(t)] = any;
@@ -214,7 +189,7 @@ class SlopeRelaxer {
   bool interior(int x, int y) const { return x > 0 && y > 0 && x < w_ - 1 && y < hgt_ - 1; }
   // Neighbour k of cell (x, y) lies in the grid.
   bool has(int x, int y, int k) const {
-    return inside(x + kNeighbours[k].dx, y + kNeighbours[k].dy);
+    return inside(x + kNeighbours8[k].dx, y + kNeighbours8[k].dy);
   }
   const SlopeRule& rule_at(std::size_t i) const {
     return cells_.rule_of_cell ? cells_.rules[cells_.rule_of_cell->values()[i]] : cells_.rules[0];
@@ -373,22 +348,16 @@ class SlopeRelaxer {
       ws_.mult_.resize(active.size()), ws_.post_.resize(active.size());
       ws_.factor_.resize(active.size());
     }
-    for_each_index(
-        active.size(),
-        [&](std::size_t s) {
-          const auto i = static_cast<std::size_t>(active[s]);
-          if (giver(i)) give(s, i);
-        },
-        kParallelCells);
+    for_each_index(active.size(), kParallelCells, [&](std::size_t s) {
+      const auto i = static_cast<std::size_t>(active[s]);
+      if (giver(i)) give(s, i);
+    });
     for_each_cell(near, [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
     gave_.assign(near.size(), 0.0);
-    for_each_index(
-        near.size(),
-        [&](std::size_t k) {
-          const int c = near[k];
-          gave_[k] = change(static_cast<std::size_t>(c), c % w_, c / w_);
-        },
-        kParallelCells);
+    for_each_index(near.size(), kParallelCells, [&](std::size_t k) {
+      const int c = near[k];
+      gave_[k] = change(static_cast<std::size_t>(c), c % w_, c / w_);
+    });
     for (int c : active) ws_.slot_[static_cast<std::size_t>(c)] = -1;
     double moved = 0.0;
     for (double g : gave_) moved += g;
@@ -443,13 +412,10 @@ class SlopeRelaxer {
   }
   template <class Fn>
   void for_each_cell(const std::vector<int>& cells, const Fn& fn) const {
-    for_each_index(
-        cells.size(),
-        [&](std::size_t k) {
-          const int c = cells[k];
-          fn(static_cast<std::size_t>(c), c % w_, c / w_);
-        },
-        kParallelCells);
+    for_each_index(cells.size(), kParallelCells, [&](std::size_t k) {
+      const int c = cells[k];
+      fn(static_cast<std::size_t>(c), c % w_, c / w_);
+    });
   }
 
   void clear_active(int t) {
@@ -468,12 +434,12 @@ class SlopeRelaxer {
     for (int t : was_active)  // active before, not a candidate now: clear
       if (ws_.tile_mark_[static_cast<std::size_t>(t)]) clear_active(t);
     for (int t : was_active) ws_.tile_mark_[static_cast<std::size_t>(t)] = 0;
-    for_tiles(candidates, [&](int t) { mark_active(t); });
-    for_tiles(touched, [&](int t) {
+    for_each_item(candidates, kParallelTiles, [&](int t) { mark_active(t); });
+    for_each_item(touched, kParallelTiles, [&](int t) {
       ws_.tile_ever_[static_cast<std::size_t>(t)] = 1;
       for_cells(t, [&](std::size_t i, int, int) { ws_.ever_[i] |= ws_.touched_[i]; });
     });
-    for_tiles(touched, [&](int t) {
+    for_each_item(touched, kParallelTiles, [&](int t) {
       for_cells(t, [&](std::size_t i, int, int) { ws_.touched_[i] = 0; });
       ws_.tile_touched_[static_cast<std::size_t>(t)] = 0;
     });
@@ -553,7 +519,7 @@ double max_slope_excess(const Grid<double>& heights, const SlopeCells& cells,
     const double floor = std::max(cells.floor ? cells.floor->values()[i] : -kInf, cells.min_value);
     if (!(h[i] - floor > min_room)) return;
     const int x = index % w, y = index / w;
-    for (const Neighbour& nb : kNeighbours) {
+    for (const NeighbourOffset& nb : kNeighbours8) {
       const int nx = x + nb.dx, ny = y + nb.dy;
       if (nx < 0 || ny < 0 || nx >= w || ny >= hgt) continue;
       const std::size_t n = static_cast<std::size_t>(ny) * w + nx;

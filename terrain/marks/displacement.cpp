@@ -5,13 +5,13 @@
 #include <cmath>
 
 #include "terrain/marks/distance_transform.h"
+#include "terrain/neighbours.h"
 
 namespace drift::marks {
 
 namespace {
 
-constexpr std::array<std::array<int, 2>, 8> kNeighbours{
-    {{-1, -1}, {0, -1}, {1, -1}, {-1, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}}};
+using terrain::kNeighbours8;
 
 // The window's cells with their state for one contact.
 struct Patch {
@@ -24,7 +24,7 @@ struct Patch {
 
   int global(int li) const { return (w.row0 + li / w.width) * grid_w + w.col0 + li % w.width; }
   int neighbour(int li, int k) const {  // local index, or -1 outside the window
-    const int x = li % w.width + kNeighbours[k][0], y = li / w.width + kNeighbours[k][1];
+    const int x = li % w.width + kNeighbours8[k].dx, y = li / w.width + kNeighbours8[k].dy;
     return (x < 0 || y < 0 || x >= w.width || y >= w.height) ? -1 : y * w.width + x;
   }
 };
@@ -76,7 +76,7 @@ bool hand_on(Patch& p, int li, Weight weight) {
 }
 
 double along(const std::optional<Eigen::Vector2d>& drag, int k) {
-  return drag ? kNeighbours[k][0] * drag->x() + kNeighbours[k][1] * drag->y() : 0.0;
+  return drag ? kNeighbours8[k].dx * drag->x() + kNeighbours8[k].dy * drag->y() : 0.0;
 }
 
 // Material with nowhere to go under the object (a hole enclosed by the contact,
@@ -218,7 +218,7 @@ DisplacementReport compress_and_displace(terrain::Grid<double>& heights, const B
   std::optional<Eigen::Vector2d> dir;
   if (drag && drag->norm() > 0) dir = drag->normalized();
   for (int k = 0; k < 8; ++k)
-    p.length[k] = std::hypot(kNeighbours[k][0] * dx, kNeighbours[k][1] * dy);
+    p.length[k] = std::hypot(kNeighbours8[k].dx * dx, kNeighbours8[k].dy * dy);
   p.outer = euclidean_distance(p.contact, p.w.width, p.w.height, dx, dy, false);
   displace_contact(p, dir, r);
   settle_outside(p, heights, bottom, dir, r, disturbed);

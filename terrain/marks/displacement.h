@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "terrain/grid.h"
-#include "terrain/marks/material.h"
+#include "terrain/marks/ground_material.h"
 #include "terrain/marks/object_bottom.h"
 
 namespace drift::marks {

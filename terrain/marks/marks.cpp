@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "terrain/angles.h"
 #include "terrain/error.h"
 #include "terrain/hash.h"
 #include "terrain/marks/displacement.h"
@@ -226,8 +226,8 @@ int MarksSimulation::resolution_for(const MarkObject& object, const Eigen::Vecto
   if (!options_.camera) return 1;
   // Paper 000, 3.6 A: the projected size of a cell against a pixel.
   const double distance = (options_.camera->position - where).norm();
-  const double focal_px = 0.5 * options_.camera->width_px /
-                          std::tan(0.5 * options_.camera->fov_deg * std::numbers::pi / 180.0);
+  const double focal_px =
+      0.5 * options_.camera->width_px / std::tan(terrain::radians(0.5 * options_.camera->fov_deg));
   const double cell_px = std::min(frame_.dx, frame_.dy) * focal_px / std::max(distance, 1e-9);
   return cell_px <= 0.25 ? 4 : cell_px <= 0.5 ? 2 : 1;
 }

@@ -38,8 +38,8 @@
 #include <vector>
 
 #include "terrain/grid.h"
+#include "terrain/marks/ground_material.h"
 #include "terrain/marks/marks_options.h"
-#include "terrain/marks/material.h"
 #include "terrain/marks/object_bottom.h"
 #include "terrain/marks/object_geometry.h"
 #include "terrain/marks/trajectory.h"

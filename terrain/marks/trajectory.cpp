@@ -2,14 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "terrain/angles.h"
 #include "terrain/error.h"
 
 namespace drift::marks {
 
 Eigen::Quaterniond rotation_from_ypr(double yaw_deg, double pitch_deg, double roll_deg) {
-  const double k = std::numbers::pi / 180.0;
+  const double k = terrain::kRadiansPerDegree<double>;
   return Eigen::Quaterniond(Eigen::AngleAxisd(yaw_deg * k, Eigen::Vector3d::UnitZ()) *
                             Eigen::AngleAxisd(-pitch_deg * k, Eigen::Vector3d::UnitY()) *
                             Eigen::AngleAxisd(roll_deg * k, Eigen::Vector3d::UnitX()));

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "terrain/angles.h"
 #include "terrain/soil/soil_slice.h"
 
 namespace drift::soil {
@@ -246,7 +247,7 @@ void Slippage::rest_angles(const SoilType& soil) {
   std::vector<int> scratch(toe_.size());
   chain_ends(down_, toe_, scratch);
   chain_ends(up_, crest_, scratch);
-  const double h = shape_.voxel_size, phi = soil.phi_deg * M_PI / 180.0;
+  const double h = shape_.voxel_size, phi = terrain::radians(soil.phi_deg);
   auto top = [&](std::size_t node) {
     return spans_.column(node / kMaxPiles)[pile_span_[node]].top;
   };
@@ -335,7 +336,7 @@ void Slippage::slide_pile(int x, int y, int pile, const HeightSpan& p, const Sli
   // Failure of the slope along its steepest descent, over one voxel's run;
   // once stopped, only above the static angle.
   const double h = k.voxel;
-  const double margin = (v > 0 ? kStopDeg : kStaticDeg) * M_PI / 180.0;
+  const double margin = terrain::radians(v > 0 ? kStopDeg : kStaticDeg);
   const double wedge = (steepest - std::tan(rest)) * h;  // above the rest plane, m
   if (d1 < 0 || std::atan(steepest) <= rest + margin || (v > 0 && wedge <= kStopHeight)) {
     v = 0;

@@ -15,7 +15,7 @@
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
-#include "terrain/soil/surface.h"
+#include "terrain/soil/soil_surface.h"
 
 namespace drift::soil {
 

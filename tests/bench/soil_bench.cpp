@@ -6,7 +6,7 @@
 // R9 270 GPU; t = 1.17 alpha + 8.95 ms at 72^3.
 #include <benchmark/benchmark.h>
 
-#include "terrain/soil/surface.h"
+#include "terrain/soil/soil_surface.h"
 #include "tests/bench/peak_memory.h"
 #include "tests/soil/soil_fixtures.h"
 

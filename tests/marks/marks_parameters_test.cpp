@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "terrain/marks/material.h"
+#include "terrain/marks/ground_material.h"
 #include "tests/parameter_table.h"
 
 using namespace drift::marks;
@@ -39,10 +39,9 @@ TEST(MarksParameters, MaterialRangesHoldAtBothEndsWithTheStagesErrorType) {
 // (material_preset) and each track-file key's range and meaning
 // (material_parameters()), row by row, and nothing else.
 TEST(MarksParameters, DocsMaterialsTablesAgreeWithThePresetsAndTheRows) {
-  using drift::testing::markdown_table;
   using drift::terrain::format_value;
-  const auto presets =
-      markdown_table("docs/marks.md", "| preset | theta (deg) | alpha | sigma |");
+  using drift::testing::markdown_table;
+  const auto presets = markdown_table("docs/marks.md", "| preset | theta (deg) | alpha | sigma |");
   std::size_t listed = 0;
   for (const std::string name : {"sand", "mud", "snow"}) {
     const Material m = *material_preset(name);

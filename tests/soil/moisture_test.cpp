@@ -10,7 +10,7 @@
 
 #include "terrain/products.h"
 #include "terrain/soil/scenario.h"
-#include "terrain/soil/surface.h"
+#include "terrain/soil/soil_surface.h"
 #include "tests/soil/soil_fixtures.h"
 
 namespace drift::soil {

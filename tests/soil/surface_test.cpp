@@ -1,6 +1,4 @@
 // Soil surfaces (paper 004, sec. 3.3 and 5.3.2): closed, outward, ridge-free.
-#include "terrain/soil/surface.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -11,6 +9,7 @@
 #include <map>
 #include <string>
 
+#include "terrain/soil/soil_surface.h"
 #include "tests/soil/soil_fixtures.h"
 
 namespace drift::soil {

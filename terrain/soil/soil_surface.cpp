@@ -1,4 +1,4 @@
-#include "terrain/soil/surface.h"
+#include "terrain/soil/soil_surface.h"
 
 #include <tbb/parallel_for.h>
 

@@ -1,4 +1,4 @@
-#include "terrain/marks/material.h"
+#include "terrain/marks/ground_material.h"
 
 #include <cmath>
 
