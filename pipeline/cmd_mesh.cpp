@@ -24,8 +24,6 @@ struct MeshCommand {
 };
 
 void run_mesh(const MeshCommand& c) {
-  if (!terrain::is_mesh_output(c.output))
-    usage_error("-o '" + c.output + "' must end in .glb, .gltf, .fbx, .stl, .obj or .ply");
   std::vector<std::pair<std::string, std::string>> named;  // name, raster
   std::vector<std::filesystem::path> inputs = {c.raster};
   for (const std::string& a : c.attributes) {
@@ -35,7 +33,10 @@ void run_mesh(const MeshCommand& c) {
     named.emplace_back(a.substr(0, eq), a.substr(eq + 1));
     inputs.emplace_back(a.substr(eq + 1));
   }
+  // The path's own problems (a device, an input) first, as every command reports them.
   OutputSet outputs({c.output}, inputs);
+  if (!terrain::is_mesh_output(c.output))
+    usage_error("-o '" + c.output + "' must end in .glb, .gltf, .fbx, .stl, .obj or .ply");
   terrain::ReadOptions read;
   if (!c.crop.empty()) {
     read.window = terrain::crop_window(terrain::read_raster_header(c.raster),
