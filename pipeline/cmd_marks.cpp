@@ -151,7 +151,11 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
   }
   if (!c.posed.empty()) {  // issue 32 item 7: the objects where they stand at --posed-at
     const double t = c.posed_at.value_or(marks::run_end(track.objects));
-    terrain::write_obj(marks::posed_objects(track.objects, ground, t), c.posed);
+    const terrain::Mesh posed = marks::posed_objects(track.objects, ground, t);
+    if (terrain::is_mesh_output(c.posed))  // .glb/.gltf/.fbx/.stl/.ply by extension
+      terrain::write_mesh(posed, c.posed);
+    else
+      terrain::write_obj(posed, c.posed);
   }
   outputs.commit();
   std::printf("marks: wrote %s\n", c.output.c_str());
@@ -201,7 +205,8 @@ void add_marks_command(CLI::App& root) {
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   sub->add_option("--posed", c->posed,
-                  "OBJ of the objects at their pose at --posed-at (same keyframes as the marks), "
+                  "mesh (OBJ; .glb, .gltf, .fbx, .stl, .ply by extension) of the objects at their "
+                  "pose at --posed-at (same keyframes as the marks), "
                   "in the ground's CRS from the raster's north-west corner: a scene's [[objects]] "
                   "mesh, at position = that corner ([0, 0, 0] on a local grid)");
   sub->add_option("--posed-at", c->posed_at,

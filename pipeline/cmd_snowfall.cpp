@@ -81,7 +81,12 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   if (!c.surface.empty())
     terrain::write_geotiff(terrain::lay_on_ground(ground, r.depth, "the snow depth"), c.surface,
                            {"snow surface height, ground + depth (m)", "m"});
-  if (!c.mesh_out.empty()) terrain::write_ply(r.objects, c.mesh_out);
+  if (!c.mesh_out.empty()) {  // .glb/.gltf/.obj/.stl/.fbx by extension, else PLY as before
+    if (terrain::is_mesh_output(c.mesh_out))
+      terrain::write_mesh(r.objects, c.mesh_out);
+    else
+      terrain::write_ply(r.objects, c.mesh_out);
+  }
   outputs.commit();
   std::printf("snow fall: wrote %s\n", c.output.c_str());
   if (!c.cover.empty()) std::printf("snow fall: wrote %s\n", c.cover.c_str());

@@ -38,17 +38,10 @@ struct SoilCommand {
   bool no_ridge_fix = false;
 };
 
-void write_mesh(const terrain::Mesh& mesh, const fs::path& path) {
-  if (path.extension() == ".obj")
-    terrain::write_obj(mesh, path);
-  else
-    terrain::write_ply(mesh, path);
-}
-
 void check_mesh_path(const std::string& path, const char* flag) {
-  const std::string ext = fs::path(path).extension().string();
-  if (ext != ".ply" && ext != ".obj")
-    usage_error(std::string(flag) + " '" + path + "' must end in .ply or .obj");
+  if (!terrain::is_mesh_output(path))
+    usage_error(std::string(flag) + " '" + path +
+                "' must end in .ply, .obj, .glb, .gltf, .stl or .fbx");
 }
 
 // The command line's values over the scenario's own.
@@ -69,12 +62,12 @@ std::vector<std::string> write_products(const SoilCommand& c, const soil::SoilSc
   std::vector<std::string> wrote;
   const terrain::Mesh mesh = soil::soil_surface(state, surface);
   if (mesh.triangles.empty()) throw Error("scenario '" + c.scenario + "' left no soil surface");
-  write_mesh(mesh, c.output);
+  terrain::write_mesh(mesh, c.output);  // by extension (terrain/mesh_io.h)
   wrote.push_back(c.output + " (" + std::to_string(mesh.triangle_count()) + " triangles)");
   if (!c.collision.empty()) {
     const terrain::Mesh bodies = soil::iso_surface(state.shape, state.psi);
     if (bodies.triangles.empty()) throw Error("--collision: the scenario has no terrain or bodies");
-    write_mesh(bodies, c.collision);
+    terrain::write_mesh(bodies, c.collision);
     wrote.push_back(c.collision + " (" + std::to_string(bodies.triangle_count()) + " triangles)");
   }
   if (!c.vdb.empty()) {
@@ -134,7 +127,7 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
       char name[32];
       if (!c.frames.empty()) {
         std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-        write_mesh(soil::soil_surface(s.state(), surface), fs::path(c.frames) / name);
+        terrain::write_mesh(soil::soil_surface(s.state(), surface), fs::path(c.frames) / name);
       }
       if (!c.vdb_frames.empty()) {  // soil_00010.vdb, ...: a volume sequence
         std::snprintf(name, sizeof name, "soil_%05d.vdb", step);

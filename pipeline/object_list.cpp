@@ -1,6 +1,5 @@
 #include "pipeline/object_list.h"
 
-#include <cctype>
 #include <cmath>
 
 #include "pipeline/toml_section.h"
@@ -14,17 +13,6 @@ namespace drift::pipeline {
 namespace fs = std::filesystem;
 
 namespace {
-
-// OBJ, or PLY (as drift snow fall --mesh-out writes) by the file's extension.
-terrain::Mesh mesh_file(const fs::path& path, bool y_up) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".ply") return terrain::read_obj(path, y_up);
-  terrain::Mesh m = terrain::read_ply(path);
-  if (y_up)
-    for (auto& p : m.positions) p = Eigen::Vector3f(p.x(), -p.z(), p.y());
-  return m;
-}
 
 // An entry's mesh: relative paths are relative to the file naming them.
 fs::path mesh_path(const fs::path& file, const std::string& mesh) {
@@ -45,8 +33,12 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs:
       Section obj(entry.as_table(), "objects", file);
       const auto mesh = obj.string("mesh");
       if (!mesh)
-        throw Error(file.string() + ": an [[objects]] entry needs 'mesh' (an OBJ or PLY file)");
-      const bool y_up = obj.boolean("y_up", false);
+        throw Error(file.string() +
+                    ": an [[objects]] entry needs 'mesh' (a glTF/GLB, FBX, STL, OBJ or PLY file)");
+      // Unset: the format says which way is up (glTF y, FBX its header, others z).
+      const terrain::UpAxis up = !obj.has("y_up")             ? terrain::UpAxis::Auto
+                                 : obj.boolean("y_up", false) ? terrain::UpAxis::Y
+                                                              : terrain::UpAxis::Z;
       const auto position = obj.vector<3>("position", -1e8, 1e8);
       const double scale = obj.number("scale", 1.0, 1e-6, 1e6);
       const double rotate = obj.number("rotate_z", 0.0, -360.0, 360.0);
@@ -54,7 +46,7 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs:
       placed.albedo = obj.color("color", placed.albedo);
       if (extra) extra(obj, out.size());
       obj.finish();
-      placed.mesh = mesh_file(mesh_path(file, *mesh), y_up);
+      placed.mesh = terrain::read_mesh(mesh_path(file, *mesh), up);
       const double a = terrain::radians(rotate);
       placed.position = position ? *position : Eigen::Vector3d::Zero();
       for (auto& p : placed.mesh.positions) {
@@ -63,6 +55,9 @@ std::vector<terrain::PlacedMesh> read_objects(const toml::table& root, const fs:
                             static_cast<float>(std::sin(a) * x + std::cos(a) * y),
                             static_cast<float>(z));
       }
+      for (auto& n : placed.mesh.normals)  // a glTF's or FBX's normals turn with it
+        n = Eigen::Vector3f(static_cast<float>(std::cos(a) * n.x() - std::sin(a) * n.y()),
+                            static_cast<float>(std::sin(a) * n.x() + std::cos(a) * n.y()), n.z());
       out.push_back(std::move(placed));
     }
   }

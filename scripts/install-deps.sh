@@ -11,7 +11,7 @@ packages=(
   parallel
   libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev libtomlplusplus-dev libtinyobjloader-dev
+  libcli11-dev libtomlplusplus-dev libtinyobjloader-dev libassimp-dev
   libopenvdb-dev libboost-iostreams-dev
   fonts-dejavu-core
 )

@@ -3,6 +3,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -405,6 +406,54 @@ Mesh read_ply(const fs::path& path) {
   read_ply_vertices(f, header, mesh, bad);
   read_ply_faces(f, header, mesh, bad);
   return mesh;
+}
+
+}  // namespace drift::terrain
+
+namespace drift::terrain {
+
+namespace {
+
+std::string lower_ext(const fs::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+}  // namespace
+
+Mesh read_mesh(const fs::path& path, UpAxis up) {
+  const std::string ext = lower_ext(path);
+  // OBJ and PLY keep their own readers: both are fuzzed (tests/fuzz) and refuse
+  // what Assimp would read silently (OBJ's "nan" and hex coordinates, a PLY
+  // header larger than its file); PLY also carries drift's named attributes.
+  if (ext == ".obj") return read_obj(path, up == UpAxis::Y);
+  if (ext == ".ply") {
+    Mesh m = read_ply(path);
+    if (up == UpAxis::Y) {
+      for (auto& p : m.positions) p = Eigen::Vector3f(p.x(), -p.z(), p.y());
+      for (auto& n : m.normals) n = Eigen::Vector3f(n.x(), -n.z(), n.y());
+    }
+    return m;
+  }
+  return read_mesh_assimp(path, up);
+}
+
+bool is_mesh_output(const fs::path& path) {
+  const std::string ext = lower_ext(path);
+  return ext == ".ply" || ext == ".obj" || ext == ".glb" || ext == ".gltf" || ext == ".stl" ||
+         ext == ".fbx";
+}
+
+void write_mesh(const Mesh& mesh, const fs::path& path) {
+  const std::string ext = lower_ext(path);
+  if (ext == ".ply") return write_ply(mesh, path);
+  if (ext == ".obj") return write_obj(mesh, path);
+  if (ext == ".glb" || ext == ".gltf") return write_gltf(mesh, path);
+  if (ext == ".stl") return write_stl(mesh, path);
+  if (ext == ".fbx") return write_fbx(mesh, path);
+  throw Error("cannot write mesh '" + path.string() + "': unknown extension '" + ext +
+              "'; use .glb, .gltf, .fbx, .stl, .obj or .ply");
 }
 
 }  // namespace drift::terrain

@@ -1,5 +1,9 @@
-// Reading OBJ meshes (tinyobjloader), writing OBJ, and writing PLY meshes (with per-vertex
-// attributes as extra properties, which Blender, MeshLab and CloudCompare read).
+// Meshes in and out. Reading: OBJ (tinyobjloader), drift's own PLY, and through
+// Assimp glTF/GLB, FBX, STL, DAE and the other formats Assimp reads. Writing: OBJ,
+// PLY (per-vertex attributes as extra properties, which Blender, MeshLab and
+// CloudCompare read), glTF/GLB (attributes as custom vertex attributes), STL and
+// FBX. Units are metres and z is up inside drift; each format's units and up
+// axis are converted at the file (docs/meshes.md).
 #pragma once
 
 #include <filesystem>
@@ -34,5 +38,56 @@ Mesh read_ply(const std::filesystem::path& path);
 // the vertices whose value is k and the triangles among them, attributes and
 // origin carried along. Throws drift::Error if the attribute is missing.
 std::vector<Mesh> split_by_attribute(const Mesh& mesh, const std::string& name);
+
+// Which way is up in a mesh file. Auto: as the format defines it (glTF and DAE
+// y up; FBX from its header's UpAxis; OBJ, PLY, STL and the rest z up as stored,
+// since they do not say). Y or Z: the caller (e.g. an objects entry's `y_up`)
+// says so, overriding the format.
+enum class UpAxis { Auto, Z, Y };
+
+// Any mesh drift reads, chosen by extension: .obj through read_obj, .ply through
+// read_ply (both fuzzed and tested longer), anything else Assimp reads through
+// Assimp (read_mesh_assimp). Positions come back in metres, z up.
+Mesh read_mesh(const std::filesystem::path& path, UpAxis up = UpAxis::Auto);
+
+// Reads one file through Assimp, every file it opens (a .gltf's .bin buffers)
+// passing the input checks (regular files only, size known and within memory)
+// and read whole into memory before Assimp parses it. All triangle meshes of the
+// scene are joined with their node transforms; points and lines are dropped.
+// Units: glTF metres; FBX by its header's UnitScaleFactor (centimetres a unit);
+// DAE by its <unit> (Assimp applies it); STL and others taken as metres.
+// Throws drift::Error naming the file and Assimp's reason.
+Mesh read_mesh_assimp(const std::filesystem::path& path, UpAxis up = UpAxis::Auto);
+
+// The extensions read_mesh takes, for messages ("*.3ds;*.dae;...").
+std::string mesh_read_extensions();
+
+// Writes by extension: .ply, .obj (z up, as write_obj), .glb/.gltf (write_gltf),
+// .stl (write_stl), .fbx (write_fbx). Anything else is a drift::Error naming the
+// path and the extensions it takes. Written atomically.
+void write_mesh(const Mesh& mesh, const std::filesystem::path& path);
+// True if write_mesh takes the extension of `path`.
+bool is_mesh_output(const std::filesystem::path& path);
+
+// glTF 2.0: binary GLB for .glb, JSON with the buffer embedded as a data URI
+// for .gltf. Metres, y up as glTF requires: drift's (x, y, z) is written as
+// (x, z, -y), a rotation, so windings stay counter-clockwise. NORMAL always
+// (area-weighted vertex normals when the mesh has none); each named attribute
+// as a custom vertex attribute "_NAME" (upper case, e.g. "_SNOW_COVERAGE");
+// the origin in the CRS in the asset's extras ("drift_origin").
+void write_gltf(const Mesh& mesh, const std::filesystem::path& path);
+
+// Binary STL: facets with their normals, z up and metres as stored (STL says
+// neither; docs/meshes.md).
+void write_stl(const Mesh& mesh, const std::filesystem::path& path);
+
+// ASCII FBX 7.5 through Assimp's exporter (its binary writer of Debian's 5.2
+// writes files that Assimp itself cannot read back): y up, in centimetres, the
+// unit FBX's header declares (UnitScaleFactor 1), so Blender and Maya place it
+// in metres.
+void write_fbx(const Mesh& mesh, const std::filesystem::path& path);
+
+// Area-weighted vertex normals (unit length; a vertex of no area gets +z).
+std::vector<Eigen::Vector3f> vertex_normals(const Mesh& mesh);
 
 }  // namespace drift::terrain

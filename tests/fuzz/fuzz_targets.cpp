@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -179,6 +180,27 @@ void ply(const std::uint8_t* data, std::size_t size) {
   });
 }
 
+// Meshes through Assimp (terrain/mesh_assimp.cpp), the format by the bytes'
+// start as a user's file would be named: GLB, glTF JSON, ASCII FBX, else STL.
+void mesh(const std::uint8_t* data, std::size_t size) {
+  const std::string head(reinterpret_cast<const char*>(data), std::min<std::size_t>(size, 8));
+  const char* name = head.rfind("glTF", 0) == 0    ? "mesh.glb"
+                     : head.rfind("{", 0) == 0     ? "mesh.gltf"
+                     : head.rfind("; FBX", 0) == 0 ? "mesh.fbx"
+                                                   : "mesh.stl";
+  const fs::path file = as_file(data, size, name);
+  refusals_allowed([&] {
+    const terrain::Mesh m = terrain::read_mesh(file);
+    for (const auto& p : m.positions) {
+      if (!p.allFinite()) throw std::logic_error("read_mesh let a non-finite vertex through");
+    }
+    for (const auto& t : m.triangles)
+      for (int v : t)
+        if (v < 0 || static_cast<std::size_t>(v) >= m.positions.size())
+          throw std::logic_error("read_mesh let a face name a missing vertex");
+  });
+}
+
 // EXR and PNG tiles as merge and compare read them.
 void image(const std::uint8_t* data, std::size_t size) {
   const bool png = size >= 8 && data[1] == 'P' && data[2] == 'N' && data[3] == 'G';
@@ -196,8 +218,9 @@ void bound_work_per_input() { g_bounded = true; }
 
 const std::vector<Target>& targets() {
   static const std::vector<Target> all = {
-      {"raster", raster},     {"scene", scene}, {"objects", objects}, {"track", track},
-      {"scenario", scenario}, {"obj", obj},     {"ply", ply},         {"image", image}};
+      {"raster", raster}, {"scene", scene},       {"objects", objects},
+      {"track", track},   {"scenario", scenario}, {"obj", obj},
+      {"ply", ply},       {"image", image},       {"mesh", mesh}};
   return all;
 }
 

@@ -18,7 +18,7 @@ struct Target {
   void (*run)(const std::uint8_t* data, std::size_t size);
 };
 
-// Every target, by name: raster, scene, objects, track, scenario, obj, ply,
+// Every target, by name: raster, scene, objects, track, scenario, obj, ply, mesh,
 // image.
 const std::vector<Target>& targets();
 

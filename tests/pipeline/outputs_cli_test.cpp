@@ -185,12 +185,14 @@ const std::vector<Command>& commands() {
       {"sheet", "sheet " + png + " -o OUT", ".png", in.png},
       {"marks", "marks " + in.marks_ground.string() + " --track " + in.track.string() + " -o OUT",
        ".tif", in.marks_ground},
+      {"mesh", "mesh " + dem + " --step 4 -o OUT", ".glb", in.dem},
   };
   return all;
 }
 
-const std::vector<std::string> kCommandNames = {
-    "import", "dunes", "snow cover", "snow fall", "render", "merge", "compare", "sheet", "marks"};
+const std::vector<std::string> kCommandNames = {"import", "dunes", "snow cover", "snow fall",
+                                                "render", "merge", "compare",    "sheet",
+                                                "marks",  "mesh"};
 
 // The tests below run once per subcommand that writes (named in the test's name).
 class EachCommand : public ::testing::TestWithParam<std::string> {

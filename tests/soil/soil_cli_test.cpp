@@ -164,7 +164,11 @@ TEST(SoilCli, BadScenariosAreErrorsNamingTheValueAndWriteNothing) {
   EXPECT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.ply").string() + " --soil clay", d),
             2);
   EXPECT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.ply").string() + " --phi 75", d), 2);
-  EXPECT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.stl").string(), d), 2);
+  EXPECT_EQ(run((d / "s.toml").string() + " -o " +
+                    (d / "soil.xyz")  // .stl is a mesh output now (docs/meshes.md)
+                        .string(),
+                d),
+            2);
   EXPECT_FALSE(fs::exists(d / "soil.ply"));
 }
 

@@ -1,0 +1,90 @@
+// drift mesh RASTER -o OUT.glb: a DEM (or a part of it) or any product raster
+// (marked ground, snow surface, dunes) as a triangle mesh for Blender, game
+// engines and viewers: glTF/GLB, FBX, STL, OBJ or PLY by the output's extension.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+
+#include "pipeline/cli.h"
+#include "pipeline/object_list.h"
+#include "terrain/height_mesh.h"
+#include "terrain/mesh_io.h"
+#include "terrain/output_set.h"
+#include "terrain/raster_io.h"
+
+namespace drift::pipeline {
+
+namespace {
+
+struct MeshCommand {
+  std::string raster, output;
+  std::vector<double> crop;
+  std::vector<std::string> attributes;  // NAME=RASTER
+  int step = 1;
+};
+
+void run_mesh(const MeshCommand& c) {
+  std::vector<std::pair<std::string, std::string>> named;  // name, raster
+  std::vector<std::filesystem::path> inputs = {c.raster};
+  for (const std::string& a : c.attributes) {
+    const auto eq = a.find('=');
+    if (eq == 0 || eq == std::string::npos || eq + 1 == a.size())
+      usage_error("--attribute '" + a + "' must be NAME=RASTER, e.g. snow_coverage=cover.tif");
+    named.emplace_back(a.substr(0, eq), a.substr(eq + 1));
+    inputs.emplace_back(a.substr(eq + 1));
+  }
+  // The path's own problems (a device, an input) first, as every command reports them.
+  OutputSet outputs({c.output}, inputs);
+  if (!terrain::is_mesh_output(c.output))
+    usage_error("-o '" + c.output + "' must end in .glb, .gltf, .fbx, .stl, .obj or .ply");
+  terrain::ReadOptions read;
+  if (!c.crop.empty()) {
+    read.window = terrain::crop_window(terrain::read_raster_header(c.raster),
+                                       {c.crop[0], c.crop[1], c.crop[2], c.crop[3]}, c.raster);
+  }
+  const terrain::HeightField heights = terrain::read_raster(c.raster, read);
+  require_metric_crs(heights, c.raster);
+  std::vector<std::pair<std::string, terrain::HeightField>> attributes;
+  for (const auto& [name, path] : named)
+    attributes.emplace_back(name, terrain::read_raster(path, read));
+  const terrain::Mesh mesh = terrain::height_field_mesh(heights, c.step, attributes);
+  terrain::write_mesh(mesh, c.output);
+  outputs.commit();
+  std::printf(
+      "mesh: wrote %s (%zu vertices, %zu triangles; origin %.3f, %.3f in the raster's CRS)\n",
+      c.output.c_str(), mesh.vertex_count(), mesh.triangle_count(), mesh.origin.x(),
+      mesh.origin.y());
+}
+
+}  // namespace
+
+void add_mesh_command(CLI::App& root) {
+  auto c = std::make_shared<MeshCommand>();
+  CLI::App* sub = add_subcommand(
+      root, "mesh",
+      "a DEM or product raster as a triangle mesh: glTF/GLB, FBX, STL, OBJ or PLY (metres; "
+      "glTF and FBX y up, the others z up)",
+      [c] { run_mesh(*c); });
+  sub->add_option("raster", c->raster, "heights: a metric DEM or product raster (GeoTIFF, ...)")
+      ->required();
+  sub->add_option("-o,--output", c->output,
+                  "mesh file: .glb, .gltf, .fbx, .stl, .obj or .ply (by extension)")
+      ->required();
+  sub->add_option("--crop", c->crop, "xmin,ymin,xmax,ymax in the raster's own CRS")
+      ->expected(4)
+      ->delimiter(',');
+  whole_in_range(
+      sub->add_option("--step", c->step,
+                      "a vertex every STEP cells (1: every cell; 4: 1/16 the triangles)"),
+      1, 1 << 16)
+      ->capture_default_str();
+  sub->add_option("--attribute", c->attributes,
+                  "NAME=RASTER: another raster of the same grid as a per-vertex attribute "
+                  "(glTF: custom attribute _NAME; PLY: property NAME), e.g. "
+                  "snow_coverage=cover.tif; repeatable")
+      ->allow_extra_args(false);  // one NAME=RASTER a flag: a raster after it stays the raster
+}
+
+DRIFT_COMMAND(65, add_mesh_command);
+
+}  // namespace drift::pipeline

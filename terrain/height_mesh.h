@@ -1,0 +1,33 @@
+// A height field as a triangle mesh: for `drift mesh` (terrain crops, marked
+// ground, snow surfaces, any product raster laid out as heights).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "terrain/grid.h"
+#include "terrain/mesh.h"
+#include "terrain/raster_io.h"
+
+namespace drift::terrain {
+
+// Which cells of a north-up raster cover the box xmin,ymin,xmax,ymax of its CRS
+// (the cells whose centres lie inside). Throws drift::Error naming `name` if the
+// raster is rotated or the box misses it or holds fewer than 2 x 2 cells.
+RasterWindow crop_window(const RasterHeader& header, const std::array<double, 4>& box,
+                         const std::string& name);
+
+// One vertex at the centre of every `step`-th cell (and the last row and
+// column), two triangles a square, counter-clockwise seen from above; squares
+// touching a nodata (NaN) cell are left out, and so are vertices no triangle
+// uses. Positions are metres from `origin` = the first cell's centre at height
+// 0 in the raster's CRS (floats hold centimetres then, whatever the CRS's
+// magnitude); normals are the triangles' area-weighted. `attributes` are other
+// rasters of the same grid, carried as named per-vertex attributes. Throws
+// drift::Error if a grid differs or nothing is left.
+Mesh height_field_mesh(const HeightField& heights, int step,
+                       const std::vector<std::pair<std::string, HeightField>>& attributes = {});
+
+}  // namespace drift::terrain
