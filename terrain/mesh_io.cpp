@@ -3,6 +3,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -175,7 +176,7 @@ void write_obj(const Mesh& mesh, const fs::path& path, bool y_up) {
       f << line;
     }
     f.flush();
-    if (!f) throw Error("cannot write '" + path.string() + "' (disk full?)");
+    if (!f) throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
   }
   out.commit();
 }
@@ -218,7 +219,7 @@ void write_ply(const Mesh& mesh, const fs::path& path) {
       for (int v : tri) put(v);
     }
     f.flush();
-    if (!f) throw Error("cannot write '" + path.string() + "' (disk full?)");
+    if (!f) throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
   }
   out.commit();
 }

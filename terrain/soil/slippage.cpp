@@ -100,6 +100,12 @@ void add_up(float* rho, const float* psi, int from, int nz, float amount) {
 
 }  // namespace
 
+std::uint64_t Slippage::bytes_per_column() {
+  return HeightSpans::kMaxSpans * sizeof(HeightSpan) + sizeof(std::uint8_t) +
+         kMaxPiles * (kDirections * sizeof(Out) + 2 * sizeof(float) + sizeof(std::int8_t) +
+                      5 * sizeof(int));
+}
+
 Slippage::Slippage(const terrain::Grid3Shape& shape)
     : shape_(shape),
       out_(shape.columns() * kMaxPiles * kDirections),

@@ -78,6 +78,10 @@ class Slippage {
 
   explicit Slippage(const terrain::Grid3Shape& shape);
 
+  // Bytes a column of the grid costs here (its spans and every per-pile
+  // array), counted in the run's memory check (soil_run_bytes).
+  static std::uint64_t bytes_per_column();
+
   // One slippage step on state.rho (psi read).
   void step(SoilState& state, const SoilType& soil, double gravity, double dt);
 
