@@ -224,7 +224,7 @@ ComparisonResult compare_images(const Image& a, const Image& b, const Comparison
   // The two images and, at the peak (SSIM's means), per pixel: two luma
   // planes and two per-pixel errors (4 B each), five double planes and their
   // five Gaussian means (8 B each) and one blur's two work planes; counted with
-  // the images, as the run's estimate (MemoryEstimate.CompareCountsSsimsPlanes).
+  // the images, as the run's estimate (MemoryEstimate.ImagesOfRenderCompareAndSheet).
   const std::uint64_t pixels = static_cast<std::uint64_t>(a.width) * a.height;
   require_memory(
       (a.pixels.size() + b.pixels.size()) * sizeof(float) +

@@ -203,7 +203,7 @@ Image render_image(const TerrainScene& scene, const SceneInput& input, const Cam
   const std::vector<std::string> channels = image_channels(scene, layout);
   // The image, and its file encoded in memory before it is written: half as
   // much again, measured at 3000 x 2000 (28 channels: 940 MiB over the
-  // program's own for EXR, 899 for PNG; MemoryEstimate.RenderCountsItsImage).
+  // program's own for EXR, 899 for PNG; MemoryEstimate.ImagesOfRenderCompareAndSheet).
   require_memory(
       static_cast<std::uint64_t>(span) * band * channels.size() * sizeof(float) * 3 / 2,
       "a " + std::to_string(span) + " x " + std::to_string(band) + " image of " +

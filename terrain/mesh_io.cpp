@@ -176,7 +176,8 @@ void write_obj(const Mesh& mesh, const fs::path& path, bool y_up) {
       f << line;
     }
     f.flush();
-    if (!f) throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
+    if (!f)
+      throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
   }
   out.commit();
 }
@@ -219,7 +220,8 @@ void write_ply(const Mesh& mesh, const fs::path& path) {
       for (int v : tri) put(v);
     }
     f.flush();
-    if (!f) throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
+    if (!f)
+      throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
   }
   out.commit();
 }

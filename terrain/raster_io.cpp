@@ -297,8 +297,8 @@ void write_geotiff(const HeightField& grid, const fs::path& path, const WriteOpt
   GDALClose(GDALDataset::ToHandle(ds.release()));
   if (CPLGetLastErrorType() == CE_Failure) err = CE_Failure;
   if (err != CE_None) {
-    throw Error("cannot write '" + path.string() + "': " +
-                reason(last_gdal_message() + " (disk full or not writable?)"));
+    throw Error("cannot write '" + path.string() +
+                "': " + reason(last_gdal_message() + " (disk full or not writable?)"));
   }
   out.commit();
 }

@@ -127,4 +127,10 @@ class Slippage {
   std::vector<float> rest_;                         // per node: rest angle, rad
 };
 
+// Bytes a whole run on `shape` holds at its peak, what make_simulation checks
+// first: the state, the slippage's heightfield (per column), the terrain's
+// heights, and the surface's extraction (two density copies and the mesh).
+// Within 25 % of the measured peak (MemoryEstimate.SoilCountsItsHeightfieldAndSurface).
+std::uint64_t soil_run_bytes(const terrain::Grid3Shape& shape);
+
 }  // namespace drift::soil

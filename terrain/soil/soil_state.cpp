@@ -1,7 +1,6 @@
 #include "terrain/soil/soil_state.h"
 
 #include "terrain/memory.h"
-#include "terrain/soil/slippage.h"
 
 namespace drift::soil {
 
@@ -10,25 +9,13 @@ std::uint64_t soil_state_bytes(const terrain::Grid3Shape& shape) {
   return static_cast<std::uint64_t>(shape.count()) * (17 * sizeof(float) + 1);
 }
 
-std::uint64_t soil_run_bytes(const terrain::Grid3Shape& shape) {
-  // The surface (surface.cpp): the straightened density and its copy padded
-  // one voxel deeper, 8 B a voxel, then OpenVDB's volumeToMesh and the mesh.
-  // A surface crossing each column twice (the soil's top and the floor) gives
-  // 4 triangles a column; measured, they cost 270 B a column at the peak.
-  constexpr std::uint64_t kSurfaceVoxel = 2 * sizeof(float), kSurfaceColumn = 288;
-  constexpr std::uint64_t kHeightsColumn = sizeof(float);  // a DEM's terrain heights
-  const auto columns = static_cast<std::uint64_t>(shape.nx) * static_cast<std::uint64_t>(shape.ny);
-  return soil_state_bytes(shape) + static_cast<std::uint64_t>(shape.count()) * kSurfaceVoxel +
-         columns * (Slippage::bytes_per_column() + kSurfaceColumn + kHeightsColumn);
-}
-
 SoilState::SoilState(const terrain::Grid3Shape& s) : shape(s) {
   if (s.nx <= 0 || s.ny <= 0 || s.nz <= 0)
     throw Error("soil grid size must be positive, got " + std::to_string(s.nx) + " x " +
                 std::to_string(s.ny) + " x " + std::to_string(s.nz));
   if (s.nz > 32000)
     throw Error("soil grid is " + std::to_string(s.nz) + " voxels tall; at most 32000");
-  require_memory(soil_run_bytes(s),
+  require_memory(soil_state_bytes(s),
                  "soil grid " + std::to_string(s.nx) + " x " + std::to_string(s.ny) + " x " +
                      std::to_string(s.nz),
                  "use a smaller grid or larger voxels");

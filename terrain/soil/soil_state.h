@@ -47,10 +47,4 @@ void copy_back(SoilState& state, std::size_t i);
 // Bytes SoilState plus the step's scratch buffers take for `shape`.
 std::uint64_t soil_state_bytes(const terrain::Grid3Shape& shape);
 
-// Bytes a whole run on `shape` holds at its peak, what SoilState's constructor
-// checks: the state, the slippage's heightfield (per column), the terrain's
-// heights, and the surface's extraction (two density copies and the mesh).
-// Within 25 % of the measured peak (SoilCli.MemoryEstimateMatchesThePeak).
-std::uint64_t soil_run_bytes(const terrain::Grid3Shape& shape);
-
 }  // namespace drift::soil
