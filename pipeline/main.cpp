@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 
@@ -11,10 +12,25 @@
 #include "terrain/memory.h"
 #include "terrain/temp_registry.h"
 
+namespace {
+
+// DRIFT_MEMORY_REPORT=1: the run's memory estimate on stderr at exit (any
+// status), for the tests that hold it to the measured peak (docs/testing.md).
+void report_memory_estimate() {
+  const char* flag = std::getenv("DRIFT_MEMORY_REPORT");
+  if (!flag || !*flag || std::string(flag) == "0") return;
+  std::fprintf(stderr, "drift: memory estimate: %llu bytes (%s)\n",
+               static_cast<unsigned long long>(drift::memory_estimate_bytes()),
+               drift::memory_estimate_what().c_str());
+}
+
+}  // namespace
+
 int main(int argc, char** argv) try {
   // SIGINT, SIGTERM, SIGHUP and every other signal that would end the process
   // from outside: remove temporary files, exit 128 + the signal (temp_registry.h).
   drift::install_signal_cleanup();
+  std::atexit(report_memory_estimate);
   // A malformed DRIFT_MEMORY_LIMIT is refused before any work, as a usage error.
   if (const std::string problem = drift::memory_limit_problem(); !problem.empty()) {
     std::fprintf(stderr, "drift: usage error: %s\n", problem.c_str());

@@ -77,8 +77,11 @@ std::vector<terrain::PlacedMesh> read_objects_file(const fs::path& path) {
 }
 
 std::vector<fs::path> object_mesh_paths(const fs::path& path, const char* what) {
+  return object_mesh_paths(parse_toml_file(path, what), path);
+}
+
+std::vector<fs::path> object_mesh_paths(const toml::table& root, const fs::path& path) {
   std::vector<fs::path> meshes;
-  const toml::table root = parse_toml_file(path, what);
   if (const toml::array* list = root["objects"].as_array()) {
     for (const toml::node& entry : *list) {
       const toml::table* t = entry.as_table();

@@ -40,6 +40,10 @@ std::vector<terrain::PlacedMesh> read_objects_file(const std::filesystem::path& 
 std::vector<std::filesystem::path> object_mesh_paths(const std::filesystem::path& path,
                                                      const char* what);
 
+// The same for an already parsed file's root table.
+std::vector<std::filesystem::path> object_mesh_paths(const toml::table& root,
+                                                     const std::filesystem::path& path);
+
 // Throws drift::Error if `raster` (read from `path`) is in a geographic CRS
 // (degrees), telling the user to run drift import first.
 void require_metric_crs(const terrain::HeightField& raster, const std::filesystem::path& path);

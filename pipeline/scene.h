@@ -49,6 +49,9 @@ struct SceneFile {
   std::vector<std::filesystem::path> layer_masks;
   // [terrain] surround: coarser DEMs around the terrain (render/surround.h).
   std::vector<std::filesystem::path> surround_rasters;
+  // The files [[objects]] and [terrain] objects name (the objects file and its
+  // meshes): inputs too, so no output may replace them (issue 34).
+  std::vector<std::filesystem::path> object_files;
   // The product files the stages' sections name, by "section.key" ("snow.cover",
   // "ripples.raster": pipeline/scene_products.h), resolved likewise; drift
   // render's flags override them.

@@ -554,7 +554,11 @@ SceneFile read_scene_file(const fs::path& path, const SceneVariables& variables)
   read_clouds(root, path, scene.input);
   read_camera(root, path, scene);
   scene.input.meshes = read_objects_with_materials(root, path, scene.input.object_names);
+  scene.object_files = object_mesh_paths(root, path);
   if (objects_file) {
+    scene.object_files.push_back(*objects_file);
+    for (fs::path& mesh : object_mesh_paths(*objects_file, "objects file"))
+      scene.object_files.push_back(std::move(mesh));
     for (auto& placed : read_objects_file(*objects_file))
       scene.input.meshes.push_back(std::move(placed));
   }
@@ -721,6 +725,7 @@ std::vector<fs::path> scene_inputs(const SceneFile& scene) {
   for (const auto& [key, file] : scene.product_files) inputs.push_back(file);
   inputs.insert(inputs.end(), scene.layer_masks.begin(), scene.layer_masks.end());
   inputs.insert(inputs.end(), scene.surround_rasters.begin(), scene.surround_rasters.end());
+  inputs.insert(inputs.end(), scene.object_files.begin(), scene.object_files.end());
   std::erase_if(inputs, [](const fs::path& p) { return p.empty(); });
   return inputs;
 }

@@ -29,7 +29,8 @@ std::vector<std::string> scene_sections();
 // (pipeline/scene_variables.h).
 SceneFile read_scene_file(const std::filesystem::path& path, const SceneVariables& variables = {});
 
-// Every file the scene reads (rasters, masks, product files), for refusing
+// Every file the scene reads (rasters, masks, product files, the objects file
+// and every mesh its objects name), for refusing
 // them as outputs.
 std::vector<std::filesystem::path> scene_inputs(const SceneFile& scene);
 

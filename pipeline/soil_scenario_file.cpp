@@ -17,7 +17,9 @@ namespace drift::pipeline {
 namespace {
 
 constexpr const char* kDoc = "docs/soil.md";
-constexpr double kBig = 1e7;  // metres: any coordinate a scenario can sensibly hold
+constexpr double kBig = 1e7;
+constexpr int kMaxColumns = 4096;  // [grid] size's bound on x and y, also under a DEM  // metres:
+                                   // any coordinate a scenario can sensibly hold
 
 soil::Primitive read_primitive(const toml::table* t, const std::filesystem::path& file,
                                const std::string& owner) {
@@ -202,6 +204,17 @@ void read_dem(Section& s, const toml::table& root, const std::filesystem::path& 
   const double depth = s.number("depth", 2.0, 0, 1e4);
   const terrain::RasterWindow window{static_cast<int>((*w)[0]), static_cast<int>((*w)[1]),
                                      static_cast<int>((*w)[2]), static_cast<int>((*w)[3])};
+  // The grid's 4096 columns a side hold under a DEM too: a window upsampled
+  // to 6400 a side was accepted, and one upsampled 64 times allocated its
+  // heights (16 GiB) unchecked (issue 34).
+  for (int i : {2, 3})
+    if ((*w)[i] * up > kMaxColumns) {
+      std::ostringstream what;
+      what << "[" << list(*w) << "] with upsample " << up << " makes a grid of " << (*w)[2] * up
+           << " x " << (*w)[3] * up << " columns; at most " << kMaxColumns
+           << " a side: use a smaller window or upsample";
+      s.invalid("window", what.str());
+    }
   const WindowWithApron apron = with_apron(window, terrain::read_raster_header(dem));
   terrain::ReadOptions ro;
   ro.window = apron.read;

@@ -10,6 +10,7 @@
 
 #include "render/tonemap.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::render {
 
@@ -220,6 +221,16 @@ void judge(const ComparisonOptions& o, const std::vector<float>& pix_rmse,
 
 ComparisonResult compare_images(const Image& a, const Image& b, const ComparisonOptions& o) {
   check_comparison(a, b, o);
+  // The two images and, at the peak (SSIM's means), per pixel: two luma
+  // planes and two per-pixel errors (4 B each), five double planes and their
+  // five Gaussian means (8 B each) and one blur's two work planes; counted with
+  // the images, as the run's estimate (MemoryEstimate.ImagesOfRenderCompareAndSheet).
+  const std::uint64_t pixels = static_cast<std::uint64_t>(a.width) * a.height;
+  require_memory(
+      (a.pixels.size() + b.pixels.size()) * sizeof(float) +
+          pixels * (4 * sizeof(float) + 12 * sizeof(double)),
+      "comparing two " + std::to_string(a.width) + " x " + std::to_string(a.height) + " images",
+      "compare a --region of them");
   ComparisonResult r;
   r.channels = choose_channels(a, b, o.channels);
   std::vector<int> ia, ib;

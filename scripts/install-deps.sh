@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs exactly the Debian 12 packages Driftscape builds, tests and runs with.
 # Does nothing (and needs no network) when they are all present already.
+#   scripts/install-deps.sh [--lint]
 set -euo pipefail
 
 packages=(
@@ -15,6 +16,10 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev
   fonts-dejavu-core
 )
+# --lint: also what scripts/lint.sh runs (CI runs it; .ci/run).
+if [ "${1:-}" = "--lint" ]; then
+  packages+=(python3 clang-format clang-tidy cppcheck)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

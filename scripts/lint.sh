@@ -16,6 +16,13 @@ unformatted=$(clang-format --dry-run "${sources[@]}" 2>&1 | grep -c "warning:" |
 echo "clang-format: $unformatted places differ from .clang-format"
 echo "== clang-tidy"
 mapfile -t cpps < <(printf '%s\n' "${sources[@]}" | grep -E '\.cpp$' | grep -v '^tests/')
+# DRIFT_TIDY_SINCE=REV (CI: the last commit a day before HEAD): clang-tidy only on the
+# files changed since REV, about 33 s of CPU a file; all of them if REV is unknown.
+if [ -n "${DRIFT_TIDY_SINCE:-}" ] && git rev-parse -q --verify "$DRIFT_TIDY_SINCE^{commit}" >/dev/null; then
+  mapfile -t changed < <(git diff --name-only "$DRIFT_TIDY_SINCE" -- '*.cpp')
+  mapfile -t cpps < <(printf '%s\n' "${cpps[@]}" | grep -Fxf <(printf '%s\n' "${changed[@]}") || true)
+  echo "clang-tidy: ${#cpps[@]} files changed since $DRIFT_TIDY_SINCE"
+fi
 # The build precompiles CLI11 with GCC; clang cannot read GCC's PCH, so give
 # clang-tidy a copy of the compile database without the PCH include.
 mkdir -p build/tidy
@@ -26,7 +33,10 @@ for entry in db:
     entry["command"] = re.sub(r"-Xclang -include-pch -Xclang \S+|-include \S+cmake_pch\.hxx|-Winvalid-pch", "", entry["command"])
 json.dump(db, open("build/tidy/compile_commands.json", "w"))
 PY
-clang-tidy -p build/tidy --quiet "${cpps[@]}" 2>/dev/null | grep -E "warning:|error:" | sort -u | tee "$reports/tidy.txt"
+# A few files a process, one process a core: CI runs this (.ci/run).
+[ ${#cpps[@]} -gt 0 ] && printf '%s\0' "${cpps[@]}" |
+  xargs -0 -n 4 -P "${DRIFT_JOBS:-$(nproc)}" clang-tidy -p build/tidy --quiet 2>/dev/null |
+  grep -E "warning:|error:" | sort -u | tee "$reports/tidy.txt"
 [ -s "$reports/tidy.txt" ] && status=1
 echo "== cppcheck"
 cppcheck --quiet --std=c++20 --language=c++ --enable=warning,performance,portability \

@@ -65,10 +65,18 @@ void AtomicFile::commit() {
   slot_ = -1;
 }
 
+std::string write_failure_reason(const fs::path& target, int error) {
+  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec))
+    return "its folder '" + folder.string() + "' was removed during the run";
+  return std::strerror(error != 0 ? error : EIO);
+}
+
 void write_all_bytes(const fs::path& temp, const void* data, std::size_t size,
                      const fs::path& target) {
   const auto fail = [&](int error) {
-    throw Error("cannot write '" + target.string() + "': " + std::strerror(error) +
+    throw Error("cannot write '" + target.string() + "': " + write_failure_reason(target, error) +
                 " (the existing file, if any, is left as it was)");
   };
   const int fd = ::open(temp.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);

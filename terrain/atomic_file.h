@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <string>
 
 namespace drift {
 
@@ -44,5 +45,10 @@ class AtomicFile {
 // encode into memory and this writes the bytes.
 void write_all_bytes(const std::filesystem::path& temp, const void* data, std::size_t size,
                      const std::filesystem::path& target);
+
+// Why writing `target` failed, after the system's `error`: "its folder 'out'
+// was removed during the run" when it was (a deleted output folder read as
+// "disk full?", issue 34), else the system's reason ("No space left on device").
+std::string write_failure_reason(const std::filesystem::path& target, int error);
 
 }  // namespace drift

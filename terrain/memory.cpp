@@ -1,12 +1,14 @@
 #include "terrain/memory.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <string>
 
@@ -117,7 +119,27 @@ std::string human_bytes(std::uint64_t bytes) {
   return buf;
 }
 
+namespace {
+std::atomic<std::uint64_t> g_estimate{0};
+std::mutex g_estimate_mutex;
+std::string g_estimate_what;
+}  // namespace
+
+std::uint64_t memory_estimate_bytes() { return g_estimate.load(); }
+
+std::string memory_estimate_what() {
+  const std::lock_guard<std::mutex> lock(g_estimate_mutex);
+  return g_estimate_what;
+}
+
 void require_memory(std::uint64_t bytes, const std::string& what, const std::string& fix) {
+  {
+    const std::lock_guard<std::mutex> lock(g_estimate_mutex);
+    if (bytes > g_estimate.load()) {
+      g_estimate.store(bytes);
+      g_estimate_what = what;
+    }
+  }
   // Leave a quarter of what is free for the rest of the process and the system.
   const std::uint64_t avail = available_memory_bytes();
   const std::uint64_t budget = avail - avail / 4;

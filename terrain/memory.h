@@ -19,6 +19,15 @@ void require_memory(std::uint64_t bytes, const std::string& what, const std::str
 
 std::string human_bytes(std::uint64_t bytes);
 
+// The run's memory estimate: the largest amount any require_memory call of this
+// process asked for, and what it named. Each subcommand's largest check counts
+// every buffer its inputs size that is alive at its peak (docs/outputs.md), so
+// this is what the run needs beyond the program itself; with
+// DRIFT_MEMORY_REPORT=1 drift prints it on exit (the memory tests compare it
+// with the measured peak). 0 and "" before any check.
+std::uint64_t memory_estimate_bytes();
+std::string memory_estimate_what();
+
 // The documented forms of a size such as DRIFT_MEMORY_LIMIT: a whole or decimal
 // number of bytes, optionally followed by K, M, G or T (powers of 1024), with or
 // without "iB" or "B" ("512M", "8GiB", "1.5T", "4096"), no spaces, more than 0

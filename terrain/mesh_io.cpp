@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -176,7 +177,8 @@ void write_obj(const Mesh& mesh, const fs::path& path, bool y_up) {
       f << line;
     }
     f.flush();
-    if (!f) throw Error("cannot write '" + path.string() + "' (disk full?)");
+    if (!f)
+      throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
   }
   out.commit();
 }
@@ -219,7 +221,8 @@ void write_ply(const Mesh& mesh, const fs::path& path) {
       for (int v : tri) put(v);
     }
     f.flush();
-    if (!f) throw Error("cannot write '" + path.string() + "' (disk full?)");
+    if (!f)
+      throw Error("cannot write '" + path.string() + "': " + write_failure_reason(path, errno));
   }
   out.commit();
 }

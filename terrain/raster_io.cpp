@@ -269,9 +269,13 @@ void write_geotiff(const HeightField& grid, const fs::path& path, const WriteOpt
   g_last_gdal_message.clear();
   DatasetPtr ds(driver->Create(out.temp_path().c_str(), grid.width(), grid.height(), 1, GDT_Float32,
                                co.List()));
-  if (!ds) {
-    throw Error("cannot create '" + path.string() + "': " + last_gdal_message());
-  }
+  // GDAL's reasons never say that the output's folder is gone.
+  const auto reason = [&path](const std::string& gdal) {
+    std::error_code ec;
+    const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+    return fs::is_directory(folder, ec) ? gdal : write_failure_reason(path, 0);
+  };
+  if (!ds) throw Error("cannot create '" + path.string() + "': " + reason(last_gdal_message()));
   const GeoReference& geo = grid.geo();
   double gt[6];
   std::copy(geo.geotransform.begin(), geo.geotransform.end(), gt);
@@ -293,8 +297,8 @@ void write_geotiff(const HeightField& grid, const fs::path& path, const WriteOpt
   GDALClose(GDALDataset::ToHandle(ds.release()));
   if (CPLGetLastErrorType() == CE_Failure) err = CE_Failure;
   if (err != CE_None) {
-    throw Error("cannot write '" + path.string() + "': " + last_gdal_message() +
-                " (disk full or not writable?)");
+    throw Error("cannot write '" + path.string() +
+                "': " + reason(last_gdal_message() + " (disk full or not writable?)"));
   }
   out.commit();
 }

@@ -8,6 +8,7 @@
 #include "terrain/bilinear.h"
 #include "terrain/error.h"
 #include "terrain/hash.h"
+#include "terrain/memory.h"
 
 namespace drift::soil {
 
@@ -97,6 +98,10 @@ SoilSimulation make_simulation(const SoilScenario& sc) {
   if (!g.origin.allFinite()) throw Error("scenario '" + sc.name + "': grid origin is not finite");
   if (sc.steps < 0) throw Error("scenario '" + sc.name + "': steps must be >= 0");
   sc.options.validate();
+  require_memory(soil_run_bytes(g),  // the whole run's, before any of it is allocated
+                 "soil grid " + std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " +
+                     std::to_string(g.nz),
+                 "use a smaller grid or larger voxels");
   SoilState state(g);  // checks sizes and memory
   if (sc.terrain.kind == TerrainSource::Kind::HeightField)
     voxelise_heights(sc.terrain.heights, state);

@@ -81,6 +81,10 @@ class Slippage {
 
   explicit Slippage(const terrain::Grid3Shape& shape);
 
+  // Bytes a column of the grid costs here (its spans and every per-pile
+  // array), counted in the run's memory check (soil_run_bytes).
+  static std::uint64_t bytes_per_column();
+
   // One slippage step on state.rho (psi read).
   void step(SoilState& state, const SoilType& soil, double gravity, double dt);
 
@@ -137,5 +141,11 @@ class Slippage {
   std::vector<std::uint8_t> overfilled_;            // per column
   bool any_overfilled_ = false;
 };
+
+// Bytes a whole run on `shape` holds at its peak, what make_simulation checks
+// first: the state, the slippage's heightfield (per column), the terrain's
+// heights, and the surface's extraction (two density copies and the mesh).
+// Within 25 % of the measured peak (MemoryEstimate.SoilCountsItsHeightfieldAndSurface).
+std::uint64_t soil_run_bytes(const terrain::Grid3Shape& shape);
 
 }  // namespace drift::soil

@@ -402,8 +402,18 @@ TEST(OutputsCli, FilesNamedInInputsAreRefusedAsOutputs) {
       "[grid]\nsize = [0, 0, 12]\n[terrain]\ndem = \"dem.tif\"\nwindow = [0, 0, 4, 4]\n"
       "[simulation]\nsteps = 1\n[[soil_body]]\n[[soil_body.primitive]]\nshape = \"sphere\"\n"
       "center = [20, 20, 150]\nradius = 15\n");
+  // A scene's meshes, by [[objects]] and by its [terrain] objects file, are
+  // render's inputs: OBJ files named like images, so that -o can name them.
+  fs::copy_file(d / "ball.obj", d / "m.exr");
+  fs::copy_file(d / "ball.obj", d / "n.png");
+  put(d / "objs.toml", "[[objects]]\nmesh = \"n.png\"\nposition = [150, -150, 200]\n");
+  put(d / "scene.toml",
+      "[terrain]\nraster = \"dem.tif\"\nobjects = \"objs.toml\"\n[sun]\nazimuth = 120\n"
+      "elevation = 35\n[[objects]]\nmesh = \"m.exr\"\nposition = [100, -100, 200]\n");
   const std::string before_ply = slurp(d / "rock.ply"), before_obj = slurp(d / "ball.obj"),
-                    before_dem = slurp(d / "dem.tif");
+                    before_dem = slurp(d / "dem.tif"), before_m = slurp(d / "m.exr"),
+                    before_n = slurp(d / "n.png");
+  const std::string render = "render " + (d / "scene.toml").string() + " --size 8x4 --spp 1 -o ";
   const std::string runs[] = {"snow fall " + in.dem.string() + " --maps 1 --spread 0 --objects " +
                                   (d / "objects.toml").string() + " --mesh-out " +
                                   (d / "rock.ply").string() + " -o " + (d / "depth.tif").string(),
@@ -411,7 +421,8 @@ TEST(OutputsCli, FilesNamedInInputsAreRefusedAsOutputs) {
                                   (d / "track.toml").string() + " -o " + (d / "ball.obj").string(),
                               "soil " + (d / "soil.toml").string() + " -o " +
                                   (d / "soil.ply").string() + " --surface " +
-                                  (d / "dem.tif").string()};
+                                  (d / "dem.tif").string(),
+                              render + (d / "m.exr").string(), render + (d / "n.png").string()};
   for (const std::string& args : runs) {
     const Result r = drift(args, d);
     EXPECT_EQ(r.status, 1) << args << "\n" << r.log;
@@ -420,6 +431,8 @@ TEST(OutputsCli, FilesNamedInInputsAreRefusedAsOutputs) {
   EXPECT_EQ(slurp(d / "rock.ply"), before_ply);
   EXPECT_EQ(slurp(d / "ball.obj"), before_obj);
   EXPECT_EQ(slurp(d / "dem.tif"), before_dem);
+  EXPECT_EQ(slurp(d / "m.exr"), before_m);
+  EXPECT_EQ(slurp(d / "n.png"), before_n);
   EXPECT_FALSE(fs::exists(d / "depth.tif") || fs::exists(d / "soil.ply"));
   EXPECT_TRUE(hidden_files(d).empty());
   // The same soil run with another --surface works: it was refused for the DEM.
@@ -428,6 +441,8 @@ TEST(OutputsCli, FilesNamedInInputsAreRefusedAsOutputs) {
                   d)
                 .status,
             0);
+  const Result rendered = drift(render + (d / "frame.png").string(), d);
+  EXPECT_EQ(rendered.status, 0) << rendered.log;
 }
 
 // Commands with several outputs: a path named twice or a bad second output is
@@ -527,6 +542,32 @@ TEST(OutputsCli, FileSizeLimitLeavesNoTemporaryFile) {
   EXPECT_NE(log.find("big.exr"), std::string::npos) << log;
   EXPECT_EQ(slurp(out), "old");
   EXPECT_TRUE(hidden_files(d).empty());
+}
+
+
+// An output folder removed while the run computes: the error names the folder
+// and what happened to it, for every kind of writer (PLY/OBJ, GeoTIFF through
+// GDAL, images encoded in memory); it had said "disk full?" (issue 34).
+TEST(OutputsCli, AnOutputFolderRemovedDuringTheRunIsNamed) {
+  const Inputs in = make_inputs();
+  const std::string soil =
+      "soil " + std::string(DRIFT_SOURCE_DIR) + "/data/soil/cone.toml --steps 1 -o ";
+  const std::string runs[] = {soil + "OUT/a.ply", soil + "OUT/a.obj",
+                              "import " + in.dem.string() + " -o OUT/a.tif",
+                              "render " + in.scene.string() + " --size 16x8 --spp 1 -o OUT/a.png"};
+  for (const std::string& run : runs) {
+    const fs::path d = test_dir(), out = d / "out";
+    fs::create_directories(out);
+    std::string args = run;
+    args.replace(args.find("OUT"), 3, out.string());
+    const Result r = drift(args, d, {Stop::write, 1}, 0, [&] { fs::remove_all(out); });
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.log;
+    EXPECT_NE(r.log.find("its folder '" + out.string() + "' was removed during the run"),
+              std::string::npos)
+        << args << "\n"
+        << r.log;
+    EXPECT_EQ(r.log.find("disk full"), std::string::npos) << r.log;
+  }
 }
 
 }  // namespace
