@@ -5,7 +5,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "render/json_text.h"
+#include "terrain/json_text.h"
 
 namespace drift::render {
 
@@ -102,8 +102,8 @@ std::vector<std::pair<std::string, std::string>> CryptomatteLayer::header() cons
   std::string manifest = "{";
   for (std::size_t i = 0; i < names.size(); ++i) {
     if (i) manifest += ",";
-    manifest +=
-        json_string(names[i]) + ":" + json_string(cryptomatte_hex(cryptomatte_id(names[i])));
+    manifest += terrain::json_string(names[i]) + ":" +
+                terrain::json_string(cryptomatte_hex(cryptomatte_id(names[i])));
   }
   manifest += "}";
   const std::string prefix = "cryptomatte/" + key() + "/";

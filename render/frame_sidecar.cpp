@@ -6,21 +6,17 @@
 
 #include "render/camera_setup.h"
 #include "render/cryptomatte.h"
-#include "render/json_text.h"
 #include "render/mattes.h"
 #include "render/terrain_scene.h"
 #include "terrain/angles.h"
 #include "terrain/direction.h"
+#include "terrain/json_text.h"
 
 namespace drift::render {
 
 namespace {
 
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string number(double v) { return terrain::json_number(v); }
 
 std::string vec(const Eigen::Vector3d& v) {
   // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + string.
@@ -34,8 +30,9 @@ std::string ids(const CryptomatteLayer& layer) {
   std::string out = "{";
   for (std::size_t i = 0; i < layer.names.size(); ++i) {
     const float id = cryptomatte_id(layer.names[i]);
-    out += (i ? ", " : "") + json_string(layer.names[i]) +
-           ": {\"id_hex\": " + json_string(cryptomatte_hex(id)) + ", \"id\": " + number(id) + "}";
+    out += (i ? ", " : "") + terrain::json_string(layer.names[i]) +
+           ": {\"id_hex\": " + terrain::json_string(cryptomatte_hex(id)) +
+           ", \"id\": " + number(id) + "}";
   }
   return out + "}";
 }
@@ -92,7 +89,7 @@ std::string frame_sidecar_json(const TerrainScene& scene, const SceneInput& inpu
   j << "  \"sun\": {\"azimuth_deg\": " << number(input.sun.azimuth_deg)
     << ", \"elevation_deg\": " << number(input.sun.elevation_deg) << ", \"direction\": " << vec(sun)
     << "},\n";
-  j << "  \"crs_wkt\": " << json_string(input.terrain.geo().crs_wkt) << ",\n";
+  j << "  \"crs_wkt\": " << terrain::json_string(input.terrain.geo().crs_wkt) << ",\n";
   j << "  \"origin\": " << vec(world_origin)
     << ",\n  \"origin_note\": \"the EXR's P.X/Y/Z plus origin is the point in the CRS\",\n";
   const FrameMattes mattes(scene, input);

@@ -8,6 +8,8 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "render/embree_ray.h"
 #include "render/ground_detail.h"
@@ -147,6 +149,22 @@ struct TerrainScene::Embree {
   RTCScene scene = nullptr;
   std::vector<RTCGrid> grids;
   std::vector<RTCGrid> surround_grids;
+  // A device (TBB's threads) and an empty scene built for tracing speed.
+  void open() {
+    device = rtcNewDevice("threads=0");
+    if (!device) throw Error("cannot create an Embree device");
+    rtcSetDeviceErrorFunction(device, embree_error, nullptr);
+    scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+  }
+  // Builds the scene of what was attached; its lowest and highest z.
+  std::pair<float, float> commit() {
+    rtcCommitScene(scene);
+    check_device(device, "build the scene");
+    RTCBounds bounds;
+    rtcGetSceneBounds(scene, &bounds);
+    return {bounds.lower_z, bounds.upper_z};
+  }
   ~Embree() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -171,8 +189,9 @@ TerrainScene::TerrainScene(const SceneInput& input, PagedTerrain& paged)
 
 void TerrainScene::build_paged(const SceneInput& input, PagedTerrain& paged) {
   if (!input.height_changes.empty())
-    throw Error("an out-of-core terrain (--memory-budget) cannot have height changes (snow depth) "
-                "laid on it; render without --memory-budget or lay them on the DEM first");
+    throw Error(
+        "an out-of-core terrain (--memory-budget) cannot have height changes (snow depth) "
+        "laid on it; render without --memory-budget or lay them on the DEM first");
   paged_ = &paged;
   heights_ = paged.frame();
   width_ = heights_.width;
@@ -188,21 +207,12 @@ void TerrainScene::build_paged(const SceneInput& input, PagedTerrain& paged) {
   surface_.cell = std::min(std::abs(static_cast<float>(paged.geo().cell_size_x())),
                            std::abs(static_cast<float>(paged.geo().cell_size_y())));
   coverage_ = coverage_channels(surface_);
-  embree_->device = rtcNewDevice("threads=0");
-  if (!embree_->device) throw Error("cannot create an Embree device");
-  rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
-  embree_->scene = rtcNewScene(embree_->device);
-  rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
+  embree_->open();
   blocks_ = std::make_unique<HeightFieldBlocks>(heights_, paged, paged.take_leaves());
   attach_blocks();
   // The surround ring reads the DEM's whole edge from memory: not built here.
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
-  rtcCommitScene(embree_->scene);
-  check_device(embree_->device, "build the scene");
-  RTCBounds bounds;
-  rtcGetSceneBounds(embree_->scene, &bounds);
-  bottom_ = bounds.lower_z;
-  top_ = bounds.upper_z;
+  std::tie(bottom_, top_) = embree_->commit();
 }
 
 void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
@@ -218,11 +228,7 @@ void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
   // A raised copy is the scene's own: its storage can become the heights.
   fill_heights(dem, raised ? &*raised : adopt, static_cast<float>(input.vertical_exaggeration));
 
-  embree_->device = rtcNewDevice("threads=0");
-  if (!embree_->device) throw Error("cannot create an Embree device");
-  rtcSetDeviceErrorFunction(embree_->device, embree_error, nullptr);
-  embree_->scene = rtcNewScene(embree_->device);
-  rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
+  embree_->open();
   if (geometry == TerrainGeometry::Auto)
     geometry =
         dem.size() < kHeightFieldMinCells ? TerrainGeometry::Grid : TerrainGeometry::HeightField;
@@ -235,12 +241,7 @@ void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
   }
   attach_surround(input.surround);
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
-  rtcCommitScene(embree_->scene);
-  check_device(embree_->device, "build the scene");
-  RTCBounds bounds;
-  rtcGetSceneBounds(embree_->scene, &bounds);
-  bottom_ = bounds.lower_z;
-  top_ = bounds.upper_z;
+  std::tie(bottom_, top_) = embree_->commit();
 }
 
 void TerrainScene::check_terrain(const terrain::HeightField& dem) {

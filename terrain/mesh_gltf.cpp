@@ -14,6 +14,7 @@
 
 #include "terrain/atomic_file.h"
 #include "terrain/error.h"
+#include "terrain/json_text.h"
 #include "terrain/mesh_io.h"
 
 namespace drift::terrain {
@@ -26,17 +27,9 @@ namespace {
 // about x by -90 degrees (determinant 1), so windings and normals keep their sense.
 Eigen::Vector3f to_y_up(const Eigen::Vector3f& v) { return {v.x(), v.z(), -v.y()}; }
 
-std::string number(double v) {
-  char s[40];
-  std::snprintf(s, sizeof s, "%.9g", v);
-  return s;
-}
-
-std::string number17(double v) {
-  char s[40];
-  std::snprintf(s, sizeof s, "%.17g", v);
-  return s;
-}
+// Floats with 9 digits, the origin's doubles with 17 (terrain/json_text.h).
+std::string number(double v) { return json_number(v, 9); }
+std::string number17(double v) { return json_number(v); }
 
 // "snow_coverage" -> "_SNOW_COVERAGE": glTF requires application-specific
 // attribute names to start with an underscore (spec 3.7.2.1).

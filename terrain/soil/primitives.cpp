@@ -228,13 +228,9 @@ double coverage(const std::vector<Primitive>& prims, const Vector3d& pos, const 
   return static_cast<double>(in) / (n * n * n);
 }
 
-VoxelBox voxel_box(const std::vector<Primitive>& prims, const Vector3d& pos,
-                   const terrain::Grid3Shape& shape) {
-  Vector3d lo = Vector3d::Constant(1e300), hi = Vector3d::Constant(-1e300);
-  for (const Primitive& p : prims) {
-    lo = lo.cwiseMin(p.lower() + pos);
-    hi = hi.cwiseMax(p.upper() + pos);
-  }
+namespace {
+// The voxels a world box [lo, hi] touches, clamped to the grid.
+VoxelBox voxel_box_of(const Vector3d& lo, const Vector3d& hi, const terrain::Grid3Shape& shape) {
   VoxelBox box;
   const Eigen::Vector3i n(shape.nx, shape.ny, shape.nz);
   for (int a = 0; a < 3; ++a) {
@@ -244,6 +240,17 @@ VoxelBox voxel_box(const std::vector<Primitive>& prims, const Vector3d& pos,
     box.hi[a] = static_cast<int>(std::clamp(h, 0.0, static_cast<double>(n[a])));
   }
   return box;
+}
+}  // namespace
+
+VoxelBox voxel_box(const std::vector<Primitive>& prims, const Vector3d& pos,
+                   const terrain::Grid3Shape& shape) {
+  Vector3d lo = Vector3d::Constant(1e300), hi = Vector3d::Constant(-1e300);
+  for (const Primitive& p : prims) {
+    lo = lo.cwiseMin(p.lower() + pos);
+    hi = hi.cwiseMax(p.upper() + pos);
+  }
+  return voxel_box_of(lo, hi, shape);
 }
 
 void for_each_covered_voxel(const std::vector<Primitive>& prims, const Vector3d& pos,
@@ -291,15 +298,7 @@ VoxelBox voxel_box(const PlacedSolid& solid, const terrain::Grid3Shape& shape) {
   for (const Primitive& p : *solid.primitives)
     placed_bounds(solid.pose, p.lower(), p.upper(), lo, hi);
   if (solid.mesh) placed_bounds(solid.pose, solid.mesh->lower(), solid.mesh->upper(), lo, hi);
-  VoxelBox box;
-  const Eigen::Vector3i n(shape.nx, shape.ny, shape.nz);
-  for (int a = 0; a < 3; ++a) {
-    const double l = std::floor((lo[a] - shape.origin[a]) / shape.voxel_size);
-    const double h = std::ceil((hi[a] - shape.origin[a]) / shape.voxel_size);
-    box.lo[a] = static_cast<int>(std::clamp(l, 0.0, static_cast<double>(n[a])));
-    box.hi[a] = static_cast<int>(std::clamp(h, 0.0, static_cast<double>(n[a])));
-  }
-  return box;
+  return voxel_box_of(lo, hi, shape);
 }
 
 double coverage(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi) {
