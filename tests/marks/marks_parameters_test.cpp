@@ -41,7 +41,8 @@ TEST(MarksParameters, MaterialRangesHoldAtBothEndsWithTheStagesErrorType) {
 TEST(MarksParameters, DocsMaterialsTablesAgreeWithThePresetsAndTheRows) {
   using drift::terrain::format_value;
   using drift::testing::markdown_table;
-  const auto presets = markdown_table("docs/marks.md", "| preset | theta (deg) | alpha | sigma |");
+  const auto presets =
+      markdown_table(DRIFT_SOURCE_DIR "/docs/marks.md", "| preset | theta (deg) | alpha | sigma |");
   std::size_t listed = 0;
   for (const std::string name : {"sand", "mud", "snow"}) {
     const Material m = *material_preset(name);
@@ -55,7 +56,8 @@ TEST(MarksParameters, DocsMaterialsTablesAgreeWithThePresetsAndTheRows) {
   }
   EXPECT_EQ(presets.size(), listed) << "docs/marks.md lists other presets";
 
-  const auto keys = markdown_table("docs/marks.md", "| material key | range | meaning |");
+  const auto keys =
+      markdown_table(DRIFT_SOURCE_DIR "/docs/marks.md", "| material key | range | meaning |");
   ASSERT_EQ(keys.size(), material_parameters().size()) << "docs/marks.md's material keys";
   for (const auto& p : material_parameters()) {
     const std::string label = std::string("`") + p.key + "`";

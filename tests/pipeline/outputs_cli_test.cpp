@@ -426,7 +426,13 @@ TEST(OutputsCli, FilesNamedInInputsAreRefusedAsOutputs) {
   for (const std::string& args : runs) {
     const Result r = drift(args, d);
     EXPECT_EQ(r.status, 1) << args << "\n" << r.log;
-    EXPECT_NE(r.log.find("input"), std::string::npos) << args << "\n" << r.log;
+    // A scene's mesh named like an image is now refused by the mesh reader
+    // itself (read by its extension, docs/meshes.md) before the outputs are
+    // checked; either way nothing is written over it.
+    const bool refused =
+        r.log.find("input") != std::string::npos ||
+        (args.rfind("render", 0) == 0 && r.log.find("cannot read mesh") != std::string::npos);
+    EXPECT_TRUE(refused) << args << "\n" << r.log;
   }
   EXPECT_EQ(slurp(d / "rock.ply"), before_ply);
   EXPECT_EQ(slurp(d / "ball.obj"), before_obj);
@@ -441,7 +447,10 @@ TEST(OutputsCli, FilesNamedInInputsAreRefusedAsOutputs) {
                   d)
                 .status,
             0);
-  const Result rendered = drift(render + (d / "frame.png").string(), d);
+  put(d / "plain.toml", "[terrain]\nraster = \"dem.tif\"\n[sun]\nazimuth = 120\nelevation = 35\n");
+  const Result rendered = drift("render " + (d / "plain.toml").string() +
+                                    " --size 8x4 --spp 1 -o " + (d / "frame.png").string(),
+                                d);
   EXPECT_EQ(rendered.status, 0) << rendered.log;
 }
 
@@ -543,7 +552,6 @@ TEST(OutputsCli, FileSizeLimitLeavesNoTemporaryFile) {
   EXPECT_EQ(slurp(out), "old");
   EXPECT_TRUE(hidden_files(d).empty());
 }
-
 
 // An output folder removed while the run computes: the error names the folder
 // and what happened to it, for every kind of writer (PLY/OBJ, GeoTIFF through
