@@ -195,6 +195,22 @@ void validate(const RigidObject& o, const std::string& what) {
   }
 }
 
+namespace {
+// The share of the box [lo, hi] that `inside` holds, sampled at the centres
+// of 4 x 4 x 4 sub-boxes (where a box is not wholly in or out).
+template <class Inside>
+double sampled_share(const Vector3d& lo, const Vector3d& hi, const Inside& inside) {
+  constexpr int n = 4;
+  int in = 0;
+  const Vector3d step = (hi - lo) / n;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        in += inside(lo + step.cwiseProduct(Vector3d(i + 0.5, j + 0.5, k + 0.5)));
+  return static_cast<double>(in) / (n * n * n);
+}
+}  // namespace
+
 double coverage(const std::vector<Primitive>& prims, const Vector3d& pos, const Vector3d& lo,
                 const Vector3d& hi) {
   const Vector3d llo = lo - pos, lhi = hi - pos;
@@ -212,20 +228,11 @@ double coverage(const std::vector<Primitive>& prims, const Vector3d& pos, const 
     return overlap(llo.x(), lhi.x(), a.x(), b.x()) * overlap(llo.y(), lhi.y(), a.y(), b.y()) *
            overlap(llo.z(), lhi.z(), a.z(), b.z());
   }
-  constexpr int n = 4;
-  int in = 0;
-  const Vector3d step = (lhi - llo) / n;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const Vector3d q = llo + step.cwiseProduct(Vector3d(i + 0.5, j + 0.5, k + 0.5));
-        for (const Primitive& p : prims)
-          if (p.inside(q)) {
-            ++in;
-            break;
-          }
-      }
-  return static_cast<double>(in) / (n * n * n);
+  return sampled_share(llo, lhi, [&](const Vector3d& q) {
+    for (const Primitive& p : prims)
+      if (p.inside(q)) return true;
+    return false;
+  });
 }
 
 namespace {
@@ -322,20 +329,13 @@ double coverage(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi
     if (all) return 1.0;
   }
   if (!touches) return 0.0;
-  constexpr int n = 4;
-  int in = 0;
-  const Vector3d step = (hi - lo) / n;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const Vector3d q =
-            solid.pose.to_body(lo + step.cwiseProduct(Vector3d(i + 0.5, j + 0.5, k + 0.5)));
-        bool inside = solid.mesh && solid.mesh->inside(q);
-        for (const Primitive& p : *solid.primitives)
-          if (inside || (inside = p.inside(q))) break;
-        in += inside;
-      }
-  return static_cast<double>(in) / (n * n * n);
+  return sampled_share(lo, hi, [&](const Vector3d& world) {
+    const Vector3d q = solid.pose.to_body(world);
+    bool inside = solid.mesh && solid.mesh->inside(q);
+    for (const Primitive& p : *solid.primitives)
+      if (inside || (inside = p.inside(q))) break;
+    return inside;
+  });
 }
 
 void for_each_covered_voxel(const PlacedSolid& solid, const terrain::Grid3Shape& shape,
