@@ -298,6 +298,25 @@ TEST(SnowfallStabilise, SameBitsWithAndWithoutAvx2) {
   EXPECT_EQ(avx2.values(), baseline.values());
 }
 
+// The corner of the benchmark's mountains (1 m cells, 0.5 m of snow
+// everywhere) settled twice without the coarse start: with the shortcut for
+// the slow tail and by the passes alone. The shortcut's and the coarse start's
+// tests both measure against these runs.
+struct MountainCorner {
+  static constexpr int n = 128;
+  Grid<float> ground = drift::testing::snowfall_mountains(n);
+  StabiliseOptions o;
+  Grid<double> shortcut{n, n, 0.5}, slow{n, n, 0.5};
+  StabiliseReport with_shortcut, passes_alone;
+  MountainCorner() {
+    o.coarse_levels = 0;
+    with_shortcut = stabilise_grid(ground, shortcut, 1.0, 1.0, o);
+    StabiliseOptions alone = o;
+    alone.shortcut = false;
+    passes_alone = stabilise_grid(ground, slow, 1.0, 1.0, alone);
+  }
+};
+
 // The shortcut for the slow tail (snow/stabilise_settle.h) on the corner of
 // the benchmark's mountains (1 m cells, 0.5 m of snow everywhere): a wedge on a
 // ledge along the closed edge drains over its lip into a corner deposit, which
@@ -305,14 +324,11 @@ TEST(SnowfallStabilise, SameBitsWithAndWithoutAvx2) {
 // same criterion met, mass kept, and a state within a few centimetres of the
 // passes' own.
 TEST(SnowfallStabilise, ShortcutSettlesTheSlowTailToNearlyTheSameState) {
-  const int n = 128;
-  const Grid<float> ground = drift::testing::snowfall_mountains(n);
-  Grid<double> fast(n, n, 0.5), slow(n, n, 0.5);
-  StabiliseOptions o;
-  o.coarse_levels = 0;  // the shortcut alone (the coarse start has its own test)
-  const auto rf = stabilise_grid(ground, fast, 1.0, 1.0, o);
-  o.shortcut = false;
-  const auto rs = stabilise_grid(ground, slow, 1.0, 1.0, o);
+  const MountainCorner c;
+  const Grid<float>& ground = c.ground;
+  const StabiliseOptions& o = c.o;
+  const Grid<double>&fast = c.shortcut, &slow = c.slow;
+  const StabiliseReport &rf = c.with_shortcut, &rs = c.passes_alone;
   ASSERT_TRUE(rf.converged && rs.converged);
   EXPECT_LE(max_repose_excess(ground, fast, 1.0, 1.0, o.repose_deg, o.tolerance), o.tolerance);
   EXPECT_NEAR(total(fast), total(slow), 1e-12 * total(slow));
@@ -475,14 +491,12 @@ TEST(SnowfallStabilise, TowersSettleAtReposeWithAndWithoutTheCoarseStart) {
 // level: RMS 1.8 cm, 0.43 % of the cells off by more than 10 cm; two: 5.6 cm,
 // 5.2 %: each level settles the snow its coarser ground lets slide).
 TEST(SnowfallStabilise, CoarseStartSettlesNearThePassesAlone) {
-  const int n = 128;
-  const Grid<float> ground = drift::testing::snowfall_mountains(n);
-  Grid<double> slow(n, n, 0.5), shortcut(n, n, 0.5);
-  StabiliseOptions o;
-  o.coarse_levels = 0;
-  const auto rc = stabilise_grid(ground, shortcut, 1.0, 1.0, o);
-  o.shortcut = false;
-  const auto rs = stabilise_grid(ground, slow, 1.0, 1.0, o);
+  const MountainCorner c;
+  constexpr int n = MountainCorner::n;
+  const Grid<float>& ground = c.ground;
+  const Grid<double>& slow = c.slow;
+  const StabiliseReport &rc = c.with_shortcut, &rs = c.passes_alone;
+  StabiliseOptions o = c.o;
   ASSERT_TRUE(rs.converged && rc.converged);
   struct Bound {
     int levels;
