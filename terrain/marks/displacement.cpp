@@ -167,11 +167,43 @@ void displace_contact(Patch& p, const std::optional<Eigen::Vector2d>& drag, Disp
       fallback(li);
 }
 
+// Heave (issue 32; docs/marks.md, "Mud's heave"): a press into a material of
+// heave H > 0 hands the volume on its ring (where spread_over_rings left it)
+// to a band of width W = H B beside the contact, B the footing's width
+// (footing_width): a free cell at distance d < W from the contact takes a
+// share in proportion to 1 - d / W, so the heave is highest at the wall and
+// runs out at W, the same in every direction (straight edges give even
+// bands, round prints round ones). A drag keeps the paper's flow (its bow
+// wave goes ahead, not back into the trough).
+void spread_heave(Patch& p, const MaterialField& materials, double footing) {
+  const int n = static_cast<int>(p.contact.size());
+  auto band = [&](int li) { return materials.at(p.global(li)).heave * footing; };
+  double volume = 0.0;
+  for (int li = 0; li < n; ++li)
+    if (!p.contact[li] && p.pending[li] > 0.0 && p.outer[li] < band(li))
+      volume += p.pending[li], p.pending[li] = 0.0;
+  if (!(volume > 0.0)) return;
+  std::vector<double> weight(p.contact.size(), 0.0);
+  double total = 0.0;
+  for (int li = 0; li < n; ++li) {
+    const double w = band(li);
+    if (p.contact[li] || !(p.outer[li] < w)) continue;
+    weight[li] = 1.0 - p.outer[li] / w;
+    total += weight[li];
+  }
+  for (int li = 0; li < n; ++li)
+    if (weight[li] > 0.0) p.pending[li] += volume * (weight[li] / total);
+}
+
 // Free cells from the ring outwards: each keeps what fits under the object's
 // bottom and pushes the rest on to the free cells farther out (never backwards
 // when dragging if it can help it). The object's bottom is a hard ceiling
-// (paper 000, 3.4, last paragraph): what cannot go anywhere is compressed.
+// (paper 000, 3.4, last paragraph): what cannot go anywhere is compressed. A
+// press into a material that heaves first spreads its volume over the band
+// (spread_heave). Cells with no free cell farther out in the window keep all
+// that fits.
 void settle_outside(Patch& p, terrain::Grid<double>& h, const BottomMap& bottom,
+                    const MaterialField& materials, double footing,
                     const std::optional<Eigen::Vector2d>& drag, DisplacementReport& r,
                     terrain::Grid<float>* disturbed) {
   std::vector<int> order;
@@ -179,6 +211,7 @@ void settle_outside(Patch& p, terrain::Grid<double>& h, const BottomMap& bottom,
     if (!p.contact[li] && std::isfinite(p.outer[li])) order.push_back(li);
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return p.outer[a] < p.outer[b]; });
+  if (!drag && footing > 0.0) spread_heave(p, materials, footing);
   for (int li : order) {
     const double amount = p.pending[li];
     if (!(amount > 0.0)) continue;
@@ -186,20 +219,47 @@ void settle_outside(Patch& p, terrain::Grid<double>& h, const BottomMap& bottom,
     double& height = h.values()[static_cast<std::size_t>(g)];
     const double room = std::max(bottom.z[li] - height, 0.0);  // +inf: nothing above
     const double keep = std::min(amount, room);
-    height += keep;
+    auto put = [&](double v) {
+      height += v;
+      if (v > 0.0) {
+        r.received.push_back(g);
+        if (disturbed) disturbed->values()[static_cast<std::size_t>(g)] += static_cast<float>(v);
+      }
+    };
+    put(keep);
     p.pending[li] = amount - keep;
-    if (keep > 0.0) {
-      r.received.push_back(g);
-      if (disturbed) disturbed->values()[static_cast<std::size_t>(g)] += static_cast<float>(keep);
-    }
     // Outwards, in proportion to how much farther each neighbour is per metre.
     auto farther = [&](int m, int k) {
       return p.contact[m] ? 0.0 : std::max(p.outer[m] - p.outer[li], 0.0) / p.length[k];
     };
     if (hand_on(p, li, [&](int m, int k) { return along(drag, k) >= -1e-9 ? farther(m, k) : 0.0; }))
       continue;
-    if (!hand_on(p, li, farther)) trap(p, li, r);
+    if (hand_on(p, li, farther)) continue;
+    // Nowhere farther (the window's edge): what fits stays here.
+    const double more = std::min(p.pending[li], std::max(room - keep, 0.0));
+    if (more > 0.0) {
+      put(more);
+      p.pending[li] -= more;
+    }
+    if (p.pending[li] > 0.0) trap(p, li, r);
   }
+}
+
+// The footing's width B (m): the diameter of the widest disc inside the
+// contact (twice the largest distance from a contact cell's centre to a free
+// cell's, less a cell), so a strip's B is its width, a square's its side and
+// a disc's its diameter. 0 when no material heaves (it is not needed).
+double footing_width(const Patch& p, const MaterialField& materials, double dx, double dy) {
+  double heave = 0.0;
+  for (const Material& m : materials.table) heave = std::max(heave, m.heave);
+  if (!(heave > 0.0)) return 0.0;
+  std::vector<char> free(p.contact.size());
+  for (std::size_t i = 0; i < free.size(); ++i) free[i] = !p.contact[i];
+  const std::vector<double> inside = euclidean_distance(free, p.w.width, p.w.height, dx, dy, true);
+  double deepest = 0.0;
+  for (std::size_t i = 0; i < inside.size(); ++i)
+    if (p.contact[i] && std::isfinite(inside[i])) deepest = std::max(deepest, inside[i]);
+  return std::max(2.0 * deepest - std::min(dx, dy), std::min(dx, dy));
 }
 
 }  // namespace
@@ -221,7 +281,8 @@ DisplacementReport compress_and_displace(terrain::Grid<double>& heights, const B
     p.length[k] = std::hypot(kNeighbours8[k].dx * dx, kNeighbours8[k].dy * dy);
   p.outer = euclidean_distance(p.contact, p.w.width, p.w.height, dx, dy, false);
   displace_contact(p, dir, r);
-  settle_outside(p, heights, bottom, dir, r, disturbed);
+  settle_outside(p, heights, bottom, materials, footing_width(p, materials, dx, dy), dir, r,
+                 disturbed);
   std::sort(r.received.begin(), r.received.end());
   return r;
 }

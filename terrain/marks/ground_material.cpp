@@ -19,6 +19,9 @@ const std::vector<terrain::Parameter<Material>>& material_parameters() {
       {"sigma", "", 0.0, 0.5, Ends::OpenLow, false, "",
        "roughness: share of a slope's excess moved per pass",
        DRIFT_PARAMETER_FIELD(Material, sigma), "roughness"},
+      {"heave", "", 0.0, 4.0, Ends::Closed, false, "",
+       "width of the heave beside a press, in footing widths (0: the paper's rim on the ring)",
+       DRIFT_PARAMETER_FIELD(Material, heave), "heave"},
   };
   return table;
 }
@@ -44,9 +47,12 @@ terrain::SlopeRule Material::slope_rule() const {
 
 std::optional<Material> material_preset(const std::string& name) {
   // Paper 000, section 4: figs. 7 (sand), 8 (mud), 9 (snow); sigma 0.2 (3.5).
-  if (name == "sand") return Material{"sand", 30.0, 1.0, 0.2};
-  if (name == "mud") return Material{"mud", 60.0, 0.8, 0.2};
-  if (name == "snow") return Material{"snow", 90.0, 0.0, 0.2};
+  // Mud's heave of one footing width: soft mud fails undrained in Prandtl's
+  // mechanism, lifting ground about a footing width beyond each edge
+  // (Terzaghi 1943; docs/marks.md, "Mud's heave").
+  if (name == "sand") return Material{"sand", 30.0, 1.0, 0.2, 0.0};
+  if (name == "mud") return Material{"mud", 60.0, 0.8, 0.2, 1.0};
+  if (name == "snow") return Material{"snow", 90.0, 0.0, 0.2, 0.0};
   return std::nullopt;
 }
 
@@ -55,7 +61,8 @@ std::string material_preset_names() { return "sand, mud, snow"; }
 std::uint8_t MaterialField::add(const Material& m) {
   for (std::size_t i = 0; i < table.size(); ++i) {
     const Material& t = table[i];
-    if (t.name == m.name && t.theta_deg == m.theta_deg && t.alpha == m.alpha && t.sigma == m.sigma)
+    if (t.name == m.name && t.theta_deg == m.theta_deg && t.alpha == m.alpha &&
+        t.sigma == m.sigma && t.heave == m.heave)
       return static_cast<std::uint8_t>(i);
   }
   if (table.size() >= 255) throw Error("more than 255 different ground materials");

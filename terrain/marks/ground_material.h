@@ -3,12 +3,14 @@
 // pushes aside is displaced rather than compressed (alpha), and how rough the
 // slipped slopes are (sigma). The paper's presets:
 //
-//   name   theta (deg)  alpha  sigma   look (paper figs. 7-9)
-//   sand   30           1.0    0.2     crumbled rims
-//   mud    60           0.8    0.2     sharp walls, a packed floor
-//   snow   90           0.0    0.2     clean compressed prints, no rim
+//   name   theta (deg)  alpha  sigma  heave  look (paper figs. 7-9)
+//   sand   30           1.0    0.2    0      crumbled rims
+//   mud    60           0.8    0.2    1      sharp walls, a packed floor, a wide low heave
+//   snow   90           0.0    0.2    0      clean compressed prints, no rim
 //
-// theta in (0, 90] (90: never slips), alpha in [0, 1], sigma in (0, 0.5].
+// theta in (0, 90] (90: never slips), alpha in [0, 1], sigma in (0, 0.5],
+// heave in [0, 4] (issue 32, not the paper: the width of the heave beside a
+// print in footing widths; 0: the paper's rim on the contact's ring).
 #pragma once
 
 #include <cstdint>
@@ -27,6 +29,10 @@ struct Material {
   double theta_deg = 30.0;  // angle of the slope after slipping (deg)
   double alpha = 1.0;       // displaced share of the material an object pushes out
   double sigma = 0.2;       // roughness: share of a slope's excess moved per pass
+  // Width of the heave the displaced volume spreads over beside a press, in
+  // footing widths (displacement.cpp, docs/marks.md "Mud's heave"; 0: the
+  // paper's ring).
+  double heave = 0.0;
 
   // Throws terrain::ParameterError naming `what`, the material, the key and
   // the bad value (the ranges: material_parameters()).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "terrain/angles.h"
 #include "terrain/error.h"
@@ -148,12 +149,24 @@ struct MarksSimulation::Impl {
     remember(held);
     return out;
   }
+  // The window's margin (cells): the options', widened by the heave's band
+  // (displacement.cpp: heave x the footing's width, at most the diameter of
+  // a disc of the footprint's area) so that the heave is not cut short.
+  int margin(const CellTriangles& tris) const {
+    double heave = 0.0;
+    for (const Material& m : sim.materials_.table) heave = std::max(heave, m.heave);
+    if (!(heave > 0.0)) return sim.options_.margin;
+    const CellWindow f = footprint_window(tris, 0, sim.heights_.width(), sim.heights_.height());
+    const double diameter =
+        2.0 * std::sqrt(static_cast<double>(f.width) * f.height / std::numbers::pi);
+    return sim.options_.margin + static_cast<int>(std::ceil(heave * diameter)) + 1;
+  }
   // Paper 000, 3.3-3.5 on the full-resolution field: collision, displacement, erosion.
   BottomMap deform(const CellTriangles& tris, const MarkObject& object,
                    const std::optional<Eigen::Vector2d>& drag, bool erode_now, StepReport& report) {
     BottomMap bottom;
     bottom.window =
-        footprint_window(tris, sim.options_.margin, sim.heights_.width(), sim.heights_.height());
+        footprint_window(tris, margin(tris), sim.heights_.width(), sim.heights_.height());
     if (bottom.window.empty()) return bottom;
     rasteriser->render(tris, bottom);
     if (object.material) claim_material(below(bottom), object);

@@ -53,6 +53,7 @@ TEST(MarksParameters, DocsMaterialsTablesAgreeWithThePresetsAndTheRows) {
     EXPECT_EQ(row->at(1), format_value(m.theta_deg)) << name;
     EXPECT_EQ(row->at(2), format_value(m.alpha)) << name;
     EXPECT_EQ(row->at(3), format_value(m.sigma)) << name;
+    EXPECT_EQ(row->at(4), format_value(m.heave)) << name;
   }
   EXPECT_EQ(presets.size(), listed) << "docs/marks.md lists other presets";
 

@@ -125,11 +125,21 @@ TEST(MarksErosion, SandRimsSlumpMudWallsStandSnowHasNoRim) {
     return top - 1.0;
   };
   EXPECT_LE(steepest(sand.sim), 30.5);
-  EXPECT_GT(steepest(mud.sim), 40.0);  // walls far steeper than sand's
+  // Walls far steeper than sand's (the ball's own flank, 48 degrees at the
+  // contact's edge, read over a 1 cm cell: 39 degrees).
+  EXPECT_GT(steepest(mud.sim), 35.0);
   EXPECT_LE(steepest(mud.sim), 60.5 + 0.0) << "mud wall";
   EXPECT_GT(rim(sand.sim), 0.001);
-  EXPECT_GT(rim(mud.sim), rim(sand.sim));  // alpha 0.8 but steeper, so higher rims
-  EXPECT_LE(rim(snow.sim), 0.0);           // alpha 0: compressed, no rim
+  // Mud's heave (docs/marks.md) spreads its rim about a footing wide, so it
+  // stands lower than sand's; by the paper's rule (heave 0) the displaced
+  // volume stays on the ring, and at theta 60 it stands higher than sand's.
+  EXPECT_LT(rim(mud.sim), 0.5 * rim(sand.sim)) << "mud's heave";
+  MaterialField ring = only("mud");
+  ring.table[0].heave = 0.0;
+  Press paper(ring);
+  settle(paper.sim, 10);
+  EXPECT_GT(rim(paper.sim), rim(sand.sim));  // alpha 0.8 but steeper, so higher rims
+  EXPECT_LE(rim(snow.sim), 0.0);             // alpha 0: compressed, no rim
 }
 
 // Compression and displacement are symmetric (a material that does not slip:
@@ -205,7 +215,7 @@ TEST(MarksMaterials, PerRegionMaterialsFromAPaintedRaster) {
         worst = std::max(worst, std::abs(sim.heights()(c + 1, r) - sim.heights()(c, r)));
     return std::atan(worst / kCell) * 180 / std::numbers::pi;
   };
-  EXPECT_GT(steepest(4, 44), 40.0) << "mud's walls stand";
+  EXPECT_GT(steepest(4, 44), 35.0) << "mud's walls stand";
   EXPECT_LE(steepest(52, 92), 30.5) << "sand's slump to 30 degrees";
   painted(5, 7) = 0.5f;
   try {
