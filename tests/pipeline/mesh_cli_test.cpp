@@ -3,6 +3,8 @@
 // STL land where the same mesh as OBJ lands.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -59,6 +61,49 @@ TEST(MeshCli, CropAsGlbLiesOnTheDemsCells) {
   EXPECT_FLOAT_EQ(origin.y() + peak.y(), 4000195.0);  // row 10's centre
   EXPECT_NE(drift::testing::slurp(d / "crop.glb").find("\"drift_origin\":[700105,4000245,0]"),
             std::string::npos);
+}
+
+TEST(MeshCli, DecimateKeepsEveryCellWithinTheBound) {
+  const fs::path d = test_dir("mesh_cli");
+  const fs::path dem = make_dem(d);  // a plane with one spike: few triangles but round the spike
+  ASSERT_EQ(
+      run_drift("mesh " + dem.string() + " --decimate 0.01 -o " + (d / "dec.glb").string(), d), 0)
+      << drift_log(d);
+  EXPECT_NE(drift_log(d).find("of 2262 triangles; largest vertical error 0 m (bound 0.01 m)"),
+            std::string::npos)
+      << drift_log(d);
+  const drift::terrain::Mesh m = drift::terrain::read_mesh(d / "dec.glb");
+  EXPECT_LT(m.triangles.size(), 2262u / 4);
+  bool spike = false;
+  for (const auto& p : m.positions) spike = spike || p.z() == 1500.0f;
+  EXPECT_TRUE(spike);
+  // Every cell centre lies on the mesh: the plane's height where it is not the spike.
+  const drift::terrain::HeightField g = drift::terrain::read_raster(dem);
+  double worst = 0;
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3f a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+    const Eigen::Vector3f n = (b - a).cross(c - a);
+    ASSERT_GT(n.z(), 0.0f);  // counter-clockwise seen from above
+    for (int r = 0; r < g.height(); ++r) {
+      for (int x = 0; x < g.width(); ++x) {
+        const Eigen::Vector2f p(10.0f * x, -10.0f * r);  // metres from cell (0, 0)'s centre
+        auto side = [&](const Eigen::Vector3f& u, const Eigen::Vector3f& v) {
+          return (v.x() - u.x()) * (p.y() - u.y()) - (v.y() - u.y()) * (p.x() - u.x());
+        };
+        if (side(a, b) < -1e-3f || side(b, c) < -1e-3f || side(c, a) < -1e-3f) continue;
+        const float z = a.z() - (n.x() * (p.x() - a.x()) + n.y() * (p.y() - a.y())) / n.z();
+        worst = std::max(worst, std::abs(static_cast<double>(z - g(x, r))));
+      }
+    }
+  }
+  EXPECT_LE(worst, 0.01);
+  EXPECT_EQ(
+      run_drift("mesh " + dem.string() + " --decimate 1 --step 2 -o " + (d / "b.glb").string(), d),
+      2);
+  EXPECT_EQ(run_drift("mesh " + dem.string() + " --decimate=-1 -o " + (d / "b.glb").string(), d),
+            2);
+  EXPECT_NE(drift_log(d).find("--decimate"), std::string::npos) << drift_log(d);
+  EXPECT_FALSE(fs::exists(d / "b.glb"));
 }
 
 TEST(MeshCli, UsageErrorsExitTwo) {
