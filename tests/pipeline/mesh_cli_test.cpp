@@ -13,26 +13,24 @@
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
 #include "tests/test_files.h"
+#include "tests/utm_fixture.h"
 
 namespace fs = std::filesystem;
-using drift::testing::drift_log;
-using drift::testing::put;
-using drift::testing::run_drift;
-using drift::testing::test_dir;
+using namespace drift::testing;  // test_dir, put, run_drift, drift_log
 
 namespace {
 
+// drift mesh DEM FLAGS -o OUT, run in d; its exit status.
+int mesh(const fs::path& dem, const std::string& flags, const fs::path& out, const fs::path& d) {
+  return run_drift("mesh " + dem.string() + " " + flags + " -o " + out.string(), d);
+}
+
 // A 40 x 30 DEM of 10 m cells at UTM magnitude: a tilted plane with a peak.
 fs::path make_dem(const fs::path& d) {
-  drift::terrain::HeightField g(40, 30, 0.0f);
-  g.geo().geotransform = {700000.0, 10.0, 0.0, 4000300.0, 0.0, -10.0};
-  for (int r = 0; r < 30; ++r)
-    for (int x = 0; x < 40; ++x)
-      g(x, r) = 1000.0f + 2.0f * static_cast<float>(x) - static_cast<float>(r);
-  g(20, 10) = 1500.0f;
-  const fs::path dem = d / "dem.tif";
-  drift::terrain::write_geotiff(g, dem);
-  return dem;
+  return drift::testing::write_dem(d, 40, 30, 700000.0, 4000300.0, 10.0, "", [](int x, int r) {
+    return x == 20 && r == 10 ? 1500.0f
+                              : 1000.0f + 2.0f * static_cast<float>(x) - static_cast<float>(r);
+  });
 }
 
 }  // namespace
@@ -41,10 +39,7 @@ TEST(MeshCli, CropAsGlbLiesOnTheDemsCells) {
   const fs::path d = test_dir("mesh_cli");
   const fs::path dem = make_dem(d);
   // Cells 10..29 x 5..14: centres x 700105..700295, y 4000155..4000245.
-  ASSERT_EQ(run_drift("mesh " + dem.string() + " --crop 700100,4000150,700300,4000250 -o " +
-                          (d / "crop.glb").string(),
-                      d),
-            0)
+  ASSERT_EQ(mesh(dem, "--crop 700100,4000150,700300,4000250", d / "crop.glb", d), 0)
       << drift_log(d);
   EXPECT_NE(drift_log(d).find("200 vertices, 342 triangles"), std::string::npos) << drift_log(d);
   const drift::terrain::Mesh m = drift::terrain::read_mesh(d / "crop.glb");
@@ -66,9 +61,7 @@ TEST(MeshCli, CropAsGlbLiesOnTheDemsCells) {
 TEST(MeshCli, DecimateKeepsEveryCellWithinTheBound) {
   const fs::path d = test_dir("mesh_cli");
   const fs::path dem = make_dem(d);  // a plane with one spike: few triangles but round the spike
-  ASSERT_EQ(
-      run_drift("mesh " + dem.string() + " --decimate 0.01 -o " + (d / "dec.glb").string(), d), 0)
-      << drift_log(d);
+  ASSERT_EQ(mesh(dem, "--decimate 0.01", d / "dec.glb", d), 0) << drift_log(d);
   EXPECT_NE(drift_log(d).find("of 2262 triangles; largest vertical error 0 m (bound 0.01 m)"),
             std::string::npos)
       << drift_log(d);
@@ -97,11 +90,8 @@ TEST(MeshCli, DecimateKeepsEveryCellWithinTheBound) {
     }
   }
   EXPECT_LE(worst, 0.01);
-  EXPECT_EQ(
-      run_drift("mesh " + dem.string() + " --decimate 1 --step 2 -o " + (d / "b.glb").string(), d),
-      2);
-  EXPECT_EQ(run_drift("mesh " + dem.string() + " --decimate=-1 -o " + (d / "b.glb").string(), d),
-            2);
+  EXPECT_EQ(mesh(dem, "--decimate 1 --step 2", d / "b.glb", d), 2);
+  EXPECT_EQ(mesh(dem, "--decimate=-1", d / "b.glb", d), 2);
   EXPECT_NE(drift_log(d).find("--decimate"), std::string::npos) << drift_log(d);
   EXPECT_FALSE(fs::exists(d / "b.glb"));
 }
@@ -109,16 +99,14 @@ TEST(MeshCli, DecimateKeepsEveryCellWithinTheBound) {
 TEST(MeshCli, UsageErrorsExitTwo) {
   const fs::path d = test_dir("mesh_cli");
   const fs::path dem = make_dem(d);
-  EXPECT_EQ(run_drift("mesh " + dem.string() + " -o " + (d / "crop.xyz").string(), d), 2);
+  EXPECT_EQ(mesh(dem, "", d / "crop.xyz", d), 2);
   EXPECT_NE(drift_log(d).find(".glb, .gltf, .fbx, .stl, .obj or .ply"), std::string::npos)
       << drift_log(d);
-  EXPECT_EQ(run_drift("mesh " + dem.string() + " --step 0 -o " + (d / "a.glb").string(), d), 2);
-  EXPECT_EQ(
-      run_drift("mesh " + dem.string() + " --attribute cover -o " + (d / "a.glb").string(), d), 2);
+  EXPECT_EQ(mesh(dem, "--step 0", d / "a.glb", d), 2);
+  EXPECT_EQ(mesh(dem, "--attribute cover", d / "a.glb", d), 2);
   EXPECT_EQ(run_drift("mesh -o " + (d / "a.glb").string(), d), 2);
   // A box beside the DEM is bad input (exit 1), naming the fix.
-  EXPECT_EQ(run_drift("mesh " + dem.string() + " --crop 0,0,10,10 -o " + (d / "a.glb").string(), d),
-            1);
+  EXPECT_EQ(mesh(dem, "--crop 0,0,10,10", d / "a.glb", d), 1);
   EXPECT_NE(drift_log(d).find("drift info"), std::string::npos) << drift_log(d);
   EXPECT_FALSE(fs::exists(d / "a.glb"));
 }
