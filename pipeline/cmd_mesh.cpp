@@ -2,8 +2,10 @@
 // (marked ground, snow surface, dunes) as a triangle mesh for Blender, game
 // engines and viewers: glTF/GLB, FBX, STL, OBJ or PLY by the output's extension.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "pipeline/cli.h"
 #include "pipeline/object_list.h"
@@ -21,6 +23,7 @@ struct MeshCommand {
   std::vector<double> crop;
   std::vector<std::string> attributes;  // NAME=RASTER
   int step = 1;
+  std::optional<double> decimate;  // metres of vertical error (terrain/mesh_rtin.h)
 };
 
 void run_mesh(const MeshCommand& c) {
@@ -37,6 +40,11 @@ void run_mesh(const MeshCommand& c) {
   OutputSet outputs({c.output}, inputs);
   if (!terrain::is_mesh_output(c.output))
     usage_error("-o '" + c.output + "' must end in .glb, .gltf, .fbx, .stl, .obj or .ply");
+  if (c.decimate && c.step != 1)
+    usage_error("--decimate and --step both choose the vertices; give one of them");
+  if (c.decimate && !(*c.decimate >= 0.0 && std::isfinite(*c.decimate)))
+    usage_error("--decimate " + std::to_string(*c.decimate) +
+                " must be a vertical error of 0 metres or more, e.g. --decimate 0.5");
   terrain::ReadOptions read;
   if (!c.crop.empty()) {
     read.window = terrain::crop_window(terrain::read_raster_header(c.raster),
@@ -47,9 +55,19 @@ void run_mesh(const MeshCommand& c) {
   std::vector<std::pair<std::string, terrain::HeightField>> attributes;
   for (const auto& [name, path] : named)
     attributes.emplace_back(name, terrain::read_raster(path, read));
-  const terrain::Mesh mesh = terrain::height_field_mesh(heights, c.step, attributes);
+  double error = 0.0;
+  const terrain::Mesh mesh =
+      c.decimate ? terrain::decimated_height_field_mesh(heights, *c.decimate, attributes, &error)
+                 : terrain::height_field_mesh(heights, c.step, attributes);
   terrain::write_mesh(mesh, c.output);
   outputs.commit();
+  if (c.decimate) {
+    std::printf(
+        "mesh: decimated to %zu of %zu triangles; largest vertical error %.4g m (bound %g m)\n",
+        mesh.triangle_count(),
+        2 * static_cast<std::size_t>(heights.width() - 1) * (heights.height() - 1), error,
+        *c.decimate);
+  }
   std::printf(
       "mesh: wrote %s (%zu vertices, %zu triangles; origin %.3f, %.3f in the raster's CRS)\n",
       c.output.c_str(), mesh.vertex_count(), mesh.triangle_count(), mesh.origin.x(),
@@ -78,6 +96,9 @@ void add_mesh_command(CLI::App& root) {
                       "a vertex every STEP cells (1: every cell; 4: 1/16 the triangles)"),
       1, 1 << 16)
       ->capture_default_str();
+  sub->add_option("--decimate", c->decimate,
+                  "ERR: the fewest triangles within ERR metres (vertically) of every cell "
+                  "centre, crack-free (a right-triangulated irregular network); instead of --step");
   sub->add_option("--attribute", c->attributes,
                   "NAME=RASTER: another raster of the same grid as a per-vertex attribute "
                   "(glTF: custom attribute _NAME; PLY: property NAME), e.g. "

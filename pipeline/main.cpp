@@ -56,13 +56,10 @@ int main(int argc, char** argv) try {
   } catch (const drift::Cancelled&) {
     std::fprintf(stderr, "drift: cancelled; no output written\n");
     return 1;
-  } catch (const drift::Error& e) {
-    std::fprintf(stderr, "drift: error: %s\n", e.what());
-    return 1;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "drift: error: out of memory; use a smaller input or size\n");
     return 1;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // drift::Error (bad input) and anything else
     std::fprintf(stderr, "drift: error: %s\n", e.what());
     return 1;
   }

@@ -22,8 +22,17 @@ namespace products = terrain::products;
 // per-vertex snow attributes (the renderer shades by kSnowCoverage).
 void place_snowy_objects(SceneFile& scene, const std::filesystem::path& file) {
   std::vector<terrain::PlacedMesh>& meshes = scene.input.meshes;
-  std::vector<terrain::Mesh> parts =
-      products::split_objects(terrain::read_ply(file), products::kSnowyObjects, file);
+  // Any mesh format, as every object is read; but only PLY carries the
+  // per-vertex snow back: Assimp drops glTF's custom attributes (assimp#4830)
+  // and the other formats have none, so those are refused naming the fix.
+  const terrain::Mesh snowy = terrain::read_mesh(file);
+  if (file.extension() != ".ply" && !snowy.attribute(products::kSnowCoverage)) {
+    throw Error(
+        "'" + file.string() + "' has no per-vertex snow: only PLY keeps drift's " +
+        "attributes when read (Assimp drops glTF's custom attributes); give --snow-objects " +
+        "([snow] objects) the PLY of drift snow fall --mesh-out OBJECTS.ply");
+  }
+  std::vector<terrain::Mesh> parts = products::split_objects(snowy, products::kSnowyObjects, file);
   if (parts.size() != meshes.size()) {
     throw Error("'" + file.string() + "' holds " + std::to_string(parts.size()) +
                 " objects but the scene has " + std::to_string(meshes.size()) +

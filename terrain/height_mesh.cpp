@@ -5,6 +5,7 @@
 
 #include "terrain/error.h"
 #include "terrain/mesh_io.h"
+#include "terrain/mesh_rtin.h"
 
 namespace drift::terrain {
 
@@ -31,9 +32,10 @@ RasterWindow crop_window(const RasterHeader& header, const std::array<double, 4>
   return {x0, y0, x1 - x0 + 1, y1 - y0 + 1};
 }
 
-Mesh height_field_mesh(const HeightField& h, int step,
+namespace {
+
+void require_same_grid(const HeightField& h,
                        const std::vector<std::pair<std::string, HeightField>>& attributes) {
-  if (step < 1) throw Error("internal: height_field_mesh step " + std::to_string(step));
   for (const auto& [name, a] : attributes) {
     if (a.width() != h.width() || a.height() != h.height() ||
         a.geo().geotransform != h.geo().geotransform) {
@@ -43,6 +45,55 @@ Mesh height_field_mesh(const HeightField& h, int step,
                   " grid of the heights (drift import --crop the same box)");
     }
   }
+}
+
+// The mesh's vertices, one per grid point a triangle uses, made on first use:
+// metres from the first cell's centre, with the attributes' values there.
+class GridVertices {
+ public:
+  GridVertices(Mesh& mesh, const HeightField& h,
+               const std::vector<std::pair<std::string, HeightField>>& attributes)
+      : mesh_(mesh),
+        h_(h),
+        attributes_(attributes),
+        origin_(h.geo().cell_center(0, 0)),
+        index_(static_cast<std::size_t>(h.width()) * h.height(), -1) {
+    mesh.origin = {origin_[0], origin_[1], 0.0};
+    for (const auto& [name, a] : attributes)
+      mesh.vertex_attributes.emplace_back(name, std::vector<float>{});
+  }
+
+  int operator()(int x, int r) {
+    int& v = index_[static_cast<std::size_t>(r) * h_.width() + x];
+    if (v >= 0) return v;
+    const std::array<double, 2> p = h_.geo().cell_center(x, r);
+    v = static_cast<int>(mesh_.positions.size());
+    mesh_.positions.emplace_back(static_cast<float>(p[0] - origin_[0]),
+                                 static_cast<float>(p[1] - origin_[1]), h_(x, r));
+    for (std::size_t k = 0; k < attributes_.size(); ++k)
+      mesh_.vertex_attributes[k].second.push_back(attributes_[k].second(x, r));
+    return v;
+  }
+
+ private:
+  Mesh& mesh_;
+  const HeightField& h_;
+  const std::vector<std::pair<std::string, HeightField>>& attributes_;
+  std::array<double, 2> origin_;
+  std::vector<int> index_;
+};
+
+// Rows run south in a north-up raster, north in a south-up one.
+bool south_up(const HeightField& h) {
+  return h.geo().geotransform[1] * h.geo().geotransform[5] > 0;
+}
+
+}  // namespace
+
+Mesh height_field_mesh(const HeightField& h, int step,
+                       const std::vector<std::pair<std::string, HeightField>>& attributes) {
+  if (step < 1) throw Error("internal: height_field_mesh step " + std::to_string(step));
+  require_same_grid(h, attributes);
   // The columns and rows kept: every step-th and the last.
   auto kept = [step](int n) {
     std::vector<int> k;
@@ -51,27 +102,10 @@ Mesh height_field_mesh(const HeightField& h, int step,
     return k;
   };
   const std::vector<int> cols = kept(h.width()), rows = kept(h.height());
-  const GeoReference& g = h.geo();
-  const std::array<double, 2> o = g.cell_center(0, 0);
   Mesh mesh;
-  mesh.origin = {o[0], o[1], 0.0};
-  for (const auto& [name, a] : attributes)
-    mesh.vertex_attributes.emplace_back(name, std::vector<float>{});
+  GridVertices vertex(mesh, h, attributes);
   const std::size_t nc = cols.size();
-  const bool flip = g.geotransform[1] * g.geotransform[5] > 0;
-  std::vector<int> index(nc * rows.size(), -1);
-  auto vertex = [&](std::size_t i, std::size_t j) {  // column i, row j of the kept ones
-    int& v = index[j * nc + i];
-    if (v >= 0) return v;
-    const int x = cols[i], r = rows[j];
-    const std::array<double, 2> p = g.cell_center(x, r);
-    v = static_cast<int>(mesh.positions.size());
-    mesh.positions.emplace_back(static_cast<float>(p[0] - o[0]), static_cast<float>(p[1] - o[1]),
-                                h(x, r));
-    for (std::size_t k = 0; k < attributes.size(); ++k)
-      mesh.vertex_attributes[k].second.push_back(attributes[k].second(x, r));
-    return v;
-  };
+  const bool flip = south_up(h);
   for (std::size_t j = 0; j + 1 < rows.size(); ++j) {
     for (std::size_t i = 0; i + 1 < nc; ++i) {
       const float a = h(cols[i], rows[j]), b = h(cols[i + 1], rows[j]), c = h(cols[i], rows[j + 1]),
@@ -79,8 +113,8 @@ Mesh height_field_mesh(const HeightField& h, int step,
       if (std::isnan(a) || std::isnan(b) || std::isnan(c) || std::isnan(d)) continue;
       // Rows run south in a north-up raster: (i, j+1) is south of (i, j), so
       // nw, sw, se then nw, se, ne are counter-clockwise seen from above.
-      const int nw = vertex(i, j), ne = vertex(i + 1, j), sw = vertex(i, j + 1),
-                se = vertex(i + 1, j + 1);
+      const int nw = vertex(cols[i], rows[j]), ne = vertex(cols[i + 1], rows[j]),
+                sw = vertex(cols[i], rows[j + 1]), se = vertex(cols[i + 1], rows[j + 1]);
       if (flip) {  // a south-up raster: rows run north
         mesh.triangles.push_back({nw, se, sw});
         mesh.triangles.push_back({nw, ne, se});
@@ -91,6 +125,31 @@ Mesh height_field_mesh(const HeightField& h, int step,
     }
   }
   if (mesh.triangles.empty()) throw Error("the raster has no 2 x 2 cells with data to mesh");
+  mesh.normals = vertex_normals(mesh);
+  return mesh;
+}
+
+Mesh decimated_height_field_mesh(const HeightField& h, double max_error,
+                                 const std::vector<std::pair<std::string, HeightField>>& attributes,
+                                 double* measured_error) {
+  require_same_grid(h, attributes);
+  const RtinMesh rtin = rtin_triangles(h, max_error);
+  Mesh mesh;
+  GridVertices vertex(mesh, h, attributes);
+  const bool flip = south_up(h);
+  for (const GridTriangle& t : rtin.triangles) {
+    // Counter-clockwise from above is clockwise in (column, row) when rows
+    // run south: twice the signed area in grid coordinates is negative.
+    const long long cross = static_cast<long long>(t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) -
+                            static_cast<long long>(t[1][1] - t[0][1]) * (t[2][0] - t[0][0]);
+    const int a = vertex(t[0][0], t[0][1]), b = vertex(t[1][0], t[1][1]),
+              c = vertex(t[2][0], t[2][1]);
+    if ((cross < 0) != flip)
+      mesh.triangles.push_back({a, b, c});
+    else
+      mesh.triangles.push_back({a, c, b});
+  }
+  if (measured_error) *measured_error = rtin.max_error;
   mesh.normals = vertex_normals(mesh);
   return mesh;
 }

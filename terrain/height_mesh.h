@@ -30,4 +30,13 @@ RasterWindow crop_window(const RasterHeader& header, const std::array<double, 4>
 Mesh height_field_mesh(const HeightField& heights, int step,
                        const std::vector<std::pair<std::string, HeightField>>& attributes = {});
 
+// The same mesh simplified to at most `max_error` metres of vertical error at
+// every cell centre (terrain/mesh_rtin.h: a right-triangulated irregular
+// network, crack-free). Halves of cells with a nodata corner are left out.
+// `measured_error`, if given, receives the largest error the mesh has.
+Mesh decimated_height_field_mesh(
+    const HeightField& heights, double max_error,
+    const std::vector<std::pair<std::string, HeightField>>& attributes = {},
+    double* measured_error = nullptr);
+
 }  // namespace drift::terrain

@@ -10,6 +10,7 @@
 
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
+#include "tests/cli_fixture.h"
 #include "tests/dem_fixture.h"
 #include "tests/test_files.h"
 
@@ -21,9 +22,7 @@ fs::path dir() { return drift::testing::test_dir("drift_marks_cli"); }
 
 // A flat metric ground (1 cm cells, UTM-sized coordinates) at 2000 m.
 fs::path ground(const fs::path& d) {
-  drift::terrain::write_geotiff(drift::testing::flat_utm_ground(64, 2000.0f, 0.01),
-                                d / "ground.tif");
-  return d / "ground.tif";
+  return drift::testing::write_flat_utm_ground(d, 64, 2000.0f, 0.01);
 }
 
 // A ball pressed 3 cm into the ground's middle and lifted again.

@@ -10,6 +10,7 @@
 #include "render/image_io.h"
 #include "terrain/raster_io.h"
 #include "tests/test_files.h"
+#include "tests/utm_fixture.h"
 
 namespace fs = std::filesystem;
 using drift::testing::drift_log;
@@ -19,32 +20,16 @@ using drift::testing::test_dir;
 
 namespace {
 
-std::string utm53_wkt() {
-  OGRSpatialReference srs;
-  srs.importFromEPSG(32653);
-  char* wkt = nullptr;
-  srs.exportToWkt(&wkt);
-  std::string out = wkt;
-  CPLFree(wkt);
-  return out;
-}
-
 // A 64 x 48 DEM of 10 m cells at UTM coordinates, gently rolling, with its
 // highest cell, a 60 m spike, at column 37, row 12.
 constexpr int kSpikeCol = 37, kSpikeRow = 12;
 constexpr double kWest = 741003.0, kNorth = 4029640.0, kCell = 10.0;
 fs::path write_dem(const fs::path& dir) {
-  drift::terrain::GeoReference geo;
-  geo.geotransform = {kWest, kCell, 0.0, kNorth, 0.0, -kCell};
-  geo.crs_wkt = utm53_wkt();
-  drift::terrain::HeightField dem(64, 48, 0.0f, geo);
-  for (int r = 0; r < 48; ++r)
-    for (int c = 0; c < 64; ++c)
-      dem(c, r) = static_cast<float>(1500.0 + 8.0 * std::sin(c / 7.0) * std::cos(r / 5.0));
-  dem(kSpikeCol, kSpikeRow) = 1560.0f;
-  const fs::path path = dir / "dem.tif";
-  drift::terrain::write_geotiff(dem, path);
-  return path;
+  return drift::testing::write_dem(dir, 64, 48, kWest, kNorth, kCell, drift::testing::utm53_wkt(),
+                                   [](int c, int r) {
+                                     if (c == kSpikeCol && r == kSpikeRow) return 1560.0;
+                                     return 1500.0 + 8.0 * std::sin(c / 7.0) * std::cos(r / 5.0);
+                                   });
 }
 
 }  // namespace

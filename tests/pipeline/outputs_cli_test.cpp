@@ -21,6 +21,7 @@
 
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
+#include "tests/cli_fixture.h"
 #include "tests/test_files.h"
 
 extern char** environ;
@@ -34,10 +35,7 @@ using drift::testing::slurp;
 
 fs::path test_dir() { return drift::testing::test_dir("drift_outputs_cli"); }
 
-struct Result {
-  int status = -1;  // exit status, or 128 + signal
-  std::string log;  // stdout and stderr
-};
+using Result = drift::testing::RunResult;
 
 std::vector<std::string> split(const std::string& args) {
   std::istringstream in(args);

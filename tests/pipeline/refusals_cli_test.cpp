@@ -15,6 +15,7 @@
 #include "render/image.h"
 #include "render/image_io.h"
 #include "terrain/raster_io.h"
+#include "tests/cli_fixture.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -26,10 +27,7 @@ using drift::testing::slurp;
 
 fs::path test_dir() { return drift::testing::test_dir("drift_refusals_cli"); }
 
-struct Result {
-  int status;
-  std::string log;
-};
+using Result = drift::testing::RunResult;
 
 // Runs drift (at most 60 s: a hang fails the test rather than the suite) with
 // the environment assignments in `env` and returns its status and output.

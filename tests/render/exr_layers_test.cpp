@@ -15,6 +15,7 @@
 #include "render/renderer.h"
 #include "render/terrain_scene.h"
 #include "tests/test_files.h"
+#include "tests/utm_fixture.h"
 
 using namespace drift::render;
 
@@ -57,15 +58,7 @@ void add_roof(SceneInput& in, const Eigen::Vector3d& centre) {
   in.object_names = {"hut"};
 }
 
-std::string utm53_wkt() {
-  OGRSpatialReference srs;
-  srs.importFromEPSG(32653);
-  char* wkt = nullptr;
-  srs.exportToWkt(&wkt);
-  std::string out = wkt;
-  CPLFree(wkt);
-  return out;
-}
+using drift::testing::utm53_wkt;
 
 const std::string& text(const Image& im, const std::string& name) {
   for (const auto& [k, v] : im.header_texts)

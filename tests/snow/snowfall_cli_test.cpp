@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "terrain/raster_io.h"
+#include "tests/cli_fixture.h"
 #include "tests/dem_fixture.h"
 #include "tests/test_files.h"
 
@@ -18,8 +19,7 @@ fs::path dir() { return drift::testing::test_dir("drift_snowfall_cli"); }
 
 // A small metric ground (UTM 53N) and an objects file with a rock on it.
 fs::path setup(const fs::path& d) {
-  drift::terrain::write_geotiff(drift::testing::flat_utm_ground(40, 1500.0f, 0.5),
-                                d / "ground.tif");
+  drift::testing::write_flat_utm_ground(d, 40, 1500.0f, 0.5);
   std::ofstream(d / "objects.toml") << "[[objects]]\nmesh = \"" DRIFT_SOURCE_DIR
                                        "/data/objects/rock_b.obj\"\nposition = [600010.0, "
                                        "3999990.0, 1500.0]\n";

@@ -105,6 +105,21 @@ TEST(AtomicFile, RefusesLinksDevicesAndDirectories) {
   EXPECT_EQ(read_all(d / "real.txt"), "keep");
 }
 
+namespace {
+
+// Writes `text` to a and b as one output set (each an atomic file), committed.
+void write_set(const fs::path& a, const fs::path& b, const std::string& text) {
+  drift::OutputSet set({a, b});
+  for (const fs::path& p : {a, b}) {
+    drift::AtomicFile f(p);
+    std::ofstream(f.temp_path()) << text;
+    f.commit();
+  }
+  set.commit();
+}
+
+}  // namespace
+
 TEST(OutputSet, ReplacesNothingUnlessEveryOutputIsWritten) {
   const fs::path d = fresh_dir("set"), a = d / "a.txt", b = d / "b.txt";
   std::ofstream(a) << "old a";
@@ -119,15 +134,7 @@ TEST(OutputSet, ReplacesNothingUnlessEveryOutputIsWritten) {
   EXPECT_EQ(read_all(a), "old a");
   EXPECT_FALSE(fs::exists(b));
   EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator()), 1);
-  {
-    drift::OutputSet set({a, b});
-    for (const fs::path& p : {a, b}) {
-      drift::AtomicFile f(p);
-      std::ofstream(f.temp_path()) << "new";
-      f.commit();
-    }
-    set.commit();
-  }
+  { write_set(a, b, "new"); }
   EXPECT_EQ(read_all(a), "new");
   EXPECT_EQ(read_all(b), "new");
   EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator()), 2);
@@ -146,13 +153,7 @@ TEST(OutputSet, RunsWritingOneFolderReplaceTheirOutputsOneSetAtATime) {
   ASSERT_GE(child, 0);
   if (child == 0) {
     try {
-      drift::OutputSet set({a, b});
-      for (const fs::path& p : {a, b}) {
-        drift::AtomicFile f(p);
-        std::ofstream(f.temp_path()) << "child";
-        f.commit();
-      }
-      set.commit();
+      write_set(a, b, "child");
       _exit(0);
     } catch (...) {
       _exit(1);
