@@ -108,6 +108,13 @@ const HeightRay& callback_ray(RTCRayN* rays, unsigned n, unsigned i, const Heigh
   return *own;
 }
 
+// The terrain's geometry (height field or grids), committed as geometry 0.
+void attach_as_terrain(RTCScene scene, RTCGeometry g) {
+  rtcCommitGeometry(g);
+  rtcAttachGeometryByID(scene, g, 0);
+  rtcReleaseGeometry(g);
+}
+
 void height_intersect(const RTCIntersectFunctionNArguments* args) {
   const auto* blocks = static_cast<const HeightFieldBlocks*>(args->geometryUserPtr);
   const auto* ctx = reinterpret_cast<const HeightContext*>(args->context);
@@ -328,9 +335,7 @@ void TerrainScene::attach_blocks() {
   rtcSetGeometryBoundsFunction(g, height_bounds, nullptr);
   rtcSetGeometryIntersectFunction(g, height_intersect);
   rtcSetGeometryOccludedFunction(g, height_occluded);
-  rtcCommitGeometry(g);
-  rtcAttachGeometryByID(embree_->scene, g, 0);
-  rtcReleaseGeometry(g);
+  attach_as_terrain(embree_->scene, g);
   terrain_geometries_ = 1;
   mesh_material_.push_back(surface_.ground);
   mesh_covers_.emplace_back();
@@ -365,9 +370,7 @@ void TerrainScene::attach_terrain_grids() {
                              vertices_.data(), 0, sizeof(Eigen::Vector3f), vertices_.size());
   rtcSetSharedGeometryBuffer(grid_geometry, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
                              embree_->grids.data(), 0, sizeof(RTCGrid), embree_->grids.size());
-  rtcCommitGeometry(grid_geometry);
-  rtcAttachGeometryByID(embree_->scene, grid_geometry, 0);
-  rtcReleaseGeometry(grid_geometry);
+  attach_as_terrain(embree_->scene, grid_geometry);
   terrain_geometries_ = 1;
   mesh_material_.push_back(surface_.ground);
   mesh_covers_.emplace_back();

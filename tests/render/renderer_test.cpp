@@ -100,9 +100,7 @@ TEST(Renderer, CosineLawUnderTheSun) {
   in.sun.color = {1, 1, 1};
   in.sun.irradiance = 2.0;
   const TerrainScene scene(in);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.samples_per_pixel = 8;
+  RenderSettings rs = drift::testing::frame_settings(16, 16, 8);
   rs.max_depth = 2;
   for (double elevation : {10.0, 30.0, 60.0, 90.0}) {
     in.sun.elevation_deg = elevation;
@@ -125,9 +123,7 @@ TEST(Renderer, WhiteFurnace) {
   in.sky.intensity = 1.0f;
   in.sun.irradiance = 0.0;
   const TerrainScene scene(in);
-  RenderSettings rs;
-  rs.width = rs.height = 24;
-  rs.samples_per_pixel = 32;
+  RenderSettings rs = drift::testing::frame_settings(24, 24, 32);
   rs.max_depth = 256;
   const Image img = render_image(scene, in, looking_down(scene, 600.0), rs);
   // Russian roulette keeps the mean at 1; 18432 paths give a standard error ~1e-3.
