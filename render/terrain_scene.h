@@ -65,8 +65,7 @@ class TerrainScene {
  public:
   // Throws drift::Error for an empty or all-nodata terrain. NaN (nodata) cells
   // are filled with the lowest valid height so that holes read as low ground.
-  explicit TerrainScene(const SceneInput& input,
-                        TerrainGeometry geometry = TerrainGeometry::Auto);
+  explicit TerrainScene(const SceneInput& input, TerrainGeometry geometry = TerrainGeometry::Auto);
   // The same with the terrain taken from `terrain` (input.terrain is not
   // read): its storage becomes the scene's heights, so a DEM's cells are held
   // once; `terrain` is left empty.
@@ -113,6 +112,9 @@ class TerrainScene {
   Eigen::Vector3f lowest_point() const { return lowest_; }
   Eigen::Vector2f extent() const { return extent_; }  // metres east-west, north-south
   float height_at(float x, float y) const;            // bilinear, local coordinates
+  // The shading normal on the DEM at local (x, y): Horn's vertex normals
+  // blended bilinearly (clamped to the DEM), unit length.
+  Eigen::Vector3f smooth_normal(float x, float y) const;
   // Lowest and highest z of all geometry (terrain and meshes), local.
   float bottom() const { return bottom_; }
   // The names of Hit::coverage's channels (render/coverage.h).

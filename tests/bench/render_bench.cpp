@@ -126,14 +126,31 @@ BENCHMARK(BM_TerrainSceneBuild)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();
 
-void trace_frames(benchmark::State& state, const render::SceneInput& input) {
+// Rays 0 .. n - 1 traced by trace(i) (true on a hit) over TBB's threads;
+// the hits, and the CPU seconds of the whole process added to `cpu`.
+template <class Trace>
+std::uint64_t trace_all(std::size_t n, const Trace& trace, double& cpu) {
+  std::atomic<std::uint64_t> hits{0};
+  const double start = process_cpu_seconds();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      std::uint64_t local = 0;
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) local += trace(i);
+                      hits += local;
+                    });
+  cpu += process_cpu_seconds() - start;
+  return hits;
+}
+
+void trace_frames(benchmark::State& state, const render::SceneInput& input, int spp = 64) {
   Fixture& f = fixture();
+  render::RenderSettings settings = f.scene.settings;
+  settings.samples_per_pixel = spp;
   render::RenderStats stats;
   double cpu = 0.0;
   for (auto _ : state) {
     const double start = process_cpu_seconds();
-    auto img =
-        render::render_image(*f.embree, input, f.camera, f.scene.settings, no_progress, &stats);
+    auto img = render::render_image(*f.embree, input, f.camera, settings, no_progress, &stats);
     cpu += process_cpu_seconds() - start;
     benchmark::DoNotOptimize(img.pixels.data());
   }
@@ -146,8 +163,14 @@ void trace_frames(benchmark::State& state, const render::SceneInput& input) {
   state.counters["peak_MiB"] = bench::peak_resident_mib();
 }
 
-void BM_PathTracer(benchmark::State& state) { trace_frames(state, fixture().scene.input); }
-BENCHMARK(BM_PathTracer)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+// Argument: samples a pixel. At 4 (kRecordedSpp) the path tracer traces
+// exactly the rays BM_RawEmbreeSameRays replays: its rays/cpu_s over theirs
+// (grid geometry, argument 1) is the share of the frame Embree's traversal
+// takes.
+void BM_PathTracer(benchmark::State& state) {
+  trace_frames(state, fixture().scene.input, static_cast<int>(state.range(0)));
+}
+BENCHMARK(BM_PathTracer)->Arg(64)->Arg(4)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 // A small default frame (320x180, 32 spp) on one thread through each terrain
 // geometry: argument 0 the height field, 1 Embree's grid (issue 36: 9.3 s
@@ -197,19 +220,11 @@ void BM_RawEmbreeCameraRays(benchmark::State& state) {
       for (int s = 0; s < spp; ++s)
         dirs[(static_cast<std::size_t>(y) * rs.width + x) * spp + s] =
             pinhole.direction(x + (s + 0.5f) / spp, y + 0.5f);
-  std::atomic<std::uint64_t> hits{0};
+  std::uint64_t hits = 0;
   double cpu = 0.0;
   for (auto _ : state) {
-    const double start = process_cpu_seconds();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, dirs.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        std::uint64_t local = 0;
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          local += scene.hits(pinhole.eye, dirs[i]);
-                        }
-                        hits += local;
-                      });
-    cpu += process_cpu_seconds() - start;
+    hits += trace_all(
+        dirs.size(), [&](std::size_t i) { return scene.hits(pinhole.eye, dirs[i]); }, cpu);
   }
   state.counters["rays/s"] = benchmark::Counter(
       static_cast<double>(dirs.size()) * state.iterations(), benchmark::Counter::kIsRate);
@@ -272,23 +287,14 @@ std::vector<RecordedRay> record_path_tracer_rays() {
 void BM_RawEmbreeSameRays(benchmark::State& state) {
   static const std::vector<RecordedRay> rays = record_path_tracer_rays();
   const render::TerrainScene& scene = state.range(0) ? *fixture().grid : *fixture().heights;
-  std::atomic<std::uint64_t> hits{0};
+  std::uint64_t hits = 0;
   double cpu = 0.0;
-  for (auto _ : state) {
-    const double start = process_cpu_seconds();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        std::uint64_t local = 0;
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          const RecordedRay& ray = rays[i];
-                          local += ray.shadow
-                                       ? scene.occluded(ray.origin, ray.dir, ray.max_distance)
-                                       : scene.hits(ray.origin, ray.dir);
-                        }
-                        hits += local;
-                      });
-    cpu += process_cpu_seconds() - start;
-  }
+  const auto trace = [&](std::size_t i) {
+    const RecordedRay& ray = rays[i];
+    return ray.shadow ? scene.occluded(ray.origin, ray.dir, ray.max_distance)
+                      : scene.hits(ray.origin, ray.dir);
+  };
+  for (auto _ : state) hits += trace_all(rays.size(), trace, cpu);
   const auto shadow =
       std::count_if(rays.begin(), rays.end(), [](const auto& r) { return r.shadow; });
   state.counters["rays/s"] = benchmark::Counter(

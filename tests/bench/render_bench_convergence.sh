@@ -13,9 +13,16 @@
 # reference adds its own noise (a 4096-spp one about a sixth of a 256-spp
 # render's with independent samples) and flattens the slope.
 #
+# With REF_SPP (e.g. 4096) set, each count's render of seed 1 is measured
+# against one reference of REF_SPP samples and seed 2 instead (the issue's
+# measure; the reference's own noise adds to every figure and flattens the
+# slope a little at 256 spp).
+#
 # DRIFT (default build/pipeline/drift) renders into WORK (default
 # /tmp/drift_convergence); SIZE (320x180), THREADS (0: all) and SCENES
-# ("default flat") may be set. The default scene needs out/yarigatake_utm.tif
+# ("default flat plain") may be set. "plain" is the default DEM's
+# plain-ground frame of scripts/compare-cycles.sh (grey Lambertian ground,
+# albedo 0.3, the DEM alone). The default scene needs out/yarigatake_utm.tif
 # (make -C data/scenes default).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
@@ -45,29 +52,63 @@ to = [501280, 3998720, 1000]
 seed = 1
 EOF
 
+# The plain-ground variant of the default scene (scripts/compare-cycles.sh).
+cat > "$work/plain.toml" <<EOF
+[terrain]
+raster = "$root/out/yarigatake_utm.tif"
+color = [0.3, 0.3, 0.3]
+roughness = 0
+surround_reach = 0
+[sun]
+azimuth = 110
+elevation = 28
+irradiance = 3.0
+[sky]
+visibility = 120
+[render]
+max_depth = 4
+EOF
+
 scene_file() {
   case "$1" in
     default) echo "$root/data/scenes/default.toml --terrain $root/out/yarigatake_utm.tif" ;;
     flat) echo "$work/flat.toml" ;;
+    plain) echo "$work/plain.toml" ;;
   esac
 }
 
-for scene in ${SCENES:-default flat}; do
+ref_spp="${REF_SPP:-0}"
+seeds="1 2"
+[ "$ref_spp" -gt 0 ] && seeds="1"
+
+for scene in ${SCENES:-default flat plain}; do
   logs=()
+  if [ "$ref_spp" -gt 0 ] && [ ! -f "$work/${scene}_ref${ref_spp}.exr" ]; then
+    # shellcheck disable=SC2046
+    "$drift" render $(scene_file "$scene") --size "$size" --spp "$ref_spp" --seed 2 \
+      --threads "$threads" -o "$work/${scene}_ref${ref_spp}.exr" >/dev/null
+  fi
   for spp in 4 16 64 256; do
     cpu=0
-    for seed in 1 2; do
+    for seed in $seeds; do
       # shellcheck disable=SC2046
       /usr/bin/time -f "%U %S" -o "$work/time" "$drift" render $(scene_file "$scene") \
         --size "$size" --spp "$spp" --seed "$seed" --threads "$threads" \
         -o "$work/${scene}_${spp}_${seed}.exr" >/dev/null
       cpu=$(awk -v c="$cpu" '{print c + $1 + $2}' "$work/time")
     done
-    pair=$({ "$drift" compare "$work/${scene}_${spp}_1.exr" "$work/${scene}_${spp}_2.exr" \
-      --metric relmse || true; } | awk '/^relmse:/ {print $2}')
-    rel=$(awk -v p="$pair" 'BEGIN {print p / 2}')
+    if [ "$ref_spp" -gt 0 ]; then
+      rel=$({ "$drift" compare "$work/${scene}_${spp}_1.exr" "$work/${scene}_ref${ref_spp}.exr" \
+        --metric relmse || true; } | awk '/^relmse:/ {print $2}')
+      runs=1
+    else
+      pair=$({ "$drift" compare "$work/${scene}_${spp}_1.exr" "$work/${scene}_${spp}_2.exr" \
+        --metric relmse || true; } | awk '/^relmse:/ {print $2}')
+      rel=$(awk -v p="$pair" 'BEGIN {print p / 2}')
+      runs=2
+    fi
     printf '%s %4d spp: relMSE %.4g  (%.1f s CPU a render)\n' "$scene" "$spp" "$rel" \
-      "$(awk -v c="$cpu" 'BEGIN {print c / 2}')"
+      "$(awk -v c="$cpu" -v n="$runs" 'BEGIN {print c / n}')"
     logs+=("$spp $rel")
   done
   # Least-squares slopes of log relMSE against log spp: 4-64 and 4-256.

@@ -3,7 +3,6 @@
 // its shadow darkens the ground under cloud and nowhere else, it appears in
 // the sky seen by rays, and a render with clouds is the same bits whatever
 // the thread count.
-#include "render/camera_setup.h"
 #include "render/clouds.h"
 
 #include <gtest/gtest.h>
@@ -13,10 +12,12 @@
 #include <numbers>
 #include <random>
 
+#include "render/camera_setup.h"
 #include "render/renderer.h"
 #include "render/terrain_scene.h"
 #include "terrain/error.h"
 #include "tests/dem_fixture.h"
+#include "tests/render/render_fixtures.h"
 
 namespace drift::render {
 namespace {
@@ -299,14 +300,8 @@ TEST(Clouds, SeenInTheSkyFromBelowAndSameBitsForAnyThreadCount) {
   ShadowScene s;
   s.in.clouds = s.clouds;
   const TerrainScene scene(s.in);
-  Camera up;
-  up.from = scene.origin() + Eigen::Vector3d(0, 0, 50);
-  up.to = scene.origin() + Eigen::Vector3d(0, 0.001, 1000);
-  up.vertical_fov_deg = 60.0;
-  RenderSettings rs;
-  rs.width = 40;
-  rs.height = 30;
-  rs.samples_per_pixel = 4;
+  const Camera up = drift::testing::camera_from_to(scene, {0, 0, 50}, {0, 0.001, 1000}, 60.0);
+  const RenderSettings rs = drift::testing::frame_settings(40, 30, 4);
   auto render_with = [&](int threads) {
     tbb::task_arena arena(threads);
     Image img;

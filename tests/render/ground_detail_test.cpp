@@ -210,15 +210,24 @@ TEST(LandForm, TopographicPositionOfPlaneAndValley) {
   EXPECT_THROW(topographic_position(plane, 0.0), Error);
 }
 
-TEST(LandForm, RaggednessIsSmoothBoundedNoise) {
-  std::mt19937_64 rng(3);
+// f(x, y) at n points drawn uniformly over 20 km x 20 km with seed `seed`.
+template <class F>
+void at_random_points(std::uint64_t seed, int n, F f) {
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 20000.0);
+  for (int i = 0; i < n; ++i) {
+    const double x = u(rng), y = u(rng);
+    f(x, y);
+  }
+}
+
+TEST(LandForm, RaggednessIsSmoothBoundedNoise) {
   double s = 0, s2 = 0, worst = 0;
   const int n = 20000;
-  for (int i = 0; i < n; ++i) {
-    const double r = raggedness(u(rng), u(rng));
+  at_random_points(3, n, [&](double x, double y) {
+    const double r = raggedness(x, y);
     s += r, s2 += r * r, worst = std::max(worst, std::abs(r));
-  }
+  });
   EXPECT_NEAR(s / n, 0.0, 0.05);
   EXPECT_NEAR(std::sqrt(s2 / n), 0.5, 0.1);
   EXPECT_LT(worst, 2.0);
@@ -230,16 +239,13 @@ TEST(LandForm, RaggednessSeenByAFootprintKeepsTheOctavesItResolves) {
   // 25 m) and drops the rest: what is left is the noise's coarse part, a
   // little weaker, centred on the same mean and close to the point value;
   // a footprint wider than the largest octave sees the mean, 0.
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(0.0, 20000.0);
   double s = 0, s2 = 0, d2 = 0;
   const int n = 20000;
-  for (int i = 0; i < n; ++i) {
-    const double x = u(rng), y = u(rng);
+  at_random_points(5, n, [&](double x, double y) {
     const double r = raggedness(x, y, 100.0), point = raggedness(x, y);
     s += r, s2 += r * r, d2 += (r - point) * (r - point);
     EXPECT_EQ(raggedness(x, y, 2000.0), 0.0f);
-  }
+  });
   EXPECT_NEAR(s / n, 0.0, 0.05);
   EXPECT_GT(std::sqrt(s2 / n), 0.35);
   EXPECT_LT(std::sqrt(s2 / n), 0.5);

@@ -1,7 +1,6 @@
 // Path tracer basics against closed forms: the cosine law under a sun, the white
 // furnace, grid-geometry hits on an analytic plane, and determinism across
 // thread counts.
-#include "render/camera_setup.h"
 #include "render/renderer.h"
 
 #include <gtest/gtest.h>
@@ -11,10 +10,13 @@
 #include <cstdio>
 #include <numbers>
 
+#include "render/camera_setup.h"
 #include "render/terrain_scene.h"
+#include "terrain/bilinear.h"
 #include "terrain/derivatives.h"
 #include "terrain/error.h"
 #include "tests/dem_fixture.h"
+#include "tests/render/render_fixtures.h"
 #include "tests/render/snow_layer.h"
 
 using namespace drift::render;
@@ -57,15 +59,48 @@ double mean_channel(const Image& img, int c) {
 
 }  // namespace
 
+TEST(TerrainScene, SmoothNormalsAreHornsVertexNormalsBlended) {
+  // Rough ground of 12 x 12 cells: the shading normal anywhere (the DEM's
+  // edge rows and points beyond it included) is the bilinear blend of
+  // Horn's normals at the four vertices around it, normalised, whichever
+  // path computes it (inside, one shared 4x4 stencil of heights).
+  SceneInput in;
+  in.terrain = make_dem(12, 10.0, [](double x, double y) {
+    return 20.0 * std::sin(0.031 * x + 0.4) * std::cos(0.047 * y) + 0.002 * x * y;
+  });
+  const HeightField& dem = in.terrain;
+  const TerrainScene scene(in);
+  const auto vertex = [&](int c, int r) {
+    const drift::terrain::Gradient g = drift::terrain::horn_gradient(dem, c, r);
+    return Eigen::Vector3f(-g.dzdx, -g.dzdy, 1.0f).normalized();
+  };
+  int checked = 0;
+  for (double col = -0.7; col < 12.0; col += 0.37) {
+    for (double row = -0.6; row < 12.0; row += 0.41) {
+      const auto world = dem.geo().cell_center(col, row);
+      const Eigen::Vector3f local =
+          scene.to_local(Eigen::Vector3d(world[0], world[1], scene.origin().z()));
+      const auto c = drift::terrain::clamped_cell(col, row, 12, 12);
+      const Eigen::Vector3f expected =
+          drift::terrain::bilinear_blend(vertex(c.x0, c.y0), vertex(c.x1, c.y0), vertex(c.x0, c.y1),
+                                         vertex(c.x1, c.y1), static_cast<float>(c.tx),
+                                         static_cast<float>(c.ty))
+              .normalized();
+      const Eigen::Vector3f n = scene.smooth_normal(local.x(), local.y());
+      ASSERT_NEAR((n - expected).norm(), 0.0f, 2e-5f) << "at column " << col << ", row " << row;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 900);
+}
+
 TEST(Renderer, CosineLawUnderTheSun) {
   // Flat Lambertian ground, black sky, one bounce: L = albedo/pi * E * sin(elevation).
   SceneInput in = flat_ground_black_sky(100.0);
   in.sun.color = {1, 1, 1};
   in.sun.irradiance = 2.0;
   const TerrainScene scene(in);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.samples_per_pixel = 8;
+  RenderSettings rs = drift::testing::frame_settings(16, 16, 8);
   rs.max_depth = 2;
   for (double elevation : {10.0, 30.0, 60.0, 90.0}) {
     in.sun.elevation_deg = elevation;
@@ -88,9 +123,7 @@ TEST(Renderer, WhiteFurnace) {
   in.sky.intensity = 1.0f;
   in.sun.irradiance = 0.0;
   const TerrainScene scene(in);
-  RenderSettings rs;
-  rs.width = rs.height = 24;
-  rs.samples_per_pixel = 32;
+  RenderSettings rs = drift::testing::frame_settings(24, 24, 32);
   rs.max_depth = 256;
   const Image img = render_image(scene, in, looking_down(scene, 600.0), rs);
   // Russian roulette keeps the mean at 1; 18432 paths give a standard error ~1e-3.
@@ -246,9 +279,7 @@ TEST(Camera, FocalLengthGivesTheFieldOfViewOverTheSensor) {
   SceneInput in;
   in.terrain = make_dem(8, 10.0, [](double, double) { return 0.0; });
   const TerrainScene scene(in);
-  Camera c;
-  c.from = scene.origin() + Eigen::Vector3d(0, 0, 10);
-  c.to = scene.origin() + Eigen::Vector3d(0, 100, 10);
+  Camera c = drift::testing::camera_from_to(scene, {0, 0, 10}, {0, 100, 10});
   c.focal_length_mm = 50.0;  // on 36 mm: 39.6 degrees across
   const CameraRays rays = make_camera_rays(scene, c, 160, 90);
   const Eigen::Vector3f edge = rays.direction(160.0f, 45.0f);
@@ -259,9 +290,7 @@ TEST(Camera, ThinLensRaysMeetOnTheFocalPlane) {
   SceneInput in;
   in.terrain = make_dem(8, 10.0, [](double, double) { return 0.0; });
   const TerrainScene scene(in);
-  Camera c;
-  c.from = scene.origin() + Eigen::Vector3d(0, 0, 10);
-  c.to = scene.origin() + Eigen::Vector3d(0, 100, 10);
+  Camera c = drift::testing::camera_from_to(scene, {0, 0, 10}, {0, 100, 10});
   c.focal_length_mm = 100.0;
   c.f_number = 2.0;  // 50 mm aperture: 25 mm lens radius
   c.focus_distance = 40.0;
@@ -290,15 +319,9 @@ TEST(Renderer, SkyMaskAndSnowCoverageAovs) {
       drift::testing::snow_layer(make_dem(64, 10.0, [](double, double) { return 0.25; })));
   in.sky.model = SkyModel::Simple;
   const TerrainScene scene(in);
-  Camera c;  // level, looking north across the plane: sky above, ground below
-  c.from = scene.origin() + Eigen::Vector3d(0, -300, 20);
-  c.to = scene.origin() + Eigen::Vector3d(0, 300, 20);
-  c.vertical_fov_deg = 40.0;
-  RenderSettings rs;
-  rs.width = 16;
-  rs.height = 16;
-  rs.samples_per_pixel = 2;
-  const Image img = render_image(scene, in, c, rs);
+  // Level, looking north across the plane: sky above, ground below.
+  const Camera c = drift::testing::camera_from_to(scene, {0, -300, 20}, {0, 300, 20});
+  const Image img = render_image(scene, in, c, drift::testing::frame_settings(16, 16, 2));
   const int sky = img.channel_index("mask.sky"), snow = img.channel_index("coverage.snow");
   ASSERT_GE(sky, 0);
   ASSERT_GE(snow, 0);

@@ -61,6 +61,15 @@ HeightField noise_tile(int w, int h) {
   return tile;
 }
 
+// A surface with sine ripples 2 m apart laid as a normal-detail tile.
+TerrainSurface rippled() {
+  TerrainSurface s;
+  NormalDetail ripples;
+  ripples.slopes = SlopePyramid(sine_tile(64, 0.1, 2, 0.05), 0.1);
+  s.normal_details = {ripples};
+  return s;
+}
+
 }  // namespace
 
 TEST(SlopePyramid, EachLevelIsTheAverageOfTheFinerOne) {
@@ -167,10 +176,7 @@ TEST(SlopePyramid, RejectsBadTiles) {
 }
 
 TEST(Ripples, RotationTurnsTheBumpsAndSlipFacesLoseThem) {
-  TerrainSurface s;
-  NormalDetail layer;
-  layer.slopes = SlopePyramid(sine_tile(64, 0.1, 2, 0.05), 0.1);
-  s.normal_details = {layer};
+  TerrainSurface s = rippled();
   const Eigen::Vector3f up(0, 0, 1);
   // Unrotated: crests run north-south, so the normal tilts east-west only.
   const Eigen::Vector3f n0 = shade_terrain(s, 0.05, -0.05, up, 0.0).normal;
@@ -188,10 +194,7 @@ TEST(Ripples, RotationTurnsTheBumpsAndSlipFacesLoseThem) {
 }
 
 TEST(Ripples, SnowBuriesThemAndALayerOfColourDoesNot) {
-  TerrainSurface s;
-  NormalDetail ripples;
-  ripples.slopes = SlopePyramid(sine_tile(64, 0.1, 2, 0.05), 0.1);
-  s.normal_details = {ripples};
+  TerrainSurface s = rippled();
   const Eigen::Vector3f up(0, 0, 1);
   const HeightField everywhere(4, 4, 1.0f, local_georeference(10.0));
   MaterialLayer wet;

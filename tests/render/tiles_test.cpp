@@ -1,6 +1,5 @@
 // Tiles across machines: bands rendered separately and merged are the same
 // bits as one render; a missing or doubled band is an error naming it.
-#include "render/camera_setup.h"
 #include "render/tiles.h"
 
 #include <gtest/gtest.h>
@@ -11,11 +10,13 @@
 #include <filesystem>
 #include <fstream>
 
+#include "render/camera_setup.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
 #include "render/terrain_scene.h"
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
+#include "tests/render/render_fixtures.h"
 
 using namespace drift::render;
 namespace fs = std::filesystem;
@@ -39,6 +40,22 @@ fs::path temp_dir() {
   fs::create_directories(dir);
   return dir;
 }
+
+// The hills rendered whole at `width` x `height`, 4 spp, the one frame the
+// tiles must merge back to, written to and read back from `dir`/whole.exr:
+// through EXR files, as across machines (EXR sorts the channels by name).
+struct WholeFrame {
+  SceneInput in = hills();
+  TerrainScene scene{in};
+  Camera camera = default_camera(scene);
+  RenderSettings rs;
+  fs::path dir = temp_dir();
+  Image whole;
+  WholeFrame(int width, int height) : rs(drift::testing::frame_settings(width, height, 4)) {
+    write_exr(render_image(scene, in, camera, rs), dir / "whole.exr");
+    whole = read_image(dir / "whole.exr");
+  }
+};
 
 }  // namespace
 
@@ -91,16 +108,8 @@ TEST(Tiles, BlocksCoverTheFrameOnce) {
 }
 
 TEST(Tiles, MergedBlocksAreBitIdenticalToOneRender) {
-  const SceneInput in = hills();
-  const TerrainScene scene(in);
-  const Camera camera = default_camera(scene);
-  RenderSettings rs;
-  rs.width = 41;
-  rs.height = 29;
-  rs.samples_per_pixel = 4;
-  const fs::path dir = temp_dir();
-  write_exr(render_image(scene, in, camera, rs), dir / "whole.exr");
-  const Image whole = read_image(dir / "whole.exr");
+  const WholeFrame f(41, 29);
+  const auto& [in, scene, camera, rs, dir, whole] = f;
   std::vector<Image> tiles;
   std::vector<fs::path> names;
   for (int i : {4, 0, 2, 5, 1, 3}) {  // any order
@@ -140,17 +149,8 @@ TEST(Tiles, MergedBlocksAreBitIdenticalToOneRender) {
 }
 
 TEST(Tiles, MergedBandsAreBitIdenticalToOneRender) {
-  const SceneInput in = hills();
-  const TerrainScene scene(in);
-  const Camera camera = default_camera(scene);
-  RenderSettings rs;
-  rs.width = 40;
-  rs.height = 30;
-  rs.samples_per_pixel = 4;
-  const fs::path dir = temp_dir();
-  // Through EXR files, as across machines (EXR sorts the channels by name).
-  write_exr(render_image(scene, in, camera, rs), dir / "whole.exr");
-  const Image whole = read_image(dir / "whole.exr");
+  const WholeFrame f(40, 30);
+  const auto& [in, scene, camera, rs, dir, whole] = f;
   std::vector<Image> tiles;
   std::vector<fs::path> names;
   for (int i : {2, 0, 1}) {  // any order
@@ -235,10 +235,10 @@ TEST(Tiles, GnuParallelBlocksMergeToTheSingleRun) {
                          " > /dev/null 2>&1")
                             .c_str()),
             0);
-  const std::string command = "cd " + dir.string() + " && seq 0 5 | parallel --halt now,fail=1 -j 3 " +
-                              drift + " render s.toml --tile {}/3x2 -o part_{}.exr --threads 1" +
-                              " > /dev/null 2>&1 && " + drift +
-                              " merge part_*.exr -o frame.exr > /dev/null 2>&1";
+  const std::string command =
+      "cd " + dir.string() + " && seq 0 5 | parallel --halt now,fail=1 -j 3 " + drift +
+      " render s.toml --tile {}/3x2 -o part_{}.exr --threads 1" + " > /dev/null 2>&1 && " + drift +
+      " merge part_*.exr -o frame.exr > /dev/null 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   const Image frame = read_image(dir / "frame.exr");
   const Image whole = read_image(dir / "whole.exr");
