@@ -6,6 +6,7 @@
 
 #include "terrain/error.h"
 #include "terrain/soil/deformation.h"
+#include "terrain/soil/drainage.h"
 #include "terrain/soil/soil_parameters.h"
 
 namespace drift::soil {
@@ -78,6 +79,8 @@ void SoilSimulation::step() {
     if (options_.settle && slippage_.any_overfilled())
       settle_overflow(state_, &slippage_.overfilled());
   }
+  // Water drains down and evaporates from the top (issue 33, item 3).
+  drain_moisture(state_, options_.soil, dt);
   ++steps_;
 }
 
