@@ -83,14 +83,20 @@ BodyRun run_and_check(SoilSimulation& sim, int steps, const Eigen::Vector3d& hal
   return r;
 }
 
+// A body of one cuboid of half extents `half` about its position.
+RigidObject cuboid_body(const char* name, const Eigen::Vector3d& half) {
+  RigidObject b;
+  b.name = name;
+  b.primitives = {{PrimitiveKind::Cuboid, {0, 0, 0}, half}};
+  return b;
+}
+
 // A paddle spinning about the vertical through its centre, half sunk in
 // the layer (a mixer's blade): 90 degrees a second for 2 s.
 TEST(SoilBodies, SpinningPaddleNeverHoldsSoil) {
   SoilScenario sc = layer_scenario("paddle");
-  RigidObject paddle;
-  paddle.name = "paddle";
   const Eigen::Vector3d half(0.7, 0.15, 0.3);
-  paddle.primitives = {{PrimitiveKind::Cuboid, {0, 0, 0}, half}};
+  RigidObject paddle = cuboid_body("paddle", half);
   paddle.path = {{0.0, {1.6, 1.6, 0.75}}};
   paddle.spin = {0, 0, 90 * kDeg};
   sc.bodies.push_back(paddle);
@@ -121,10 +127,8 @@ TEST(SoilBodies, KeyframedOrientationInterpolatesAndGivesItsAngularVelocity) {
 // edge, 0 to 70 degrees about y over 1.5 s), then holds.
 TEST(SoilBodies, TiltingBladeNeverHoldsSoil) {
   SoilScenario sc = layer_scenario("tilt");
-  RigidObject blade;
-  blade.name = "blade";
   const Eigen::Vector3d half(0.15, 0.8, 0.35);
-  blade.primitives = {{PrimitiveKind::Cuboid, {0, 0, 0}, half}};
+  RigidObject blade = cuboid_body("blade", half);
   const Eigen::Vector3d at(1.4, 1.6, 0.6);
   blade.path = {
       {0.0, at, Eigen::Quaterniond::Identity()},
