@@ -216,9 +216,11 @@ TEST(SoilBodies, SoilOnATurningPlatformRidesWithIt) {
   disc.path = {{0.0, {2.0, 2.0, 0.35}}};
   disc.spin = {0, 0, 45 * kDeg};
   sc.bodies.push_back(disc);
-  sc.soil.push_back(
-      {"block", {{PrimitiveKind::Cuboid, {2.7, 2.0, 0.65}, {0.15, 0.15, 0.15}}}, {0, 0, 0}, false,
-       {}});
+  sc.soil.push_back({"block",
+                     {{PrimitiveKind::Cuboid, {2.7, 2.0, 0.65}, {0.15, 0.15, 0.15}}},
+                     {0, 0, 0},
+                     false,
+                     {}});
   SoilSimulation sim = make_simulation(sc);
   const double m0 = sim.state().mass();
   ASSERT_GT(m0, 20.0);

@@ -3,10 +3,13 @@
 #include "terrain/soil/drainage.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <vector>
 
 #include "terrain/soil/scenario.h"
 #include "tests/soil/soil_fixtures.h"
@@ -98,6 +101,48 @@ TEST(SoilDrainage, DrainedHeapLosesCohesionAtItsTop) {
   const float h_drained = fixtures::pile_tops(drained.state()).peak * 0.1f;
   std::printf("damp 2 m column after 20 s: water kept %.2f m, drained %.2f m\n", h_kept, h_drained);
   EXPECT_LT(h_drained, h_kept - 0.08f);
+}
+
+// The passes added for issue 33's items 3 and 4 (drainage, evaporation,
+// riding) give the same bits on 1 and 2 threads: damp soil draining on a
+// turning disc, rho and moisture compared bit for bit.
+TEST(SoilDrainage, DrainingSoilOnATurningDiscIsTheSameOnOneAndTwoThreads) {
+  std::vector<float> first_rho, first_wet;
+  for (int threads : {1, 2}) {
+    std::vector<float> rho, wet;
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      SoilScenario sc;
+      sc.name = "damp_disc";
+      sc.shape = {32, 32, 14, 0.1, {0, 0, 0}};
+      sc.options.soil = soil_preset("sandy_loam");
+      sc.options.soil.drainage = 1.0;
+      sc.options.soil.evaporation = 1e-4;
+      RigidObject disc;
+      disc.name = "disc";
+      disc.primitives = {{PrimitiveKind::Cylinder, {0, 0, 0}, {1.2, 0, 0.15}}};
+      disc.path = {{0.0, {1.6, 1.6, 0.35}}};
+      disc.spin = {0, 0, 0.8};
+      sc.bodies.push_back(disc);
+      sc.soil.push_back({"damp",
+                         {{PrimitiveKind::Cuboid, {2.2, 1.6, 0.8}, {0.25, 0.25, 0.3}}},
+                         {0, 0, 0},
+                         false,
+                         0.9});
+      SoilSimulation sim = make_simulation(sc);
+      sim.run(90);
+      rho = sim.state().rho;
+      wet = sim.state().wet;
+    });
+    if (threads == 1) {
+      first_rho = rho;
+      first_wet = wet;
+      continue;
+    }
+    ASSERT_EQ(rho.size(), first_rho.size());
+    EXPECT_EQ(std::memcmp(rho.data(), first_rho.data(), rho.size() * sizeof(float)), 0);
+    EXPECT_EQ(std::memcmp(wet.data(), first_wet.data(), wet.size() * sizeof(float)), 0);
+  }
 }
 
 }  // namespace
