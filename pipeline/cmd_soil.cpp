@@ -121,13 +121,15 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
       c.no_ridge_fix ? soil::RidgeFix::Off : soil::RidgeFix::StraightSlopes, 3, 0.0};
   soil::SoilRunOptions run;
   run.steps = sc.steps;
+  // Mesh frames re-extract only what changed since the last (issue 33).
+  soil::SurfaceExtractor frames(surface);
   if (!c.frames.empty() || !c.vdb_frames.empty()) {
     run.frame_every = c.frame_every;
     run.frame = [&](const soil::SoilSimulation& s, int step) {
       char name[32];
       if (!c.frames.empty()) {
         std::snprintf(name, sizeof name, "frame_%05d.ply", step);
-        terrain::write_mesh(soil::soil_surface(s.state(), surface), fs::path(c.frames) / name);
+        terrain::write_mesh(frames.extract(s.state()), fs::path(c.frames) / name);
       }
       if (!c.vdb_frames.empty()) {  // soil_00010.vdb, ...: a volume sequence
         std::snprintf(name, sizeof name, "soil_%05d.vdb", step);

@@ -99,3 +99,64 @@ detail::Ranges propagate_forces(SoilState& s) {
 }
 
 }  // namespace drift::soil
+
+namespace drift::soil {
+
+void carry_riding_soil(SoilState& s, const std::vector<BodyMotion>& bodies, double dt,
+                       std::vector<std::uint8_t>& touched) {
+  const terrain::Grid3Shape& g = s.shape;
+  struct Parcel {
+    double x, y;  // where its voxel's centre goes, in voxels
+    int z;
+    float amount, wet;
+  };
+  std::vector<Parcel> parcels;
+  for (const BodyMotion& b : bodies) {
+    if (b.velocity.head<2>().isZero() && b.spin.isZero()) continue;
+    parcels.clear();
+    for (int y = std::max(0, b.box.lo.y()); y < std::min(g.ny, b.box.hi.y()); ++y)
+      for (int x = std::max(0, b.box.lo.x()); x < std::min(g.nx, b.box.hi.x()); ++x) {
+        // The body's top voxel in this column: held by a moving body.
+        int top = -1;
+        for (int z = std::min(g.nz, b.box.hi.z()) - 1; z >= std::max(0, b.box.lo.z()); --z) {
+          const std::size_t i = g.index(x, y, z);
+          if (s.psi[i] - s.psi_static[i] >= 0.5f) {
+            top = z;
+            break;
+          }
+        }
+        if (top < 0 || top + 1 >= g.nz) continue;
+        const Eigen::Vector3d contact =
+            g.origin + g.voxel_size * Eigen::Vector3d(x + 0.5, y + 0.5, top + 1.0);
+        const Eigen::Vector3d v = b.velocity + b.spin.cross(contact - b.pivot);
+        const double dx = std::clamp(v.x() * dt / g.voxel_size, -1.0, 1.0),
+                     dy = std::clamp(v.y() * dt / g.voxel_size, -1.0, 1.0);
+        if (dx == 0 && dy == 0) continue;
+        for (int z = top + 1; z < g.nz; ++z) {
+          const std::size_t i = g.index(x, y, z);
+          if (s.rho[i] <= 0 || s.psi[i] >= 0.5f) break;
+          parcels.push_back({x + dx, y + dy, z, s.rho[i], s.wet[i]});
+          s.rho[i] = 0;
+        }
+      }
+    for (const Parcel& p : parcels) {
+      const int x0 = static_cast<int>(std::floor(p.x)), y0 = static_cast<int>(std::floor(p.y));
+      const double fx = p.x - x0, fy = p.y - y0;
+      // Weights of the four columns; a column off the grid gives its share
+      // back to the nearest one on it.
+      for (int k = 0; k < 4; ++k) {
+        const double w = (k & 1 ? fx : 1 - fx) * (k & 2 ? fy : 1 - fy);
+        if (w <= 0) continue;
+        const int x = std::clamp(x0 + (k & 1), 0, g.nx - 1),
+                  y = std::clamp(y0 + (k >> 1), 0, g.ny - 1);
+        const std::size_t i = g.index(x, y, p.z);
+        const float put = static_cast<float>(w * p.amount);
+        s.wet[i] = mix_moisture(s.rho[i], s.wet[i], put, p.wet);
+        s.rho[i] += put;
+        touched[static_cast<std::size_t>(y) * g.nx + x] = 1;
+      }
+    }
+  }
+}
+
+}  // namespace drift::soil

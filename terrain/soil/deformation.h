@@ -36,3 +36,19 @@ void apply_forces(SoilState& state, const std::vector<BodyMotion>& bodies);
 detail::Ranges propagate_forces(SoilState& state);
 
 }  // namespace drift::soil
+
+namespace drift::soil {
+
+// Soil resting on a moving body rides with it (issue 33, item 4): the soil
+// standing on a body's top in a column (the contiguous soil above the top
+// voxel the body holds, not the static ground) moves sideways by the
+// body's surface velocity at the contact, v + omega x (p - pivot), over dt
+// (at most a voxel), spread bilinearly over the four columns it lands
+// between at the same height (mass and water kept). The thesis's model
+// only pushes collided soil, so a turning platform slid out from under its
+// load. Serial, in a fixed order (the same bits on any thread count).
+// Columns that may now overflow are flagged in `touched` (settle them).
+void carry_riding_soil(SoilState& state, const std::vector<BodyMotion>& bodies, double dt,
+                       std::vector<std::uint8_t>& touched);
+
+}  // namespace drift::soil

@@ -260,20 +260,31 @@ VoxelBox voxel_box(const std::vector<Primitive>& prims, const Vector3d& pos,
   return voxel_box_of(lo, hi, shape);
 }
 
-void for_each_covered_voxel(const std::vector<Primitive>& prims, const Vector3d& pos,
-                            const terrain::Grid3Shape& shape,
-                            const std::function<void(std::size_t, float)>& fill) {
-  const VoxelBox box = voxel_box(prims, pos, shape);
-  if (box.empty()) return;
+namespace {
+// Hands fill(index, share) every voxel of `box` that `share_of(lo, hi)` (its
+// corners in metres) covers, rows of y in parallel (each voxel from one task).
+template <class ShareOf>
+void fill_box(const VoxelBox& box, const terrain::Grid3Shape& shape,
+              const std::function<void(std::size_t, float)>& fill, const ShareOf& share_of) {
   const double h = shape.voxel_size;
   tbb::parallel_for(box.lo.y(), box.hi.y(), [&](int y) {
     for (int x = box.lo.x(); x < box.hi.x(); ++x)
       for (int z = box.lo.z(); z < box.hi.z(); ++z) {
         const Vector3d lo = shape.origin + h * Vector3d(x, y, z);
-        const double c = coverage(prims, pos, lo, lo + Vector3d::Constant(h));
+        const double c = share_of(lo, lo + Vector3d::Constant(h));
         if (c > 0.0) fill(shape.index(x, y, z), static_cast<float>(c));
       }
   });
+}
+}  // namespace
+
+void for_each_covered_voxel(const std::vector<Primitive>& prims, const Vector3d& pos,
+                            const terrain::Grid3Shape& shape,
+                            const std::function<void(std::size_t, float)>& fill) {
+  const VoxelBox box = voxel_box(prims, pos, shape);
+  if (box.empty()) return;
+  fill_box(box, shape, fill,
+           [&](const Vector3d& lo, const Vector3d& hi) { return coverage(prims, pos, lo, hi); });
 }
 
 void add_coverage(const std::vector<Primitive>& prims, const Vector3d& pos,
@@ -344,15 +355,8 @@ void for_each_covered_voxel(const PlacedSolid& solid, const terrain::Grid3Shape&
     return for_each_covered_voxel(*solid.primitives, solid.pose.position, shape, fill);
   const VoxelBox box = voxel_box(solid, shape);
   if (box.empty()) return;
-  const double h = shape.voxel_size;
-  tbb::parallel_for(box.lo.y(), box.hi.y(), [&](int y) {
-    for (int x = box.lo.x(); x < box.hi.x(); ++x)
-      for (int z = box.lo.z(); z < box.hi.z(); ++z) {
-        const Vector3d lo = shape.origin + h * Vector3d(x, y, z);
-        const double c = coverage(solid, lo, lo + Vector3d::Constant(h));
-        if (c > 0.0) fill(shape.index(x, y, z), static_cast<float>(c));
-      }
-  });
+  fill_box(box, shape, fill,
+           [&](const Vector3d& lo, const Vector3d& hi) { return coverage(solid, lo, hi); });
 }
 
 void add_coverage(const PlacedSolid& solid, const terrain::Grid3Shape& shape,

@@ -6,6 +6,7 @@
 
 #include "terrain/error.h"
 #include "terrain/soil/deformation.h"
+#include "terrain/soil/drainage.h"
 #include "terrain/soil/soil_parameters.h"
 
 namespace drift::soil {
@@ -78,6 +79,13 @@ void SoilSimulation::step() {
     if (options_.settle && slippage_.any_overfilled())
       settle_overflow(state_, &slippage_.overfilled());
   }
+  // Soil resting on a moving body rides with it (issue 33, item 4).
+  ColumnMask riding(state_.shape.columns(), 0);
+  carry_riding_soil(state_, motion, dt, riding);
+  if (options_.settle && std::find(riding.begin(), riding.end(), 1) != riding.end())
+    settle_overflow(state_, &riding);
+  // Water drains down and evaporates from the top (issue 33, item 3).
+  drain_moisture(state_, options_.soil, dt);
   ++steps_;
 }
 

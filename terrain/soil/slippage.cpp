@@ -171,8 +171,14 @@ void Slippage::pile_moisture(const SoilState& state) {
     const HeightSpan& p = spans_.column(col)[pile_span_[node]];
     const float* rho = state.rho.data() + col * nz;
     const float* wet = state.wet.data() + col * nz;
+    // The moisture of the pile's upper third (at least its top voxel): the
+    // sliding wedge lies above the failure plane, which through a flank's
+    // columns passes under their upper part, so water that drained to the
+    // pile's foot no longer holds its top (issue 33, item 3).
     double soil = 0, water = 0;
-    for (int z = std::max(0, static_cast<int>(p.bottom)); z <= p.top_voxel; ++z) {
+    const int bottom = std::max(0, static_cast<int>(p.bottom));
+    const int upper = std::max(bottom, p.top_voxel - (p.top_voxel - bottom + 1) / 3);
+    for (int z = upper; z <= p.top_voxel; ++z) {
       soil += rho[z];
       water += static_cast<double>(rho[z]) * wet[z];
     }

@@ -135,7 +135,7 @@ class Slippage {
   std::vector<std::int8_t> pile_span_;              // per node: span index, -1 none
   std::vector<int> down_, up_, toe_, crest_, hop_;  // per node
   std::vector<float> rest_;                         // per node: rest angle, rad
-  std::vector<float> pile_wet_;                     // per node: moisture of the pile
+  std::vector<float> pile_wet_;                     // per node: moisture of the pile's upper third
   std::vector<float> out_wet_;                      // per node: moisture of what it gave
   std::vector<int> out_from_;                       // per node: lowest voxel it gave from
   std::vector<std::uint8_t> overfilled_;            // per column

@@ -20,6 +20,12 @@ const std::vector<SoilParameter>& soil_parameters() {
        "moisture (0 dry .. 1 damp) the soil starts with where a soil body gives none: "
        "adds cohesion, wets the surface",
        DRIFT_PARAMETER_FIELD(SoilOptions, soil.moisture), "[soil] moisture"},
+      {"soil.drainage", "--drainage", 0, 1, Ends::Closed, false, "m/s",
+       "saturated hydraulic conductivity K_s: water drains down the soil at K_s S^(2b+3)",
+       DRIFT_PARAMETER_FIELD(SoilOptions, soil.drainage), "[soil] drainage"},
+      {"soil.evaporation", "--evaporation", 0, 1e-3, Ends::Closed, false, "m/s",
+       "evaporation of water from the soil's exposed top",
+       DRIFT_PARAMETER_FIELD(SoilOptions, soil.evaporation), "[soil] evaporation"},
       // The time stepping (section 4.2 of the thesis).
       {"dt", "", 0, 1, Ends::OpenLow, false, "s", "time step (soil moves at most a voxel a step)",
        DRIFT_PARAMETER_FIELD(SoilOptions, dt), "[simulation] dt"},

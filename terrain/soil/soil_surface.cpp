@@ -68,82 +68,95 @@ bool beside_floor_soil(const std::vector<float>& top, const terrain::Grid3Shape&
   return false;
 }
 
-}  // namespace
-
-std::vector<float> surface_density(const SoilState& s, const SurfaceOptions& o) {
-  std::vector<float> out = s.rho;
-  if (o.ridges == RidgeFix::Off) return out;
+// Column (x, y) of surface_density into `out` (nz values), given every
+// column's floor_pile_top: reads the column itself and its neighbours' tops.
+void density_column(const SoilState& s, const std::vector<float>& top, int ramp, int x, int y,
+                    float* out) {
   const terrain::Grid3Shape& g = s.shape;
-  const int ramp = std::clamp(o.ramp_voxels, 1, 16);
-  const std::vector<float> top = floor_pile_tops(s);
-  tbb::parallel_for(0, g.ny, [&](int y) {
-    HeightSpan spans[HeightSpans::kMaxSpans];
-    for (int x = 0; x < g.nx; ++x) {
-      const std::size_t c = g.column(x, y);
-      const int n = build_column_spans(s.rho.data() + c, s.psi.data() + c, g.nz, spans,
-                                       HeightSpans::kMaxSpans);
-      const bool foot =
-          top[static_cast<std::size_t>(y) * g.nx + x] == 0.0f && beside_floor_soil(top, g, x, y);
-      straighten_column(spans, n, g.nz, ramp, foot, s.rho.data() + c, out.data() + c);
-    }
-  });
-  return out;
+  const std::size_t c = g.column(x, y);
+  std::copy(s.rho.begin() + c, s.rho.begin() + c + g.nz, out);
+  HeightSpan spans[HeightSpans::kMaxSpans];
+  const int n =
+      build_column_spans(s.rho.data() + c, s.psi.data() + c, g.nz, spans, HeightSpans::kMaxSpans);
+  const bool foot =
+      top[static_cast<std::size_t>(y) * g.nx + x] == 0.0f && beside_floor_soil(top, g, x, y);
+  straighten_column(spans, n, g.nz, ramp, foot, s.rho.data() + c, out);
 }
-
-namespace {
 
 // The pad row under the floor: the ramp of surface.h carried on half a voxel
 // below the floor, for columns holding soil on the floor and for the bare
 // columns beside them (as if their top lay a quarter voxel under the floor,
 // so the soil's surface runs on down into the ground instead of ending in a
 // rim); 0 elsewhere.
-std::vector<float> floor_pads(const SoilState& s, int ramp) {
-  const terrain::Grid3Shape& g = s.shape;
-  const std::vector<float> top = floor_pile_tops(s);
+float floor_pad(const std::vector<float>& top, const terrain::Grid3Shape& g, int ramp, int x,
+                int y) {
   auto ramp_at = [ramp](float t) {
     return std::clamp(0.5f + (t + 0.5f) / (2.0f * ramp), 0.f, 1.f);
   };
-  std::vector<float> pad(g.columns(), 0.0f);
-  tbb::parallel_for(0, g.ny, [&](int y) {
-    for (int x = 0; x < g.nx; ++x) {
-      const float t = top[static_cast<std::size_t>(y) * g.nx + x];
-      float& out = pad[static_cast<std::size_t>(y) * g.nx + x];
-      if (t > 0) out = ramp_at(t);
-      if (t == 0 && beside_floor_soil(top, g, x, y)) out = ramp_at(-0.25f);
-    }
-  });
-  return pad;
+  const float t = top[static_cast<std::size_t>(y) * g.nx + x];
+  if (t > 0) return ramp_at(t);
+  if (t == 0 && beside_floor_soil(top, g, x, y)) return ramp_at(-0.25f);
+  return 0.0f;
 }
 
-// The straightened density over a grid one voxel deeper, the pad row under
-// the floor, so a pile's foot thinner than half a voxel (whose first voxel
-// centre lies above its top) still has its 0.5 crossing at its top instead of
-// ending in a half-voxel step at the floor.
-terrain::Mesh floor_padded_surface(const SoilState& s, const std::vector<float>& field, int ramp) {
+// The grid the surface is extracted from: with the ridge fix, one voxel
+// deeper (the pad row under the floor), so a pile's foot thinner than half a
+// voxel (whose first voxel centre lies above its top) still has its 0.5
+// crossing at its top instead of ending in a half-voxel step at the floor.
+terrain::Grid3Shape field_shape(const terrain::Grid3Shape& g, bool padded) {
+  terrain::Grid3Shape f = g;
+  if (padded) {
+    f.nz = g.nz + 1;
+    f.origin.z() -= g.voxel_size;
+  }
+  return f;
+}
+
+// Column (x, y) of the surface's field (field_shape's column, nz or nz + 1
+// values).
+void field_column(const SoilState& s, const std::vector<float>& top, const SurfaceOptions& o, int x,
+                  int y, float* out) {
   const terrain::Grid3Shape& g = s.shape;
-  terrain::Grid3Shape padded = g;
-  padded.nz = g.nz + 1;
-  padded.origin.z() -= g.voxel_size;
-  const std::vector<float> pad = floor_pads(s, ramp);
-  std::vector<float> out(padded.count());
-  tbb::parallel_for(0, g.ny, [&](int y) {
-    for (int x = 0; x < g.nx; ++x) {
-      const std::size_t c = g.column(x, y), pc = padded.column(x, y);
-      out[pc] = pad[static_cast<std::size_t>(y) * g.nx + x];
-      std::copy(field.begin() + c, field.begin() + c + g.nz, out.begin() + pc + 1);
-    }
-  });
-  terrain::Mesh mesh = iso_surface(padded, out);
-  // What lies under the floor is hidden by the ground: flatten it just under
-  // the floor (a hundredth of a voxel, so the ground, not a sheet of soil
-  // level with it, is what a ray sees there). The surface stays closed and
-  // encloses the soil's volume.
-  const float floor = static_cast<float>(g.origin.z() - 0.01 * g.voxel_size);
-  for (auto& p : mesh.positions) p.z() = std::max(p.z(), floor);
+  if (o.ridges == RidgeFix::Off) {
+    std::copy_n(s.rho.begin() + g.column(x, y), g.nz, out);
+    return;
+  }
+  const int ramp = std::clamp(o.ramp_voxels, 1, 16);
+  out[0] = floor_pad(top, g, ramp, x, y);
+  density_column(s, top, ramp, x, y, out + 1);
+}
+
+// The mesh of `mesher`, with what lies under the floor flattened and the
+// per-vertex wetness.
+terrain::Mesh finish_mesh(const SoilState& s, const SurfaceOptions& o, terrain::Mesh mesh) {
+  if (o.ridges != RidgeFix::Off) {
+    // What lies under the floor is hidden by the ground: flatten it just
+    // under the floor (a hundredth of a voxel, so the ground, not a sheet of
+    // soil level with it, is what a ray sees there). The surface stays
+    // closed and encloses the soil's volume.
+    const float floor = static_cast<float>(s.shape.origin.z() - 0.01 * s.shape.voxel_size);
+    for (auto& p : mesh.positions) p.z() = std::max(p.z(), floor);
+  }
+  std::vector<float> wetness(mesh.positions.size());
+  tbb::parallel_for(std::size_t{0}, wetness.size(),
+                    [&](std::size_t v) { wetness[v] = moisture_at(s, mesh.positions[v]); });
+  mesh.vertex_attributes.push_back({terrain::products::kWetness, std::move(wetness)});
   return mesh;
 }
 
 }  // namespace
+
+std::vector<float> surface_density(const SoilState& s, const SurfaceOptions& o) {
+  if (o.ridges == RidgeFix::Off) return s.rho;
+  const terrain::Grid3Shape& g = s.shape;
+  std::vector<float> out(g.count());
+  const int ramp = std::clamp(o.ramp_voxels, 1, 16);
+  const std::vector<float> top = floor_pile_tops(s);
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) density_column(s, top, ramp, x, y, out.data() + g.column(x, y));
+  });
+  return out;
+}
 
 float moisture_at(const SoilState& s, const Eigen::Vector3f& p) {
   const terrain::Grid3Shape& g = s.shape;
@@ -177,15 +190,119 @@ float moisture_at(const SoilState& s, const Eigen::Vector3f& p) {
 }
 
 terrain::Mesh soil_surface(const SoilState& s, const SurfaceOptions& o) {
-  terrain::Mesh mesh =
-      o.ridges == RidgeFix::Off
-          ? iso_surface(s.shape, surface_density(s, o))
-          : floor_padded_surface(s, surface_density(s, o), std::clamp(o.ramp_voxels, 1, 16));
-  std::vector<float> wetness(mesh.positions.size());
-  tbb::parallel_for(std::size_t{0}, wetness.size(),
-                    [&](std::size_t v) { wetness[v] = moisture_at(s, mesh.positions[v]); });
-  mesh.vertex_attributes.push_back({terrain::products::kWetness, std::move(wetness)});
-  return mesh;
+  const terrain::Grid3Shape f = field_shape(s.shape, o.ridges != RidgeFix::Off);
+  const std::vector<float> top =
+      o.ridges == RidgeFix::Off ? std::vector<float>{} : floor_pile_tops(s);
+  std::vector<float> field(f.count());
+  tbb::parallel_for(0, f.ny, [&](int y) {
+    for (int x = 0; x < f.nx; ++x) field_column(s, top, o, x, y, field.data() + f.column(x, y));
+  });
+  return finish_mesh(s, o, iso_surface(f, field));
+}
+
+struct SurfaceExtractor::Impl {
+  SurfaceOptions options;
+  bool primed = false;
+  terrain::Grid3Shape shape;          // the state's
+  std::vector<float> rho, psi;        // as the last extract() saw them
+  std::vector<float> top;             // floor_pile_tops of rho, psi
+  std::vector<float> field;           // the surface's field (field_shape)
+  std::vector<unsigned char> column;  // per column: 1 = rho or psi changed, 2 = recompute
+  IsoMesher mesher;
+  Work work;
+};
+
+SurfaceExtractor::SurfaceExtractor(const SurfaceOptions& o) : impl_(std::make_unique<Impl>()) {
+  impl_->options = o;
+}
+SurfaceExtractor::~SurfaceExtractor() = default;
+SurfaceExtractor::SurfaceExtractor(SurfaceExtractor&&) noexcept = default;
+SurfaceExtractor& SurfaceExtractor::operator=(SurfaceExtractor&&) noexcept = default;
+SurfaceExtractor::Work SurfaceExtractor::last_work() const { return impl_->work; }
+
+terrain::Mesh SurfaceExtractor::extract(const SoilState& s) {
+  Impl& m = *impl_;
+  const SurfaceOptions& o = m.options;
+  const terrain::Grid3Shape& g = s.shape;
+  const bool ridges = o.ridges != RidgeFix::Off;
+  const terrain::Grid3Shape f = field_shape(g, ridges);
+  const bool same = m.primed && g.nx == m.shape.nx && g.ny == m.shape.ny && g.nz == m.shape.nz &&
+                    g.voxel_size == m.shape.voxel_size && g.origin == m.shape.origin;
+  if (!same) {
+    // First frame: everything.
+    m.primed = true;
+    m.shape = g;
+    m.rho = s.rho;
+    m.psi = s.psi;
+    if (ridges) m.top = floor_pile_tops(s);
+    m.field.assign(f.count(), 0.0f);
+    tbb::parallel_for(0, f.ny, [&](int y) {
+      for (int x = 0; x < f.nx; ++x)
+        field_column(s, m.top, o, x, y, m.field.data() + f.column(x, y));
+    });
+    m.work = {g.columns(), m.mesher.update(f, m.field, nullptr)};
+    return finish_mesh(s, o, m.mesher.mesh());
+  }
+  // Columns whose rho or psi changed: their own floor-pile top again.
+  const std::size_t nz = static_cast<std::size_t>(g.nz);
+  m.column.assign(g.columns(), 0);
+  tbb::parallel_for(0, g.ny, [&](int y) {
+    for (int x = 0; x < g.nx; ++x) {
+      const std::size_t c = g.column(x, y), k = static_cast<std::size_t>(y) * g.nx + x;
+      if (std::equal(s.rho.begin() + c, s.rho.begin() + c + nz, m.rho.begin() + c) &&
+          std::equal(s.psi.begin() + c, s.psi.begin() + c + nz, m.psi.begin() + c))
+        continue;
+      std::copy_n(s.rho.begin() + c, nz, m.rho.begin() + c);
+      std::copy_n(s.psi.begin() + c, nz, m.psi.begin() + c);
+      if (ridges) m.top[k] = floor_pile_top(s.rho.data() + c, s.psi.data() + c, g.nz);
+      m.column[k] = 1;
+    }
+  });
+  // A column's field reads its neighbours' tops (a pile's foot, the floor
+  // pad): recompute the changed columns and those beside them.
+  const int reach = ridges ? 1 : 0;
+  std::vector<int> recompute;
+  for (int y = 0; y < g.ny; ++y)
+    for (int x = 0; x < g.nx; ++x) {
+      bool near = false;
+      for (int v = std::max(0, y - reach); v <= std::min(g.ny - 1, y + reach) && !near; ++v)
+        for (int u = std::max(0, x - reach); u <= std::min(g.nx - 1, x + reach) && !near; ++u)
+          near = m.column[static_cast<std::size_t>(v) * g.nx + u] == 1;
+      if (near) recompute.push_back(y * g.nx + x);
+    }
+  // Each recomputed column's field; the z range (lo, hi) that changed.
+  std::vector<std::pair<int, int>> changed(recompute.size(), {f.nz, -1});
+  tbb::parallel_for(std::size_t{0}, recompute.size(), [&](std::size_t i) {
+    const int x = recompute[i] % g.nx, y = recompute[i] / g.nx;
+    float column[4097];
+    field_column(s, m.top, o, x, y, column);
+    float* kept = m.field.data() + f.column(x, y);
+    for (int z = 0; z < f.nz; ++z)
+      if (column[z] != kept[z] || std::signbit(column[z]) != std::signbit(kept[z])) {
+        changed[i].first = std::min(changed[i].first, z);
+        changed[i].second = z;
+        kept[z] = column[z];
+      }
+  });
+  // A leaf reads its block and one voxel around it: flag every leaf within
+  // one voxel of a changed value, so each kept leaf's values and active
+  // voxels are what a fresh build gives (the mesh alone would not show a
+  // stale active flag next to a leaf border: volumeToMesh finds an edge from
+  // either end, and the leaf across is rebuilt).
+  constexpr int L = IsoMesher::kLeaf;
+  const int bx = (f.nx + L - 1) / L, by = (f.ny + L - 1) / L, bz = (f.nz + L - 1) / L;
+  std::vector<unsigned char> dirty(static_cast<std::size_t>(bx) * by * bz, 0);
+  for (std::size_t i = 0; i < recompute.size(); ++i) {
+    if (changed[i].second < 0) continue;
+    const int x = recompute[i] % g.nx, y = recompute[i] / g.nx;
+    const int z0 = std::max(0, changed[i].first - 1) / L,
+              z1 = std::min(f.nz - 1, changed[i].second + 1) / L;
+    for (int v = std::max(0, y - 1) / L; v <= std::min(f.ny - 1, y + 1) / L; ++v)
+      for (int u = std::max(0, x - 1) / L; u <= std::min(f.nx - 1, x + 1) / L; ++u)
+        for (int w = z0; w <= z1; ++w) dirty[(static_cast<std::size_t>(w) * by + v) * bx + u] = 1;
+  }
+  m.work = {recompute.size(), m.mesher.update(f, m.field, &dirty)};
+  return finish_mesh(s, o, m.mesher.mesh());
 }
 
 }  // namespace drift::soil

@@ -18,7 +18,9 @@
 // without soil has no soil surface.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "terrain/mesh.h"
@@ -55,9 +57,58 @@ enum class IsoGrid { Band, Full };
 terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<float>& field,
                           IsoGrid kind = IsoGrid::Band);
 
+// The band grid of iso_surface kept leaf by leaf (8^3 voxel blocks) between
+// frames, so a frame rebuilds only the leaves whose field changed (issue 33,
+// item 1). A leaf reads its block's field and one voxel around it.
+class IsoMesher {
+ public:
+  static constexpr int kLeaf = 8;
+  IsoMesher();
+  ~IsoMesher();
+  IsoMesher(IsoMesher&&) noexcept;
+  IsoMesher& operator=(IsoMesher&&) noexcept;
+  // Rebuilds the leaves flagged in `dirty` (one flag per leaf, x fastest,
+  // then y, then z; every leaf if null or if the shape changed) from
+  // `field`; returns how many were rebuilt.
+  std::size_t update(const terrain::Grid3Shape& shape, const std::vector<float>& field,
+                     const std::vector<unsigned char>* dirty);
+  // The iso-0.5 surface of the kept leaves: iso_surface(shape, field) of the
+  // field they were built from, bit for bit.
+  terrain::Mesh mesh() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // The soil's surface, with a per-vertex "wetness" (for the renderer's wet
 // coat): the moisture field at the vertex (moisture_at).
 terrain::Mesh soil_surface(const SoilState& state, const SurfaceOptions& options);
+
+// soil_surface frame after frame, re-extracting only what changed (issue 33,
+// item 1): the columns whose rho or psi changed since the last call (and
+// their neighbours, whose pile feet and floor pads read them) get their
+// surface density again, and only the grid leaves whose density changed
+// are rebuilt; OpenVDB's volumeToMesh then runs over the kept leaves. Each
+// extract() returns soil_surface(state, options) bit for bit
+// (SoilSurface.IncrementalExtractionEqualsTheFullOneOverARun).
+class SurfaceExtractor {
+ public:
+  explicit SurfaceExtractor(const SurfaceOptions& options = {});
+  ~SurfaceExtractor();
+  SurfaceExtractor(SurfaceExtractor&&) noexcept;
+  SurfaceExtractor& operator=(SurfaceExtractor&&) noexcept;
+  terrain::Mesh extract(const SoilState& state);
+  // What the last extract() recomputed.
+  struct Work {
+    std::size_t columns = 0, leaves = 0;
+  };
+  Work last_work() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // The moisture of the soil at p (metres): the field's trilinear mean over the
 // voxels around p weighted by the soil they hold (a surface vertex lies

@@ -33,6 +33,13 @@ struct SoilType {
   double cohesion = 0.0;  // c, t/m
   double gamma = 1.95;    // specific weight, t/m^2
   double moisture = 0.0;  // initial moisture, 0 dry .. 1 wet
+  // Water in the soil (issue 33, item 3; terrain/soil/drainage.h): the
+  // saturated hydraulic conductivity K_s (m/s) that drains it down the
+  // column, and the evaporation rate (m/s of water) at the exposed surface.
+  double drainage = 5.83e-5;    // K_s, m/s (Rawls et al. 1982, sand)
+  double evaporation = 5.8e-8;  // m/s = 5 mm a day (FAO-56 reference ET0, Allen et al. 1998)
+  double campbell_b = 4.05;     // K = K_s S^(2b + 3) (Campbell 1974; b of Clapp & Hornberger 1978)
+  double porosity = 0.395;      // saturated water content (Clapp & Hornberger 1978)
 
   // Apparent cohesion of moist sand, t/m at moisture 1 (about 3 kPa: the
   // order of the apparent cohesion suction gives damp sands, a few kPa; Lu &

@@ -41,46 +41,41 @@ openvdb::FloatGrid::Ptr to_grid(const terrain::Grid3Shape& g, const std::vector<
   return grid;
 }
 
-// The surface's grid: the values of to_grid(field, -1), built leaf by leaf
-// in parallel, with only the voxels that have a face neighbour across the
-// iso-value (density 0.5) active. volumeToMesh takes every grid edge whose
-// ends lie on both sides of the iso-value and one of which is active
-// (evalInternalVoxelEdges, tools/VolumeToMesh.h); both ends of such an edge
-// have a neighbour across, so the edges, and with the same values the mesh,
-// are those of the fully active grid, while the soil's interior is skipped
-// (issue 33, item 8; SoilSurface.BandGridGivesTheFullGridsMesh).
-openvdb::FloatGrid::Ptr surface_grid(const terrain::Grid3Shape& g,
-                                     const std::vector<float>& field) {
-  using Leaf = openvdb::FloatTree::LeafNodeType;
-  constexpr int D = Leaf::DIM;
-  const int bx = (g.nx + D - 1) / D, by = (g.ny + D - 1) / D, bz = (g.nz + D - 1) / D;
+using Leaf = openvdb::FloatTree::LeafNodeType;
+
+// One leaf of the surface's grid: the values of to_grid(field, -1) in the
+// leaf's 8^3 block, with only the voxels that have a face neighbour across
+// the iso-value (density 0.5) active; null if the block holds no density.
+// volumeToMesh takes every grid edge whose ends lie on both sides of the
+// iso-value and one of which is active (evalInternalVoxelEdges,
+// tools/VolumeToMesh.h); both ends of such an edge have a neighbour across,
+// so the edges, and with the same values the mesh, are those of the fully
+// active grid, while the soil's interior is skipped (issue 33, item 8;
+// SoilSurface.BandGridGivesTheFullGridsMesh). A leaf reads the field in its
+// block and one voxel around it, no further: what IsoMesher's incremental
+// update relies on.
+std::unique_ptr<Leaf> band_leaf(const terrain::Grid3Shape& g, const std::vector<float>& field,
+                                int X, int Y, int Z) {
   auto inside = [&](int x, int y, int z) {
     return x >= 0 && y >= 0 && z >= 0 && x < g.nx && y < g.ny && z < g.nz &&
            field[g.index(x, y, z)] > 0.5f;
   };
-  std::vector<std::unique_ptr<Leaf>> leaves(static_cast<std::size_t>(bx) * by * bz);
-  tbb::parallel_for(0, static_cast<int>(leaves.size()), [&](int b) {
-    const int X = D * (b % bx), Y = D * (b / bx % by), Z = D * (b / (bx * by));
-    std::unique_ptr<Leaf> leaf;
-    for (int x = X; x < std::min(g.nx, X + D); ++x)
-      for (int y = Y; y < std::min(g.ny, Y + D); ++y)
-        for (int z = Z; z < std::min(g.nz, Z + D); ++z) {
-          const float v = field[g.index(x, y, z)];
-          if (v == 0.0f) continue;
-          if (!leaf) leaf = std::make_unique<Leaf>(openvdb::Coord(X, Y, Z), 0.0f, false);
-          const openvdb::Coord c(x, y, z);
-          leaf->setValueOnly(c, -v);
-          const bool in = v > 0.5f;
-          if (inside(x - 1, y, z) != in || inside(x + 1, y, z) != in || inside(x, y - 1, z) != in ||
-              inside(x, y + 1, z) != in || inside(x, y, z - 1) != in || inside(x, y, z + 1) != in)
-            leaf->setValueOn(c);
-        }
-    leaves[b] = std::move(leaf);
-  });
-  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
-  for (auto& leaf : leaves)
-    if (leaf) grid->tree().addLeaf(leaf.release());
-  return grid;
+  constexpr int D = Leaf::DIM;
+  std::unique_ptr<Leaf> leaf;
+  for (int x = X; x < std::min(g.nx, X + D); ++x)
+    for (int y = Y; y < std::min(g.ny, Y + D); ++y)
+      for (int z = Z; z < std::min(g.nz, Z + D); ++z) {
+        const float v = field[g.index(x, y, z)];
+        if (v == 0.0f) continue;
+        if (!leaf) leaf = std::make_unique<Leaf>(openvdb::Coord(X, Y, Z), 0.0f, false);
+        const openvdb::Coord c(x, y, z);
+        leaf->setValueOnly(c, -v);
+        const bool in = v > 0.5f;
+        if (inside(x - 1, y, z) != in || inside(x + 1, y, z) != in || inside(x, y - 1, z) != in ||
+            inside(x, y + 1, z) != in || inside(x, y, z - 1) != in || inside(x, y, z + 1) != in)
+          leaf->setValueOn(c);
+      }
+  return leaf;
 }
 
 // OpenVDB's header (io/Archive.cc, writeHeader): magic (8 bytes), file
@@ -125,19 +120,14 @@ class MemoryArchive : public openvdb::io::Archive {
   }
 };
 
-}  // namespace
-
-terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>& field,
-                          IsoGrid kind) {
-  init_openvdb();
-  // Negated so that "inside" is below the iso-value, as for a level set:
-  // volumeToMesh then orients faces outwards; the background (0) is outside.
-  const openvdb::FloatGrid::Ptr grid =
-      kind == IsoGrid::Band ? surface_grid(g, field) : to_grid(g, field, -1.0f);
+// The mesh of `grid` (a negated field: "inside" is below the iso-value, as
+// for a level set, so volumeToMesh orients faces outwards; the background (0)
+// is outside) in metres.
+terrain::Mesh grid_mesh(const terrain::Grid3Shape& g, const openvdb::FloatGrid& grid) {
   std::vector<openvdb::Vec3s> points;
   std::vector<openvdb::Vec3I> triangles;
   std::vector<openvdb::Vec4I> quads;
-  openvdb::tools::volumeToMesh(*grid, points, triangles, quads, -0.5, 0.0);
+  openvdb::tools::volumeToMesh(grid, points, triangles, quads, -0.5, 0.0);
   terrain::Mesh mesh;
   mesh.positions.reserve(points.size());
   const double h = g.voxel_size;
@@ -157,6 +147,67 @@ terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>
         {static_cast<int>(q[0]), static_cast<int>(q[2]), static_cast<int>(q[3])});
   }
   return mesh;
+}
+
+}  // namespace
+
+struct IsoMesher::Impl {
+  terrain::Grid3Shape shape;
+  int bx = 0, by = 0, bz = 0;                 // leaves a side
+  std::vector<std::unique_ptr<Leaf>> leaves;  // x fastest, then y, then z
+};
+
+IsoMesher::IsoMesher() : impl_(std::make_unique<Impl>()) {}
+IsoMesher::~IsoMesher() = default;
+IsoMesher::IsoMesher(IsoMesher&&) noexcept = default;
+IsoMesher& IsoMesher::operator=(IsoMesher&&) noexcept = default;
+
+std::size_t IsoMesher::update(const terrain::Grid3Shape& g, const std::vector<float>& field,
+                              const std::vector<unsigned char>* dirty) {
+  Impl& m = *impl_;
+  const bool same = g.nx == m.shape.nx && g.ny == m.shape.ny && g.nz == m.shape.nz &&
+                    g.voxel_size == m.shape.voxel_size && g.origin == m.shape.origin;
+  if (!same) {
+    m.shape = g;
+    m.bx = (g.nx + kLeaf - 1) / kLeaf;
+    m.by = (g.ny + kLeaf - 1) / kLeaf;
+    m.bz = (g.nz + kLeaf - 1) / kLeaf;
+    m.leaves.clear();
+    m.leaves.resize(static_cast<std::size_t>(m.bx) * m.by * m.bz);
+    dirty = nullptr;
+  }
+  std::vector<int> todo;
+  for (std::size_t b = 0; b < m.leaves.size(); ++b)
+    if (!dirty || (*dirty)[b]) todo.push_back(static_cast<int>(b));
+  tbb::parallel_for(std::size_t{0}, todo.size(), [&](std::size_t k) {
+    const int b = todo[k];
+    m.leaves[b] = band_leaf(g, field, kLeaf * (b % m.bx), kLeaf * (b / m.bx % m.by),
+                            kLeaf * (b / (m.bx * m.by)));
+  });
+  return todo.size();
+}
+
+terrain::Mesh IsoMesher::mesh() const {
+  init_openvdb();
+  const Impl& m = *impl_;
+  const terrain::Grid3Shape& g = m.shape;
+  // A fresh tree of copies of the kept leaves: the same tree, and so the
+  // same mesh, as one built from the whole field.
+  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+  for (const auto& leaf : m.leaves)
+    if (leaf) grid->tree().addLeaf(new Leaf(*leaf));
+  return grid_mesh(g, *grid);
+}
+
+terrain::Mesh iso_surface(const terrain::Grid3Shape& g, const std::vector<float>& field,
+                          IsoGrid kind) {
+  if (kind == IsoGrid::Band) {
+    IsoMesher mesher;
+    mesher.update(g, field, nullptr);
+    return mesher.mesh();
+  }
+  init_openvdb();
+  return grid_mesh(g, *to_grid(g, field, -1.0f));
 }
 
 void write_density_vdb(const SoilState& s, const std::filesystem::path& path) {

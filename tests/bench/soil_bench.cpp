@@ -5,6 +5,7 @@
 // (fig. 57). The thesis: t = 2.4e-5 ms x voxels + 4.3 ms per frame on an
 // R9 270 GPU; t = 1.17 alpha + 8.95 ms at 72^3.
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include "terrain/soil/soil_surface.h"
 #include "tests/bench/peak_memory.h"
@@ -53,18 +54,49 @@ SoilSimulation pushing(int n) {
 }
 
 // Step plus surface extraction (the thesis's frame: simulate and mesh), at
-// 64^3: the thesis's 60 frames a second is 16.7 ms.
+// 64^3: the thesis's 60 frames a second is 16.7 ms. Args: n, threads,
+// incremental (SurfaceExtractor, issue 33 item 1) or a full soil_surface a
+// frame. Process CPU time (all threads) and wall time.
 void BM_SoilStepAndSurface(benchmark::State& state) {
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(state.range(1)));
   SoilSimulation sim = pushing(static_cast<int>(state.range(0)));
+  const bool incremental = state.range(2) != 0;
+  SurfaceExtractor extractor;
+  if (incremental) extractor.extract(sim.state());
   std::size_t triangles = 0;
   for (auto _ : state) {
     sim.step();
-    triangles = soil_surface(sim.state(), {}).triangle_count();
+    triangles = (incremental ? extractor.extract(sim.state()) : soil_surface(sim.state(), {}))
+                    .triangle_count();
   }
   state.counters["frames/s"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
   state.counters["triangles"] = static_cast<double>(triangles);
 }
-BENCHMARK(BM_SoilStepAndSurface)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SoilStepAndSurface)
+    ->ArgNames({"n", "threads", "incremental"})
+    ->Args({64, 1, 0})
+    ->Args({64, 1, 1})
+    ->Args({64, 2, 0})
+    ->Args({64, 2, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
+// The step alone on 1 or 2 threads (process CPU and wall).
+void BM_SoilStep(benchmark::State& state) {
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(state.range(1)));
+  SoilSimulation sim = pushing(static_cast<int>(state.range(0)));
+  for (auto _ : state) sim.step();
+}
+BENCHMARK(BM_SoilStep)
+    ->ArgNames({"n", "threads"})
+    ->Args({64, 1})
+    ->Args({64, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 // The surface alone (the ridge fix's density, then the mesh) and the density
 // alone, of the same push.

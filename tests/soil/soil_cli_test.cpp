@@ -139,27 +139,40 @@ TEST(SoilCli, DemGroundFollowsTheDemUpToTheWindowsEdges) {
   EXPECT_LT(worst, 1e-3);
 }
 
-TEST(SoilCli, BadScenariosAreErrorsNamingTheValueAndWriteNothing) {
-  const fs::path d = dir();
-  const std::string base = kScenario;
-  const struct {
-    std::string from, to, expect;
-  } cases[] = {
-      {"radius = 0.5", "radius = -0.5", "radius"},
-      {"radius = 0.5", "radius = nan", "radius"},
-      {"steps = 60", "steps = 60\nbogus = 1", "unknown key"},
-      {"size = [24, 24, 24]", "size = [4000, 4000, 4000]", "soil grid 4000 x 4000 x 4000"},
-      {"shape = \"cylinder\"", "shape = \"torus\"", "torus"},
-  };
-  for (const auto& c : cases) {
+// One edit of a good scenario that must be refused: `from` replaced by `to`,
+// the error naming `expect`.
+struct Refusal {
+  std::string from, to, expect;
+};
+
+// Writes `base` with each refusal's edit as bad.toml and runs it with
+// `-o out`: exit 1, the message naming the value, no output written.
+void expect_refusals(const fs::path& d, const std::string& base,
+                     const std::vector<Refusal>& refusals, const fs::path& out) {
+  for (const Refusal& c : refusals) {
     std::string text = base;
     text.replace(text.find(c.from), c.from.size(), c.to);
     std::ofstream(d / "bad.toml") << text;
-    EXPECT_EQ(run((d / "bad.toml").string() + " -o " + (d / "soil.ply").string(), d), 1)
+    EXPECT_EQ(run((d / "bad.toml").string() + " -o " + out.string(), d), 1)
         << c.to << ": " << output(d);
-    EXPECT_NE(output(d).find(c.expect), std::string::npos) << output(d);
-    EXPECT_FALSE(fs::exists(d / "soil.ply"));
+    EXPECT_NE(output(d).find(c.expect), std::string::npos) << c.to << ": " << output(d);
+    EXPECT_FALSE(fs::exists(out)) << c.to;
   }
+}
+
+TEST(SoilCli, BadScenariosAreErrorsNamingTheValueAndWriteNothing) {
+  const fs::path d = dir();
+  expect_refusals(
+      d, kScenario,
+      {
+          {"radius = 0.5", "radius = -0.5", "radius"},
+          {"radius = 0.5", "radius = nan", "radius"},
+          {"steps = 60", "steps = 60\nbogus = 1", "unknown key"},
+          {"size = [24, 24, 24]", "size = [4000, 4000, 4000]", "soil grid 4000 x 4000 x 4000"},
+          {"shape = \"cylinder\"", "shape = \"torus\"", "torus"},
+          {"[simulation]", "[soil]\ndrainage = 2\n[simulation]", "drainage"},
+      },
+      d / "soil.ply");
   std::ofstream(d / "s.toml") << kScenario;
   EXPECT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.ply").string() + " --soil clay", d),
             2);
@@ -319,26 +332,16 @@ TEST(SoilCli, SoilBodyMoistureAndATurningMeshBody) {
   const auto [lo, hi] = std::minmax_element(wet->begin(), wet->end());
   EXPECT_NEAR(*lo, 0.1f, 0.02f);
   EXPECT_NEAR(*hi, 0.7f, 0.02f);
-  const std::string base = kTurningScenario;
-  const struct {
-    std::string from, to, expect;
-  } cases[] = {
-      {"moisture = 0.7", "moisture = 1.5", "moisture"},
-      {"mesh = \"box.obj\"", "mesh = \"open.obj\"", "closed"},
-      {"mesh = \"box.obj\"", "mesh = \"none.obj\"", "none.obj"},
-      {"spin = [0, 0, 30]", "spin = [0, nan, 30]", "spin"},
-      {"spin = [0, 0, 30]", "rotation = [0, 0, 30]", "rotation"},
-  };
   std::string open = box_obj(0.3, 0.5, 0.2);
   open.erase(open.find("f 1 3 2"), std::string("f 1 3 2\nf 2 3 4\n").size());  // no bottom
   std::ofstream(d / "open.obj") << open;
-  for (const auto& c : cases) {
-    std::string text = base;
-    text.replace(text.find(c.from), c.from.size(), c.to);
-    std::ofstream(d / "bad.toml") << text;
-    EXPECT_EQ(run((d / "bad.toml").string() + " -o " + (d / "bad.ply").string(), d), 1)
-        << c.to << ": " << output(d);
-    EXPECT_NE(output(d).find(c.expect), std::string::npos) << c.to << ": " << output(d);
-    EXPECT_FALSE(fs::exists(d / "bad.ply"));
-  }
+  expect_refusals(d, kTurningScenario,
+                  {
+                      {"moisture = 0.7", "moisture = 1.5", "moisture"},
+                      {"mesh = \"box.obj\"", "mesh = \"open.obj\"", "closed"},
+                      {"mesh = \"box.obj\"", "mesh = \"none.obj\"", "none.obj"},
+                      {"spin = [0, 0, 30]", "spin = [0, nan, 30]", "spin"},
+                      {"spin = [0, 0, 30]", "rotation = [0, 0, 30]", "rotation"},
+                  },
+                  d / "bad.ply");
 }

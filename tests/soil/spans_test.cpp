@@ -19,6 +19,13 @@ struct Column {
   }
 };
 
+// A span's type and extent (voxels).
+void expect_span(const HeightSpan& s, SpanType type, float bottom, float top) {
+  EXPECT_EQ(s.type, type);
+  EXPECT_FLOAT_EQ(s.bottom, bottom);
+  EXPECT_FLOAT_EQ(s.top, top);
+}
+
 // Ground pile 2.5 high; a body from 4.3 to 7.6 (partial voxels at both ends);
 // 1.75 of soil on it (on the body's 0.6 in voxel 7); falling soil in 12-13.
 TEST(HeightSpans, PileBodyPileAndFallingSoil) {
@@ -35,21 +42,13 @@ TEST(HeightSpans, PileBodyPileAndFallingSoil) {
   c.rho[15] = 0.2f;  // loose falling soil: in no span
   const auto s = c.spans();
   ASSERT_EQ(s.size(), 4u);
-  EXPECT_EQ(s[0].type, SpanType::Piled);
-  EXPECT_FLOAT_EQ(s[0].bottom, 0.0f);
-  EXPECT_FLOAT_EQ(s[0].top, 2.5f);
+  expect_span(s[0], SpanType::Piled, 0.0f, 2.5f);
   EXPECT_FLOAT_EQ(s[0].soil, 2.5f);
   EXPECT_EQ(s[0].top_voxel, 2);
-  EXPECT_EQ(s[1].type, SpanType::Rigid);
-  EXPECT_FLOAT_EQ(s[1].bottom, 4.3f);
-  EXPECT_FLOAT_EQ(s[1].top, 7.6f);
-  EXPECT_EQ(s[2].type, SpanType::Piled);
-  EXPECT_FLOAT_EQ(s[2].bottom, 7.6f);
-  EXPECT_FLOAT_EQ(s[2].top, 9.35f);
+  expect_span(s[1], SpanType::Rigid, 4.3f, 7.6f);
+  expect_span(s[2], SpanType::Piled, 7.6f, 9.35f);
   EXPECT_FLOAT_EQ(s[2].soil, 1.75f);
-  EXPECT_EQ(s[3].type, SpanType::Falling);
-  EXPECT_FLOAT_EQ(s[3].bottom, 12.0f);
-  EXPECT_FLOAT_EQ(s[3].top, 14.0f);
+  expect_span(s[3], SpanType::Falling, 12.0f, 14.0f);
 }
 
 // Bare ground is a pile of zero height (it can receive sliding soil); a body
@@ -65,11 +64,8 @@ TEST(HeightSpans, BareGroundAndBodyOnTheFloor) {
   body.psi[2] = 0.25f;
   s = body.spans();
   ASSERT_EQ(s.size(), 2u);
-  EXPECT_EQ(s[0].type, SpanType::Rigid);
-  EXPECT_FLOAT_EQ(s[0].top, 2.25f);
-  EXPECT_EQ(s[1].type, SpanType::Piled);
-  EXPECT_FLOAT_EQ(s[1].bottom, 2.25f);
-  EXPECT_FLOAT_EQ(s[1].top, 2.25f);
+  expect_span(s[0], SpanType::Rigid, 0.0f, 2.25f);
+  expect_span(s[1], SpanType::Piled, 2.25f, 2.25f);
 }
 
 }  // namespace
