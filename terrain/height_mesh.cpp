@@ -60,6 +60,11 @@ Mesh height_field_mesh(const HeightField& h, int step,
   const std::size_t nc = cols.size();
   const bool flip = g.geotransform[1] * g.geotransform[5] > 0;
   std::vector<int> index(nc * rows.size(), -1);
+  // At most a vertex a kept cell and two triangles a square: reserved, so the
+  // memory is what mesh_and_write_bytes counts, not up to twice it by doubling.
+  mesh.positions.reserve(index.size());
+  for (auto& [name, values] : mesh.vertex_attributes) values.reserve(index.size());
+  mesh.triangles.reserve(2 * (nc - 1) * (rows.size() - 1));
   auto vertex = [&](std::size_t i, std::size_t j) {  // column i, row j of the kept ones
     int& v = index[j * nc + i];
     if (v >= 0) return v;
