@@ -189,9 +189,9 @@ TEST(MemoryEstimate, DunesWithAndWithoutSnapshots) {
   // turn a copy of the field to the grid beside it, used 18.
   const fs::path d = dir();
   const Measured tiny = run_measured("dunes --size 16 --steps 1 -o t.tif", d);
-  expect_estimate_within_a_quarter(tiny, run_measured("dunes --size 2500 --steps 2 -o a.tif", d));
+  expect_estimate_within_a_quarter(tiny, run_measured("dunes --size 3000 --steps 2 -o a.tif", d));
   expect_estimate_within_a_quarter(
-      tiny, run_measured("dunes --model dunes --size 2500 --steps 2 --wind 300 -o b.tif", d));
+      tiny, run_measured("dunes --model dunes --size 3000 --steps 2 --wind 300 -o b.tif", d));
   expect_estimate_within_a_quarter(
       run_measured("dunes --size 16 --steps 2 --snapshot-every 1 -o ts.tif", d),
       run_measured("dunes --size 2500 --steps 2 --snapshot-every 1 -o s.tif", d));
@@ -222,7 +222,7 @@ TEST(MemoryEstimate, MergeInfoAndMesh) {
   // mesh counted the raster only, and a GLB of a DEM used 50 times it.
   const fs::path d = dir();
   write_dem(d / "dem.tif", 32, 10.0);
-  write_dem(d / "big.tif", 2600, 10.0);
+  write_dem(d / "big.tif", 4000, 10.0);
   write_dem(d / "mid.tif", 1200, 10.0);
   put(d / "scene.toml", "[terrain]\nraster = \"dem.tif\"\n[sun]\nazimuth = 120\nelevation = 35\n");
   for (const char* size : {"16x8", "1600x1200"})
