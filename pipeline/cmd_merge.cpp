@@ -60,6 +60,7 @@ void run_merge(const MergeOptions& o, const CLI::App& sub) {
   std::vector<std::filesystem::path> names(o.tiles.begin(), o.tiles.end());
   OutputSet outputs({o.outputs.begin(), o.outputs.end()}, names);
   std::vector<render::Image> tiles;
+  tiles.reserve(names.size());
   for (const auto& t : names) tiles.push_back(render::read_image(t));
   // The tiles stay beside the merged frame until it is whole: merge_tiles
   // counts the frame, this counts both (the frame alone was half the peak).

@@ -44,14 +44,18 @@ void run_mesh(const MeshCommand& c) {
       for (char& ch : t) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
       return t;
     };
+    // Messages built by append: clang-tidy (performance-inefficient-string-concatenation).
+    std::string problem = "--attribute '" + a + "': ";
     for (const std::string reserved : {"X", "Y", "Z", "NX", "NY", "NZ"})
       if (upper(name) == reserved)
-        usage_error("--attribute '" + a + "': " + name +
-                    " is a vertex coordinate or normal; give another NAME");
+        usage_error(
+            problem.append(name).append(" is a vertex coordinate or normal; give another NAME"));
     for (const auto& [other, path] : named)
       if (upper(other) == upper(name))
-        usage_error("--attribute '" + a + "': the NAME '" + other +
-                    "' is given already (names differing only in case are one in glTF)");
+        usage_error(
+            problem.append("the NAME '")
+                .append(other)
+                .append("' is given already (names differing only in case are one in glTF)"));
     named.emplace_back(name, a.substr(eq + 1));
     inputs.emplace_back(a.substr(eq + 1));
   }
@@ -81,6 +85,7 @@ void run_mesh(const MeshCommand& c) {
   const terrain::HeightField heights = terrain::read_raster(c.raster, read);
   require_metric_crs(heights, c.raster);
   std::vector<std::pair<std::string, terrain::HeightField>> attributes;
+  attributes.reserve(named.size());
   for (const auto& [name, path] : named)
     attributes.emplace_back(name, terrain::read_raster(path, read));
   const terrain::Mesh mesh = terrain::height_field_mesh(heights, c.step, attributes);
