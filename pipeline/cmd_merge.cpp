@@ -1,6 +1,7 @@
 // drift merge TILE.exr... -o FRAME.exr|png: join the bands of `drift render
 // --tile i/n` into the frame a single run gives, bit for bit.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include "render/image_io.h"
 #include "render/tiles.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 #include "terrain/output_set.h"
 
 namespace drift::pipeline {
@@ -58,7 +60,18 @@ void run_merge(const MergeOptions& o, const CLI::App& sub) {
   std::vector<std::filesystem::path> names(o.tiles.begin(), o.tiles.end());
   OutputSet outputs({o.outputs.begin(), o.outputs.end()}, names);
   std::vector<render::Image> tiles;
+  tiles.reserve(names.size());
   for (const auto& t : names) tiles.push_back(render::read_image(t));
+  // The tiles stay beside the merged frame until it is whole: merge_tiles
+  // counts the frame, this counts both (the frame alone was half the peak).
+  std::uint64_t held = 0;
+  for (const render::Image& t : tiles) held += t.pixels.size() * sizeof(float);
+  const render::Image& first = tiles.at(0);  // at least one: the option is required
+  require_memory(held + static_cast<std::uint64_t>(std::max(0, first.frame.full_width)) *
+                            static_cast<std::uint64_t>(std::max(0, first.frame.full_height)) *
+                            first.channels.size() * sizeof(float),
+                 "the " + std::to_string(tiles.size()) + " tiles and their merged frame",
+                 "merge fewer channels or a smaller frame");
   const render::Image frame = render::merge_tiles(tiles, names);
   tiles.clear();
   const render::DisplayTransform display = display_of(frame, sub, o.exposure);

@@ -2,6 +2,8 @@
 // (marked ground, snow surface, dunes) as a triangle mesh for Blender, game
 // engines and viewers: glTF/GLB, FBX, STL, OBJ or PLY by the output's extension.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -10,6 +12,7 @@
 #include "pipeline/cli.h"
 #include "pipeline/object_list.h"
 #include "terrain/height_mesh.h"
+#include "terrain/memory.h"
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
@@ -33,7 +36,30 @@ void run_mesh(const MeshCommand& c) {
     const auto eq = a.find('=');
     if (eq == 0 || eq == std::string::npos || eq + 1 == a.size())
       usage_error("--attribute '" + a + "' must be NAME=RASTER, e.g. snow_coverage=cover.tif");
-    named.emplace_back(a.substr(0, eq), a.substr(eq + 1));
+    const std::string name = a.substr(0, eq);
+    // A name goes into the PLY header as one word and into glTF as _NAME in
+    // capitals: a space broke the PLY's header, and two names alike but for
+    // case (or given twice) made an invalid glTF (two attributes of one name).
+    if (!std::all_of(name.begin(), name.end(),
+                     [](unsigned char ch) { return std::isalnum(ch) || ch == '_'; }))
+      usage_error("--attribute '" + a + "': NAME must be letters, digits and _, e.g. snow_depth");
+    auto upper = [](std::string t) {
+      for (char& ch : t) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+      return t;
+    };
+    // Messages built by append: clang-tidy (performance-inefficient-string-concatenation).
+    std::string problem = "--attribute '" + a + "': ";
+    for (const std::string reserved : {"X", "Y", "Z", "NX", "NY", "NZ"})
+      if (upper(name) == reserved)
+        usage_error(
+            problem.append(name).append(" is a vertex coordinate or normal; give another NAME"));
+    for (const auto& [other, path] : named)
+      if (upper(other) == upper(name))
+        usage_error(
+            problem.append("the NAME '")
+                .append(other)
+                .append("' is given already (names differing only in case are one in glTF)"));
+    named.emplace_back(name, a.substr(eq + 1));
     inputs.emplace_back(a.substr(eq + 1));
   }
   // The path's own problems (a device, an input) first, as every command reports them.
@@ -46,13 +72,29 @@ void run_mesh(const MeshCommand& c) {
     usage_error("--decimate " + std::to_string(*c.decimate) +
                 " must be a vertical error of 0 metres or more, e.g. --decimate 0.5");
   terrain::ReadOptions read;
+  const terrain::RasterHeader header = terrain::read_raster_header(c.raster);
   if (!c.crop.empty()) {
-    read.window = terrain::crop_window(terrain::read_raster_header(c.raster),
-                                       {c.crop[0], c.crop[1], c.crop[2], c.crop[3]}, c.raster);
+    read.window =
+        terrain::crop_window(header, {c.crop[0], c.crop[1], c.crop[2], c.crop[3]}, c.raster);
   }
+  // Everything the run holds at its peak, before any of it is read: the
+  // rasters, the mesh and what its format's writer builds (a 2048 x 2048 DEM
+  // as FBX reached 4 GiB unchecked).
+  const std::uint64_t w = read.window ? read.window->width : header.width,
+                      h = read.window ? read.window->height : header.height;
+  const std::uint64_t cols = (w + c.step - 2) / c.step + 1, rows = (h + c.step - 2) / c.step + 1;
+  // The rasters and the vertex index over their grid (4 bytes a cell each).
+  require_memory(w * h * 4 * (2 + named.size()) +
+                     terrain::mesh_and_write_bytes(c.output, cols * rows,
+                                                   2 * (cols - 1) * (rows - 1), named.size()),
+                 "a mesh of " + std::to_string(cols) + " x " + std::to_string(rows) +
+                     " vertices written as '" + c.output + "'",
+                 "crop it (--crop), keep fewer cells (--step N), or write .ply or .obj, which "
+                 "stream");
   const terrain::HeightField heights = terrain::read_raster(c.raster, read);
   require_metric_crs(heights, c.raster);
   std::vector<std::pair<std::string, terrain::HeightField>> attributes;
+  attributes.reserve(named.size());
   for (const auto& [name, path] : named)
     attributes.emplace_back(name, terrain::read_raster(path, read));
   double error = 0.0;

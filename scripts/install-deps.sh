@@ -16,7 +16,7 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev
   fonts-dejavu-core
 )
-# --lint: also what scripts/lint.sh runs (CI runs it; .ci/run).
+# --lint: also what scripts/lint.sh runs (not in CI yet: docs/testing.md says why).
 if [ "${1:-}" = "--lint" ]; then
   packages+=(python3 clang-format clang-tidy cppcheck)
 fi

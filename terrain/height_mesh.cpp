@@ -106,6 +106,13 @@ Mesh height_field_mesh(const HeightField& h, int step,
   GridVertices vertex(mesh, h, attributes);
   const std::size_t nc = cols.size();
   const bool flip = south_up(h);
+  // At most a vertex a kept grid point and two triangles a square: reserved,
+  // so the memory is what mesh_and_write_bytes counts, not up to twice it by
+  // doubling.
+  const std::size_t kept_points = nc * rows.size();
+  mesh.positions.reserve(kept_points);
+  for (auto& [name, values] : mesh.vertex_attributes) values.reserve(kept_points);
+  mesh.triangles.reserve(2 * (nc - 1) * (rows.size() - 1));
   for (std::size_t j = 0; j + 1 < rows.size(); ++j) {
     for (std::size_t i = 0; i + 1 < nc; ++i) {
       const float a = h(cols[i], rows[j]), b = h(cols[i + 1], rows[j]), c = h(cols[i], rows[j + 1]),

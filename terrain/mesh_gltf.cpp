@@ -209,6 +209,7 @@ void write_gltf(const Mesh& mesh, const fs::path& path) {
 void write_stl(const Mesh& mesh, const fs::path& path) {
   check_writable_mesh(mesh, path);
   std::vector<std::uint8_t> file(80, 0);
+  file.reserve(84 + 50 * mesh.triangles.size());  // whole: growing by doubling held up to 2x
   const char header[] = "binary STL written by Driftscape: metres, z up";
   std::memcpy(file.data(), header, sizeof header - 1);
   put_u32(file, static_cast<std::uint32_t>(mesh.triangles.size()));

@@ -448,6 +448,31 @@ bool is_mesh_output(const fs::path& path) {
          ext == ".fbx";
 }
 
+std::uint64_t mesh_and_write_bytes(const fs::path& path, std::uint64_t vertices,
+                                   std::uint64_t triangles, std::size_t attributes) {
+  const std::uint64_t v = vertices, t = triangles, a = attributes;
+  // The mesh: position and normal (12 + 12), a float per attribute; 3 indices a triangle.
+  const std::uint64_t mesh = v * (24 + 4 * a) + t * 12;
+  const std::string ext = lower_ext(path);
+  // The binary buffer: y-up positions and normals, attributes, 32-bit indices.
+  const std::uint64_t bin = v * (24 + 4 * a) + t * 12;
+  std::uint64_t writer = 0;
+  if (ext == ".glb" || ext == ".gltf") {
+    // write_gltf: the normals' copy, the turned positions and normals and the
+    // indices (v 36, t 12), the buffer, and the file (GLB: the buffer again;
+    // .gltf: its base64, the JSON holding it, and the file's copy of that).
+    writer = v * 36 + t * 12 + bin + (ext == ".glb" ? bin : 3 * (bin * 4 / 3 + 4));
+  } else if (ext == ".stl") {
+    writer = 84 + t * 50;  // the whole file: 50 bytes a triangle
+  } else if (ext == ".fbx") {
+    // Assimp's aiMesh (v 24, a face's index array t 28) and its ASCII FBX
+    // exporter's node tree and text: 485 bytes a triangle measured with
+    // Assimp 5.2 (a 2048 x 2048 DEM: 4 GiB), counted as 500.
+    writer = v * 36 + t * 500;
+  }
+  return mesh + writer;
+}
+
 void write_mesh(const Mesh& mesh, const fs::path& path) {
   const std::string ext = lower_ext(path);
   if (ext == ".ply") return write_ply(mesh, path);

@@ -6,6 +6,7 @@
 #include <cpl_string.h>
 #include <gdal_priv.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -216,7 +217,16 @@ HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadO
                   std::to_string(ds->GetRasterYSize()) + ")");
     }
   }
-  const std::uint64_t bytes = static_cast<std::uint64_t>(win.width) * win.height * sizeof(float);
+  // The heights, and GDAL's block cache, which keeps the blocks read (in the
+  // file's type) until the file is closed, up to its cap (GDAL_CACHEMAX, 5 %
+  // of memory by default): drift info on a float32 raster peaked at twice the
+  // heights.
+  const std::uint64_t cells = static_cast<std::uint64_t>(win.width) * win.height;
+  const std::uint64_t cached =
+      std::min(cells * static_cast<std::uint64_t>(
+                           std::max(1, GDALGetDataTypeSizeBytes(band->GetRasterDataType()))),
+               static_cast<std::uint64_t>(std::max<GIntBig>(0, GDALGetCacheMax64())));
+  const std::uint64_t bytes = cells * sizeof(float) + cached;
   require_memory(bytes,
                  "raster '" + path.string() + "' (" + std::to_string(win.width) + " x " +
                      std::to_string(win.height) + " cells as float32)",

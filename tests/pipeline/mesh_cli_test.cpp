@@ -111,6 +111,30 @@ TEST(MeshCli, UsageErrorsExitTwo) {
   EXPECT_FALSE(fs::exists(d / "a.glb"));
 }
 
+TEST(MeshCli, AttributeNamesThatWouldBreakTheFileAreRefused) {
+  // 'a b' wrote "property float a b" into the PLY's header (unreadable); a
+  // name given twice, or twice but for case, wrote two _A attributes into one
+  // glTF primitive (invalid); 'nz' shadowed the normal. All exited 0.
+  const fs::path d = test_dir("mesh_cli_names");
+  const fs::path dem = make_dem(d);
+  const std::string a = " --attribute ";
+  for (const std::string& attributes :
+       {a + "'a b=" + dem.string() + "'", a + "a=" + dem.string() + a + "a=" + dem.string(),
+        a + "a=" + dem.string() + a + "A=" + dem.string(), a + "nz=" + dem.string()}) {
+    SCOPED_TRACE(attributes);
+    for (const char* out : {"m.ply", "m.glb"}) {
+      EXPECT_EQ(run_drift("mesh " + dem.string() + attributes + " -o " + (d / out).string(), d), 2);
+      EXPECT_NE(drift_log(d).find("--attribute"), std::string::npos) << drift_log(d);
+      EXPECT_FALSE(fs::exists(d / out));
+    }
+  }
+  EXPECT_EQ(run_drift("mesh " + dem.string() + a + "snow_depth2=" + dem.string() + " -o " +
+                          (d / "m.ply").string(),
+                      d),
+            0)
+      << drift_log(d);
+}
+
 TEST(MeshCli, ObjectsTakeGlbAndStlWhereTheObjLands) {
   const fs::path d = test_dir("mesh_cli");
   // The hut as OBJ (z up as stored), and as GLB and STL written from it.
