@@ -20,9 +20,20 @@ constexpr int kLeaf = HeightFieldBlocks::kLeaf;
 
 }  // namespace
 
+struct PagedTerrain::Readers {
+  tbb::enumerable_thread_specific<std::unique_ptr<terrain::RasterBlockReader>> local;
+};
+
+terrain::RasterBlockReader& PagedTerrain::reader() const {
+  std::unique_ptr<terrain::RasterBlockReader>& r = readers_->local.local();
+  if (!r) r = std::make_unique<terrain::RasterBlockReader>(reader_->path());
+  return *r;
+}
+
 PagedTerrain::PagedTerrain(const std::filesystem::path& dem, std::uint64_t memory_budget,
                            float vertical_exaggeration, int page_cells)
     : reader_(std::make_unique<terrain::RasterBlockReader>(dem)),
+      readers_(std::make_unique<Readers>()),
       page_cells_(page_cells),
       exaggeration_(vertical_exaggeration) {
   const int w = reader_->width(), h = reader_->height();
@@ -88,13 +99,9 @@ void PagedTerrain::scan() {
     std::uint64_t bytes = 0;
   };
   std::vector<StripResult> results(static_cast<std::size_t>(strips));
-  const std::filesystem::path path = reader_->path();
-  tbb::enumerable_thread_specific<std::unique_ptr<terrain::RasterBlockReader>> readers;
   tbb::parallel_for(0, strips, [&](int k) {
-    std::unique_ptr<terrain::RasterBlockReader>& reader = readers.local();
-    if (!reader) reader = std::make_unique<terrain::RasterBlockReader>(path);
     const int a = k * strip, b = std::min(a + strip, h);
-    const std::vector<float> rows = reader->read(0, a, w, b - a);
+    const std::vector<float> rows = reader().read(0, a, w, b - a);
     const auto z = [&](int c, int r) { return rows[static_cast<std::size_t>(r - a) * w + c]; };
     StripResult& out = results[static_cast<std::size_t>(k)];
     out.bytes = rows.size() * sizeof(float);
@@ -185,7 +192,7 @@ std::vector<float> PagedTerrain::load(std::uint64_t key) const {
   const int px = static_cast<int>(key % pages_x_), py = static_cast<int>(key / pages_x_);
   const int c0 = px * page_cells_, c1 = std::min(c0 + page_cells_, frame_.width - 1);
   const int r0 = py * page_cells_, r1 = std::min(r0 + page_cells_, frame_.height - 1);
-  std::vector<float> z = reader_->read(c0, r0, c1 - c0 + 1, r1 - r0 + 1);
+  std::vector<float> z = reader().read(c0, r0, c1 - c0 + 1, r1 - r0 + 1);
   // As TerrainScene::fill_heights converts a DEM held in core.
   const float k = exaggeration_, z0 = z0_, lo = fill_;
   for (float& v : z) {

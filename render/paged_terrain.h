@@ -70,7 +70,13 @@ class PagedTerrain final : public HeightSource {
   void scan();
   std::vector<float> load(std::uint64_t key) const;
 
+  // The raster's reader on this thread (one GDAL dataset a thread: a dataset
+  // is not thread-safe, so pages missed on two threads are read side by side).
+  terrain::RasterBlockReader& reader() const;
+
   std::unique_ptr<terrain::RasterBlockReader> reader_;
+  struct Readers;
+  std::unique_ptr<Readers> readers_;
   std::unique_ptr<BlockCache> cache_;
   int page_cells_;
   int pages_x_ = 0, pages_y_ = 0;
