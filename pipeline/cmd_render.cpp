@@ -323,14 +323,14 @@ void print_summary(const SceneFile& scene, const render::Image& image,
 }
 
 // The out-of-core terrain's page cache over the render (render/block_cache.h).
-void print_cache(const render::PagedTerrain& paged) {
+void print_cache(const render::PagedTerrain& paged, double setup_seconds) {
   const render::BlockCacheStats c = paged.cache_stats();
   std::printf(
       "terrain cache: %llu hits, %llu misses, %s read in pages (%s in the opening scan), "
-      "peak resident %s of a %s budget\n",
+      "peak resident %s of a %s budget; scene set-up %.1f s\n",
       static_cast<unsigned long long>(c.hits), static_cast<unsigned long long>(c.misses),
       human_bytes(c.bytes_read).c_str(), human_bytes(paged.scan_bytes()).c_str(),
-      human_bytes(c.peak_resident).c_str(), human_bytes(paged.budget()).c_str());
+      human_bytes(c.peak_resident).c_str(), human_bytes(paged.budget()).c_str(), setup_seconds);
 }
 
 // --set NAME=VALUE, each a usage error unless NAME can name a variable.
@@ -391,6 +391,8 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     scene.input.terrain.geo() = dem_geo;
   }
   const render::TerrainScene& embree_scene = *scene_holder;
+  const double setup_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const render::Camera camera =
       scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
   render::RenderStats stats;
@@ -411,7 +413,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   write_outputs(scene, image, embree_scene, camera);
   outputs.commit();
   print_summary(scene, image, stats, seconds);
-  if (paged) print_cache(*paged);
+  if (paged) print_cache(*paged, setup_seconds);
   print_exposure(image, scene.display, o.tile.empty());
 }
 

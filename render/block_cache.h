@@ -6,13 +6,16 @@
 // The cache changes when a block is read, never what a block holds: a loader
 // must return the same values for a key every time, so whatever the cache
 // keeps or drops, and whatever the thread interleaving, every ray sees the
-// same heights and the image is the same bits. Thread-safe: one mutex, and a
-// miss reads its block under it (the loader's GDAL dataset is not
-// thread-safe, and two threads missing one block read it once).
+// same heights and the image is the same bits. Thread-safe: one mutex over
+// the cache's lists; a miss calls the loader outside it (threads missing
+// different blocks read them side by side: the loader must be thread-safe),
+// and a thread missing a block another thread is reading waits for that read
+// (one read a block).
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <list>
 #include <memory>
 #include <mutex>
@@ -58,6 +61,8 @@ class BlockCache {
   mutable std::mutex mutex_;
   std::list<Entry> lru_;  // front: most recently used
   std::unordered_map<std::uint64_t, std::list<Entry>::iterator> index_;
+  // Blocks being read, for threads that miss them meanwhile.
+  std::unordered_map<std::uint64_t, std::shared_future<std::shared_ptr<const Block>>> loading_;
   BlockCacheStats stats_;
 };
 

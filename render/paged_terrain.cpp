@@ -1,10 +1,10 @@
 #include "render/paged_terrain.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <string>
 
@@ -20,9 +20,20 @@ constexpr int kLeaf = HeightFieldBlocks::kLeaf;
 
 }  // namespace
 
+struct PagedTerrain::Readers {
+  tbb::enumerable_thread_specific<std::unique_ptr<terrain::RasterBlockReader>> local;
+};
+
+terrain::RasterBlockReader& PagedTerrain::reader() const {
+  std::unique_ptr<terrain::RasterBlockReader>& r = readers_->local.local();
+  if (!r) r = std::make_unique<terrain::RasterBlockReader>(reader_->path());
+  return *r;
+}
+
 PagedTerrain::PagedTerrain(const std::filesystem::path& dem, std::uint64_t memory_budget,
                            float vertical_exaggeration, int page_cells)
     : reader_(std::make_unique<terrain::RasterBlockReader>(dem)),
+      readers_(std::make_unique<Readers>()),
       page_cells_(page_cells),
       exaggeration_(vertical_exaggeration) {
   const int w = reader_->width(), h = reader_->height();
@@ -68,52 +79,83 @@ void PagedTerrain::scan() {
   const int cells_x = w - 1, cells_y = h - 1;
   const int leaves_x = (cells_x + kLeaf - 1) / kLeaf, leaves_y = (cells_y + kLeaf - 1) / kLeaf;
   leaves_.assign(static_cast<std::size_t>(leaves_x) * leaves_y, {kInf, -kInf});
-  // A strip of page_cells_ rows of cells and its vertices, the last row of
-  // one strip carried over as the first of the next (each row read once).
+  // Strips of page_cells_ vertex rows [a, b), a a multiple of page_cells_, so
+  // that a raster tiled in blocks of page_cells_ (or a divisor) decodes each
+  // block once: a strip reaching one row into the next block row made GDAL
+  // decode that block row twice, and at 65536 cells a side one block row
+  // (64 MiB) no longer stayed in GDAL's 64 MiB cache. The strips are read side
+  // by side, each thread through its own dataset (a GDALDataset is not
+  // thread-safe; GDAL's block cache is). Leaf row iy spans vertex rows
+  // [4 iy, 4 iy + 4]: the strip holding row 4 iy writes it; its last vertex
+  // row may be the next strip's first, whose min-max per leaf column (the
+  // strip's "head") is merged in afterwards. Min and max are exact, so the
+  // leaves are the same bits whatever the strips or the threads.
   const int strip = page_cells_;
-  std::vector<float> rows(static_cast<std::size_t>(strip + 1) * w);
-  float lo = kInf, hi = -kInf;
-  std::size_t lo_at = 0, hi_at = 0;
-  for (int r0 = 0; r0 < cells_y; r0 += strip) {
-    const int r1 = std::min(r0 + strip, cells_y);  // last vertex row of the strip
-    const int first_new = r0 == 0 ? 0 : 1;
-    if (r0 > 0)
-      std::memcpy(rows.data(), rows.data() + static_cast<std::size_t>(strip) * w,
-                  sizeof(float) * w);
-    const std::vector<float> fresh = reader_->read(0, r0 + first_new, w, r1 - r0 + 1 - first_new);
-    std::copy(fresh.begin(), fresh.end(),
-              rows.begin() + static_cast<std::ptrdiff_t>(first_new) * w);
-    scan_bytes_ += fresh.size() * sizeof(float);
-    const auto z = [&](int c, int r) { return rows[static_cast<std::size_t>(r - r0) * w + c]; };
-    // Raw min-max of every leaf in the strip (-inf as the lowest: it holds
-    // nodata, which becomes the lowest valid height once that is known).
-    tbb::parallel_for(r0 / kLeaf, (r1 + kLeaf - 1) / kLeaf, [&](int iy) {
-      for (int ix = 0; ix < leaves_x; ++ix) {
-        HeightFieldBlocks::MinMax m{kInf, -kInf};
-        const int c0 = ix * kLeaf, c1 = std::min(c0 + kLeaf, cells_x);
-        const int rr0 = iy * kLeaf, rr1 = std::min(rr0 + kLeaf, cells_y);
-        for (int r = rr0; r <= rr1; ++r)
-          for (int c = c0; c <= c1; ++c) {
-            const float v = z(c, r);
-            if (std::isnan(v)) {
-              m.lo = -kInf;
-            } else {
-              m.lo = std::min(m.lo, v), m.hi = std::max(m.hi, v);
-            }
+  const int strips = (h + strip - 1) / strip;
+  struct StripResult {
+    std::vector<HeightFieldBlocks::MinMax> head;  // row a's min-max per leaf column
+    float lo = kInf, hi = -kInf;
+    std::size_t lo_at = 0, hi_at = 0;
+    std::uint64_t bytes = 0;
+  };
+  std::vector<StripResult> results(static_cast<std::size_t>(strips));
+  tbb::parallel_for(0, strips, [&](int k) {
+    const int a = k * strip, b = std::min(a + strip, h);
+    const std::vector<float> rows = reader().read(0, a, w, b - a);
+    const auto z = [&](int c, int r) { return rows[static_cast<std::size_t>(r - a) * w + c]; };
+    StripResult& out = results[static_cast<std::size_t>(k)];
+    out.bytes = rows.size() * sizeof(float);
+    // Raw min-max (-inf as the lowest: it holds nodata, which becomes the
+    // lowest valid height once that is known) of vertex rows [r0, r1] over
+    // leaf column ix.
+    const auto minmax = [&](int ix, int r0, int r1) {
+      HeightFieldBlocks::MinMax m{kInf, -kInf};
+      const int c0 = ix * kLeaf, c1 = std::min(c0 + kLeaf, cells_x);
+      for (int r = r0; r <= r1; ++r)
+        for (int c = c0; c <= c1; ++c) {
+          const float v = z(c, r);
+          if (std::isnan(v)) {
+            m.lo = -kInf;
+          } else {
+            m.lo = std::min(m.lo, v), m.hi = std::max(m.hi, v);
           }
-        leaves_[static_cast<std::size_t>(iy) * leaves_x + ix] = m;
-      }
-    });
-    // The extremes, the first in row-major order on a tie (vertex rows
-    // [r0 + first_new, r1], each once).
-    for (int r = r0 + first_new; r <= r1; ++r)
+        }
+      return m;
+    };
+    for (int iy = a / kLeaf; iy < leaves_y && iy * kLeaf < b; ++iy) {
+      const int r1 = std::min({iy * kLeaf + kLeaf, cells_y, b - 1});
+      for (int ix = 0; ix < leaves_x; ++ix)
+        leaves_[static_cast<std::size_t>(iy) * leaves_x + ix] = minmax(ix, iy * kLeaf, r1);
+    }
+    if (a > 0 && a % kLeaf == 0) {
+      out.head.resize(static_cast<std::size_t>(leaves_x));
+      for (int ix = 0; ix < leaves_x; ++ix)
+        out.head[static_cast<std::size_t>(ix)] = minmax(ix, a, a);
+    }
+    // The extremes, the first in row-major order on a tie.
+    for (int r = a; r < b; ++r)
       for (int c = 0; c < w; ++c) {
         const float v = z(c, r);
         if (std::isnan(v)) continue;
         const std::size_t i = static_cast<std::size_t>(r) * w + c;
-        if (v < lo) lo = v, lo_at = i;
-        if (v > hi) hi = v, hi_at = i;
+        if (v < out.lo) out.lo = v, out.lo_at = i;
+        if (v > out.hi) out.hi = v, out.hi_at = i;
       }
+  });
+  float lo = kInf, hi = -kInf;
+  std::size_t lo_at = 0, hi_at = 0;
+  for (int k = 0; k < strips; ++k) {
+    const StripResult& s = results[static_cast<std::size_t>(k)];
+    scan_bytes_ += s.bytes;
+    if (s.lo < lo) lo = s.lo, lo_at = s.lo_at;  // strictly: the earlier strip wins a tie
+    if (s.hi > hi) hi = s.hi, hi_at = s.hi_at;
+    if (s.head.empty()) continue;
+    const int iy = k * strip / kLeaf - 1;  // the leaf row whose last vertex row is a
+    for (int ix = 0; ix < leaves_x; ++ix) {
+      HeightFieldBlocks::MinMax& m = leaves_[static_cast<std::size_t>(iy) * leaves_x + ix];
+      const HeightFieldBlocks::MinMax& t = s.head[static_cast<std::size_t>(ix)];
+      m.lo = std::min(m.lo, t.lo), m.hi = std::max(m.hi, t.hi);
+    }
   }
   if (!std::isfinite(lo))
     throw Error("the terrain raster '" + reader_->path().string() +
@@ -150,7 +192,7 @@ std::vector<float> PagedTerrain::load(std::uint64_t key) const {
   const int px = static_cast<int>(key % pages_x_), py = static_cast<int>(key / pages_x_);
   const int c0 = px * page_cells_, c1 = std::min(c0 + page_cells_, frame_.width - 1);
   const int r0 = py * page_cells_, r1 = std::min(r0 + page_cells_, frame_.height - 1);
-  std::vector<float> z = reader_->read(c0, r0, c1 - c0 + 1, r1 - r0 + 1);
+  std::vector<float> z = reader().read(c0, r0, c1 - c0 + 1, r1 - r0 + 1);
   // As TerrainScene::fill_heights converts a DEM held in core.
   const float k = exaggeration_, z0 = z0_, lo = fill_;
   for (float& v : z) {

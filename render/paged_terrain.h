@@ -3,8 +3,9 @@
 // demand through an LRU cache under a memory budget (render/block_cache.h),
 // instead of the whole raster in memory (TerrainScene's HeightGrid).
 //
-// Opening scans the raster once, a strip of pages at a time, for what the
-// scene needs up front: the lowest valid height (the local frame's origin and
+// Opening scans the raster once, strips of page_cells() rows read side by
+// side on every thread (a GDAL dataset each), for what the scene needs up
+// front: the lowest valid height (the local frame's origin and
 // the nodata fill, as terrain/local_frame.h gives them in core), the highest
 // and lowest vertices, and the min-max leaves of the height field's tree
 // (render/height_field.h: 8 B per 4 x 4 cells, 0.67 B a cell with the levels
@@ -69,7 +70,13 @@ class PagedTerrain final : public HeightSource {
   void scan();
   std::vector<float> load(std::uint64_t key) const;
 
+  // The raster's reader on this thread (one GDAL dataset a thread: a dataset
+  // is not thread-safe, so pages missed on two threads are read side by side).
+  terrain::RasterBlockReader& reader() const;
+
   std::unique_ptr<terrain::RasterBlockReader> reader_;
+  struct Readers;
+  std::unique_ptr<Readers> readers_;
   std::unique_ptr<BlockCache> cache_;
   int page_cells_;
   int pages_x_ = 0, pages_y_ = 0;

@@ -234,16 +234,18 @@ void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
   surface_ = input.surface;
   surface_.cell = std::min(std::abs(dem.geo().cell_size_x()), std::abs(dem.geo().cell_size_y()));
   coverage_ = coverage_channels(surface_);
+  // Counted before fill_heights, which empties an adopted `dem` (counted
+  // after, every adopted DEM was "small" and took the grid: issue 36).
+  const std::size_t cells = dem.size();
   // A raised copy is the scene's own: its storage can become the heights.
   fill_heights(dem, raised ? &*raised : adopt, static_cast<float>(input.vertical_exaggeration));
 
   embree_->open();
   if (geometry == TerrainGeometry::Auto)
-    geometry =
-        dem.size() < kHeightFieldMinCells ? TerrainGeometry::Grid : TerrainGeometry::HeightField;
+    geometry = cells < kHeightFieldMinCells ? TerrainGeometry::Grid : TerrainGeometry::HeightField;
   if (geometry == TerrainGeometry::Grid) {
     // The float3 vertex a cell and Embree's BVH over the grids.
-    require_memory(dem.size() * 32, "the terrain's grid geometry", "crop or resample the DEM");
+    require_memory(cells * 32, "the terrain's grid geometry", "crop or resample the DEM");
     attach_terrain_grids();
   } else {
     attach_height_field();

@@ -5,9 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "terrain/error.h"
@@ -94,4 +97,42 @@ TEST(BlockCache, RefusesABudgetBelowOneBlock) {
     EXPECT_NE(what.find("--memory-budget"), std::string::npos) << what;
   }
   EXPECT_NO_THROW(BlockCache(kLargest, kLargest, block_of));
+}
+
+// Misses read outside the cache's lock: two threads missing different blocks
+// read them side by side (the out-of-core render decodes pages on every
+// core), and threads missing one block read it once and all get it.
+TEST(BlockCache, ReadsDifferentBlocksSideBySideAndOneBlockOnce) {
+  std::atomic<int> inside{0}, most{0}, calls{0};
+  BlockCache cache(1 << 20, kLargest, [&](std::uint64_t key) {
+    ++calls;
+    const int now = ++inside;
+    int seen = most.load();
+    while (now > seen && !most.compare_exchange_weak(seen, now)) {
+    }
+    // Wait (2 s at most) for the other thread's read to start, and a while
+    // for threads asking for this block.
+    for (int i = 0; i < 200 && most.load() < 2; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    --inside;
+    return block_of(key);
+  });
+  {
+    std::thread a([&] { cache.get(1); });
+    std::thread b([&] { cache.get(2); });
+    a.join();
+    b.join();
+  }
+  EXPECT_EQ(most.load(), 2) << "the two misses were read one after the other";
+  calls = 0;
+  std::vector<std::thread> threads;
+  std::atomic<int> right{0};
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&] { right += cache.get(7)->front() == 7.0f ? 1 : 0; });
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(calls.load(), 1);
+  EXPECT_EQ(right.load(), 4);
+  EXPECT_EQ(cache.stats().misses, 3u);
+  EXPECT_EQ(cache.stats().hits, 3u);
 }

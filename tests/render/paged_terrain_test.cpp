@@ -149,6 +149,37 @@ TEST(PagedTerrain, ImagesAreTheSameBitsAtAnyBudgetAndThreadCount) {
   }
 }
 
+// The opening scan reads strips of page_cells() rows side by side, each leaf
+// row whose last vertex row opens the next strip completed from that strip
+// (issue 36: the parallel opening read). Whatever the strips (16, 32 or one
+// for the whole raster) and the threads, the leaves and extremes are the same
+// bits.
+TEST(PagedTerrain, ScanGivesTheSameLeavesAtAnyStripAndThreadCount) {
+  const fs::path dem = tiled_dem();
+  std::vector<HeightFieldBlocks::MinMax> reference;
+  Eigen::Vector3f highest, lowest;
+  for (const int page : {256, 16, 32}) {
+    for (const int threads : {1, 2}) {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      PagedTerrain paged(dem, std::uint64_t{1} << 20, 1.0f, page);
+      const std::vector<HeightFieldBlocks::MinMax> leaves = paged.take_leaves();
+      ASSERT_EQ(leaves.size(), std::size_t{75} * 55);  // 299 x 219 cells in leaves of 4
+      if (reference.empty()) {
+        reference = leaves;
+        highest = paged.highest(), lowest = paged.lowest();
+        continue;
+      }
+      for (std::size_t i = 0; i < leaves.size(); ++i) {
+        ASSERT_EQ(leaves[i].lo, reference[i].lo) << "leaf " << i << ", strips of " << page;
+        ASSERT_EQ(leaves[i].hi, reference[i].hi) << "leaf " << i << ", strips of " << page;
+      }
+      EXPECT_EQ(paged.highest(), highest) << "strips of " << page << ", " << threads;
+      EXPECT_EQ(paged.lowest(), lowest) << "strips of " << page << ", " << threads;
+      EXPECT_EQ(paged.scan_bytes(), std::uint64_t{kWidth} * kHeight * sizeof(float));
+    }
+  }
+}
+
 TEST(PagedTerrain, RefusesABudgetBelowOnePage) {
   const fs::path dem = tiled_dem();
   try {
