@@ -46,15 +46,19 @@ std::string wkt_of(int epsg) {
 
 // w x h cells of `cell` m in UTM (zone 33, north or south) of ridges, bowls
 // and a plateau: heights with full float mantissas, concave and convex ground
-// (finite and infinite TSA) and slopes facing every way.
-fs::path relief(int w, int h, double cell, bool south, const std::string& name) {
+// (finite and infinite TSA) and slopes facing every way. With base 0 the
+// ground crosses sea level: heights of millimetres, whose float bits reach
+// 2^-30 m, beside hundreds of metres, so that sums of rows in double round
+// (and would round differently in a window starting elsewhere).
+fs::path relief(int w, int h, double cell, bool south, const std::string& name,
+                double base = 1800.0) {
   HeightField g(w, h, 0.0f, drift::terrain::local_georeference(cell));
   g.geo().crs_wkt = wkt_of(south ? 32733 : 32633);
   g.geo().geotransform = {500000.0, cell, 0.0, south ? 5200000.0 : 5100000.0, 0.0, -cell};
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const double e = x * cell, n = y * cell;
-      double z = 1800.0 + 420.0 * std::sin(e / 610.0) * std::cos(n / 470.0) +
+      double z = base + 420.0 * std::sin(e / 610.0) * std::cos(n / 470.0) +
                  95.0 * std::sin(e / 130.0 + n / 170.0) + 0.013 * e;
       if (std::hypot(e - 900.0, n - 700.0) < 250.0) z = std::min(z, 1900.0);  // a plateau
       g(x, y) = static_cast<float>(z);
@@ -112,8 +116,24 @@ CoverOptions quick() {  // the paper's cells on a 10 m DEM
 }  // namespace
 
 TEST(SnowCoverTiled, GivesTheOnePassBitsAtAnyBlockSize) {
-  const fs::path dem = relief(157, 131, 10.0, false, "north");
+  const fs::path dem = relief(157, 131, 9.973, false, "north");
   for (int block : {16, 37, 64}) expect_tiled_is_one_pass(dem, quick(), block);
+  const fs::path coast = relief(157, 131, 9.973, false, "coast", 0.0);
+  for (int block : {16, 50}) expect_tiled_is_one_pass(coast, quick(), block);
+}
+
+TEST(SnowCoverTiled, MudflatBesideACliffGivesTheOnePassBits) {
+  // Heights of a tenth of a millimetre east of a 5 km cliff: a row's sums in
+  // double from the west edge carry the cliff's 5e5 m and round at 2^-34 m,
+  // a window east of the cliff does not: only exact sums agree.
+  HeightField g(200, 90, 0.0f, drift::terrain::local_georeference(10.0));
+  for (int y = 0; y < g.height(); ++y)
+    for (int x = 0; x < g.width(); ++x)
+      g(x, y) = x < 60 ? static_cast<float>(5000.0 + 7.3 * std::sin(x * 0.7 + y * 0.3))
+                       : static_cast<float>(1e-4 * (1.3 + std::sin(x * 0.37) * std::cos(y * 0.29)));
+  const fs::path p = dir() / "mudflat.tif";
+  drift::terrain::write_geotiff(g, p, {"height", "m"});
+  for (int block : {16, 40}) expect_tiled_is_one_pass(p, quick(), block);
 }
 
 TEST(SnowCoverTiled, MetricDefaultsSnowLineMeanSunAndSouth) {
