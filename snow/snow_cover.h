@@ -84,7 +84,7 @@ int cover_halo(const CoverOptions& o, double cell_m);
 // OutputSet if any). The outputs hold the bits snow_cover gives on the whole
 // DEM, whatever the block size and thread count
 // (tests/snow/snow_cover_tiled_test.cpp). Memory: a window of
-// (block + 2 halo)^2 cells at 36 bytes, the smoothing's prefix sums and
+// (block + 2 halo)^2 cells at 24 bytes, the smoothing's prefix sums and
 // GDAL's cache, checked (DRIFT_MEMORY_LIMIT) before any work.
 constexpr int kCoverBlock = 2048;
 struct CoverFiles {

@@ -47,7 +47,7 @@ ImportResult import_dem(const std::filesystem::path& path, const ImportOptions& 
 // grows fourfold until it reaches r + 1 beyond every filled cell of the block.
 // Heights need no other neighbourhood. The file holds the bits import_dem
 // gives, whatever the block size (tests/terrain/import_tiled_test.cpp).
-// Memory: a window of (block + 2 halo)^2 cells at 22 bytes and GDAL's caches
+// Memory: a window of (block + 2 halo)^2 cells at 28 bytes and GDAL's caches
 // (128 MiB), checked (DRIFT_MEMORY_LIMIT) before each window is read.
 constexpr int kImportBlock = 2048;
 struct ImportFileResult {
