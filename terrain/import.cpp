@@ -253,8 +253,11 @@ bool reprojected_extent(const fs::path& path, int epsg, double& width_m, double&
 // The warped grid covers the crop box (or the source) at the plan's cell: checks
 // it fits in memory three times over (GDAL's grid, ours, the nodata filling's
 // copy) before GDAL allocates it.
+// Tiled (import_dem_to_file), only the grid's size is checked, against
+// kMaxTiledCells: the memory is the blocks'.
+constexpr double kMaxTiledCells = 17179869184.0;  // 2^34 cells (64 GiB of float32)
 void require_warp_memory(const RasterHeader& h, const ImportOptions& o, const WarpPlan& plan,
-                         const fs::path& path) {
+                         const fs::path& path, bool tiled = false) {
   const auto metric = cell_size_metres(h.geo, h.width, h.height);
   double width_m = h.width * metric[0], height_m = h.height * metric[1];
   double warped_w = 0.0, warped_h = 0.0;
@@ -279,9 +282,10 @@ void require_warp_memory(const RasterHeader& h, const ImportOptions& o, const Wa
   const std::string what = "importing '" + path.string() + "' at " + fmt(cell_m) +
                            " m cells (about " + fmt(columns) + " x " + fmt(rows) + ")";
   const std::string fix = "crop it (--crop, --crop-lonlat) or give a coarser --resample";
-  if (!(columns * rows < 2.0e9) || !std::isfinite(bytes)) {
+  if (!(columns * rows < (tiled ? kMaxTiledCells : 2.0e9)) || !std::isfinite(bytes)) {
     throw Error(what + " is too large a grid; " + fix);
   }
+  if (tiled) return;
   require_memory(static_cast<std::uint64_t>(bytes), what, fix);
 }
 
@@ -461,6 +465,7 @@ ImportFileResult import_dem_to_file(const fs::path& path, const fs::path& output
   result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
                           std::to_string(header.width) + " x " + std::to_string(header.height));
   const WarpPlan plan = plan_warp(path, header, o, result.report);
+  require_warp_memory(header, o, plan, path, true);
   Warped warped;
   open_warped(warped, path, plan, o);
   GDALDataset& ds = warped.dataset();
