@@ -107,6 +107,17 @@ HeightField RasterBlockReader::read_coarse(int max_side) const {
   return coarse;
 }
 
+namespace {
+
+// GDAL's reasons never say that the output's folder is gone (as write_geotiff).
+std::string write_reason(const std::filesystem::path& path, const std::string& gdal) {
+  std::error_code ec;
+  const std::filesystem::path folder = path.parent_path().empty() ? "." : path.parent_path();
+  return std::filesystem::is_directory(folder, ec) ? gdal : write_failure_reason(path, 0);
+}
+
+}  // namespace
+
 struct RasterBlockWriter::Dataset {
   GDALDataset* ds = nullptr;
   GDALRasterBand* band = nullptr;
@@ -130,7 +141,9 @@ RasterBlockWriter::RasterBlockWriter(const std::filesystem::path& path, int widt
   co.SetNameValue("BIGTIFF", "IF_SAFER");
   co.SetNameValue("TILED", "YES");
   ds_->ds = driver->Create(file_->temp_path().c_str(), width, height, 1, GDT_Float32, co.List());
-  if (!ds_->ds) throw Error("cannot create '" + path.string() + "': " + last_gdal_message());
+  if (!ds_->ds)
+    throw Error("cannot create '" + path.string() +
+                "': " + write_reason(path, last_gdal_message()));
   double gt[6];
   std::copy(geo.geotransform.begin(), geo.geotransform.end(), gt);
   ds_->ds->SetGeoTransform(gt);
@@ -155,8 +168,8 @@ void RasterBlockWriter::write(int x, int y, int w, int h, const float* cells) {
   const CPLErr err = ds_->band->RasterIO(GF_Write, x, y, w, h, const_cast<float*>(cells), w, h,
                                          GDT_Float32, 0, 0, nullptr);
   if (err != CE_None) {
-    throw Error("cannot write '" + path_.string() + "': " + last_gdal_message() +
-                " (disk full or not writable?)");
+    throw Error("cannot write '" + path_.string() +
+                "': " + write_reason(path_, last_gdal_message() + " (disk full or not writable?)"));
   }
 }
 
@@ -166,8 +179,8 @@ void RasterBlockWriter::finish() {
   GDALClose(GDALDataset::ToHandle(ds_->ds));
   ds_->ds = nullptr;
   if (CPLGetLastErrorType() == CE_Failure) {
-    throw Error("cannot write '" + path_.string() + "': " + last_gdal_message() +
-                " (disk full or not writable?)");
+    throw Error("cannot write '" + path_.string() +
+                "': " + write_reason(path_, last_gdal_message() + " (disk full or not writable?)"));
   }
   file_->commit();
 }
