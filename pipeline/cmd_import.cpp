@@ -1,11 +1,13 @@
 // drift import DEM -o OUT.tif: any raster GDAL reads -> float32 GeoTIFF in
-// metres (UTM of its centre), nodata filled, optionally cropped and resampled.
+// metres (UTM of its centre), nodata filled, optionally cropped and resampled;
+// block by block (terrain::import_dem_to_file), so rasters larger than memory.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 
 #include "pipeline/cli.h"
+#include "pipeline/progress_bar.h"
 #include "terrain/import.h"
 #include "terrain/output_set.h"
 #include "terrain/raster_io.h"
@@ -33,11 +35,12 @@ void run_import(const ImportCommand& c) {
                  {{"crop", "--crop"},
                   {"crop_lonlat", "--crop-lonlat"},
                   {"resample_m", "--resample"},
-                  {"exaggeration", "--exaggerate"}},
+                  {"exaggeration", "--exaggerate"},
+                  {"block", "--block"}},
                  false);
   OutputSet outputs({c.output}, {c.input});
-  const terrain::ImportResult r = terrain::import_dem(c.input, o);
-  terrain::write_geotiff(r.grid, c.output, {"height (m)", "m"});
+  const terrain::ImportFileResult r =
+      terrain::import_dem_to_file(c.input, c.output, o, terminal_progress("import"));
   outputs.commit();
   for (const auto& line : r.report) std::printf("import: %s\n", line.c_str());
   std::printf("import: wrote %s\n", c.output.c_str());
@@ -63,6 +66,8 @@ void add_import_command(CLI::App& root) {
   sub->add_option("--resample", c->resample, "output cell size in metres");
   sub->add_flag("--keep-crs", c->options.keep_crs, "keep a geographic CRS (cells stay degrees)");
   sub->add_option("--exaggerate", c->options.exaggeration, "vertical exaggeration (0, 100]");
+  sub->add_option("--block", c->options.block,
+                  "cells a side of the blocks worked in (default: DRIFT_BLOCK_CELLS, else 2048)");
 }
 
 DRIFT_COMMAND(10, add_import_command);

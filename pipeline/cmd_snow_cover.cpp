@@ -1,5 +1,6 @@
 // drift snow cover DEM.tif -o COVER.tif: the snow-cover descriptor of paper 001
-// (Tangent Sphere Accessibility of the smoothed DEM, altitude, sun aspect).
+// (Tangent Sphere Accessibility of the smoothed DEM, altitude, sun aspect),
+// block by block (snow::snow_cover_to_files), so DEMs larger than memory.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <memory>
@@ -11,7 +12,6 @@
 #include "snow/snow_cover.h"
 #include "terrain/error.h"
 #include "terrain/output_set.h"
-#include "terrain/raster_io.h"
 
 namespace drift::pipeline {
 
@@ -21,6 +21,7 @@ struct CoverCommand {
   std::string dem, output, accessibility, descriptor, hemisphere = "auto",
                                                       sun_step = "per-triangle";
   double snow_line = 0.0;
+  int block = 0;
   // The table's flags (snow/cover_parameters.h); only those given override
   // CoverOptions{}'s defaults.
   ParameterFlags<snow::CoverOptions> parameters{snow::cover_parameters()};
@@ -46,30 +47,23 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
   flags.emplace_back("snow_line_m", "--snow-line");
   validate_flags([&o] { o.validate(); }, flags);
   OutputSet outputs({c.output, c.descriptor, c.accessibility}, {c.dem});
-  const terrain::HeightField dem = terrain::read_raster(c.dem);
-  snow::CoverResult r;
+  snow::CoverFilesResult r;
   try {
-    r = snow::snow_cover(dem, o, terminal_progress("snow cover"));
+    // Block by block: the cover is what the renderer's [snow] cover takes,
+    // snow's share 1 - t.
+    r = snow::snow_cover_to_files({c.dem, c.output, c.descriptor, c.accessibility, c.block}, o,
+                                  terminal_progress("snow cover"));
+  } catch (const Cancelled&) {
+    throw;
   } catch (const Error& e) {
     throw Error(c.dem + ": " + e.what());
   }
-  // The cover is what the renderer's [snow] cover takes: snow's share, 1 - t.
-  terrain::HeightField cover = r.descriptor;
-  for (float& v : cover.values()) v = 1.0f - v;
-  terrain::write_geotiff(cover, c.output, {"snow cover (1 - t)", ""});
-  if (!c.descriptor.empty())
-    terrain::write_geotiff(r.descriptor, c.descriptor, {"snow descriptor t (0 snow, 1 rock)", ""});
-  if (!c.accessibility.empty())
-    terrain::write_geotiff(r.accessibility, c.accessibility, {"tangent sphere accessibility", "m"});
   outputs.commit();
-  double mean = 0;
-  for (float v : cover.values()) mean += v;
-  const double cell = dem.geo().cell_size_x();
   std::printf(
       "snow cover: %d x %d cells of %g m, region %d cells, probe radius %g m, mean cover %.3f, "
       "sun from the %s -> %s\n",
-      cover.width(), cover.height(), cell, snow::region_in_cells(o, cell),
-      snow::radius_in_metres(o, cell), mean / static_cast<double>(cover.size()),
+      r.width, r.height, r.cell_m, snow::region_in_cells(o, r.cell_m),
+      snow::radius_in_metres(o, r.cell_m), r.mean_cover,
       r.southern ? "north (southern hemisphere)" : "south (northern hemisphere)", c.output.c_str());
 }
 
@@ -98,6 +92,9 @@ void add_snow_cover_command(CLI::App& root) {
       ->capture_default_str();
   sub->add_option("--descriptor", c->descriptor, "also write t (0 snow, 1 rock)");
   sub->add_option("--accessibility", c->accessibility, "also write the TSA in metres");
+  sub->add_option("--block", c->block,
+                  "cells a side of the blocks worked in (default: DRIFT_BLOCK_CELLS, else 2048)")
+      ->check(CLI::Range(16, 1048576));
 }
 
 DRIFT_COMMAND(40, add_snow_cover_command);

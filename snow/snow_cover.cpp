@@ -2,11 +2,13 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -17,6 +19,8 @@
 #include "terrain/geodesy.h"
 #include "terrain/memory.h"
 #include "terrain/parameter.h"
+#include "terrain/raster_blocks.h"
+#include "terrain/raster_io.h"
 
 namespace drift::snow {
 
@@ -26,6 +30,8 @@ using terrain::HeightField;
 namespace {
 
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
+// GDAL's block cache, as the block reader and writer hold it (terrain/raster_blocks.h).
+constexpr std::uint64_t kGdalCacheBytes = std::uint64_t{64} << 20;
 
 // Rows in fixed blocks: the partition is the same for any thread count.
 template <class Fn>
@@ -58,11 +64,15 @@ constexpr std::array<std::array<int, 4>, 12> kTriangles = {{
     {0, 1, -1, 1},
 }};
 
-// Position of cell (x, row) in a local metric frame (x east, y north, z up),
-// the border clamped.
-Vector3f position(const HeightField& dem, int x, int row, float dx, float dy) {
-  const int cx = std::clamp(x, 0, dem.width() - 1), cr = std::clamp(row, 0, dem.height() - 1);
-  return {cx * dx, -cr * dy, dem(cx, cr)};
+// Cell (x + dc, row + dr), the border clamped, from cell (x, row) in a local
+// metric frame (x east, y north, z up). Differences of whole cells, not of two
+// positions from the grid's corner: the same bits wherever the pair lies in the
+// grid, so in a window of it too (the tiled descriptor).
+Vector3f offset(const HeightField& dem, int x, int row, int dc, int dr, float dx, float dy) {
+  const int cx = std::clamp(x + dc, 0, dem.width() - 1);
+  const int cr = std::clamp(row + dr, 0, dem.height() - 1);
+  return {static_cast<float>(cx - x) * dx, -static_cast<float>(cr - row) * dy,
+          dem(cx, cr) - dem(x, row)};
 }
 
 float smoothstep(float e0, float e1, float v) {
@@ -89,46 +99,68 @@ double radius_in_metres(const CoverOptions& o, double cell_m) {
 
 namespace {
 
-// Row prefix sums (double) of the DEM padded by n cells on every side (edge
-// cells repeated): row pr holds sum[px] = the first px padded heights.
-std::vector<double> padded_row_sums(const HeightField& dem, int n) {
-  const int w = dem.width(), h = dem.height(), pw = w + 2 * n + 1;
-  std::vector<double> sums(static_cast<std::size_t>(pw) * (h + 2 * n));
-  for_rows(h + 2 * n, [&](int pr) {
-    const int row = std::clamp(pr - n, 0, h - 1);
-    double* line = &sums[static_cast<std::size_t>(pr) * pw];
-    line[0] = 0.0;
-    for (int px = 0; px + 1 < pw; ++px)
-      line[px + 1] = line[px] + dem(std::clamp(px - n, 0, w - 1), row);
-  });
-  return sums;
-}
+// Heights as fixed-point integers of 2^-32 m: exact for every float height of
+// at least 2^-9 m in magnitude (finer bits of smaller ones are cut, the same
+// way wherever the cell lies); |z| <= 1e7 m (terrain/raster_io.h) is < 2^56.
+using Fixed = std::int64_t;
+__extension__ typedef __int128 FixedSum;      // a row's sum: 2^56 a cell, room for 2^70 cells
+constexpr double kFixedScale = 4294967296.0;  // 2^32: exact in double
+inline Fixed to_fixed(float v) { return static_cast<Fixed>(static_cast<double>(v) * kFixedScale); }
+
+// Rows of the output smoothed together: each chunk makes the prefix sums of
+// the rows its diamonds reach (chunk + 2n rows), so memory is chunk-sized, not
+// grid-sized.
+constexpr int kSmoothChunk = 64;
 
 }  // namespace
 
+// The diamond sums are exact integer sums, so they do not depend on where a
+// row's prefix sums start: a window of the DEM smooths to the bits the whole
+// DEM gives (away from its edges), which the tiled descriptor
+// (snow_cover_to_files) relies on. Double prefix sums from each row's first
+// cell would round differently in a window that starts elsewhere.
 HeightField smooth(const HeightField& dem, int region) {
   const int w = dem.width(), h = dem.height(), n = region, pw = w + 2 * n + 1;
-  const std::vector<double> sums = padded_row_sums(dem, n);
   HeightField out(w, h, 0.0f, dem.geo());
   const double inv_count = 1.0 / smoothing_neighbour_count(n);
-  for_rows(h, [&](int row) {
-    for (int x = 0; x < w; ++x) {
-      double sum = -static_cast<double>(dem(x, row));  // the diamond without its centre
-      for (int dr = -n; dr <= n; ++dr) {
-        const int reach = n - std::abs(dr);
-        const double* line = &sums[static_cast<std::size_t>(row + n + dr) * pw];
-        sum += line[x + n + reach + 1] - line[x + n - reach];
-      }
-      out(x, row) = static_cast<float>(0.5 * (dem(x, row) + sum * inv_count));
-    }
-  });
+  const int chunks = (h + kSmoothChunk - 1) / kSmoothChunk;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, chunks, 1),
+      [&](const tbb::blocked_range<int>& range) {
+        std::vector<FixedSum> sums;
+        for (int c = range.begin(); c < range.end(); ++c) {
+          const int r0 = c * kSmoothChunk, r1 = std::min(h, r0 + kSmoothChunk);
+          // Padded rows r0 - n .. r1 - 1 + n (edge cells repeated beyond the
+          // border); line k holds sum[px] = the first px padded heights.
+          const int lines = r1 - r0 + 2 * n;
+          sums.resize(static_cast<std::size_t>(lines) * pw);
+          for (int k = 0; k < lines; ++k) {
+            const int row = std::clamp(r0 - n + k, 0, h - 1);
+            FixedSum* line = &sums[static_cast<std::size_t>(k) * pw];
+            line[0] = 0;
+            for (int px = 0; px + 1 < pw; ++px)
+              line[px + 1] = line[px] + to_fixed(dem(std::clamp(px - n, 0, w - 1), row));
+          }
+          for (int row = r0; row < r1; ++row)
+            for (int x = 0; x < w; ++x) {
+              FixedSum sum = -FixedSum{to_fixed(dem(x, row))};  // the diamond without its centre
+              for (int dr = -n; dr <= n; ++dr) {
+                const int reach = n - std::abs(dr);
+                const FixedSum* line = &sums[static_cast<std::size_t>(row - r0 + n + dr) * pw];
+                sum += line[x + n + reach + 1] - line[x + n - reach];
+              }
+              const double mean = static_cast<double>(sum) / kFixedScale * inv_count;
+              out(x, row) = static_cast<float>(0.5 * (dem(x, row) + mean));
+            }
+        }
+      },
+      tbb::simple_partitioner());
   return out;
 }
 
 float tsa_at(const HeightField& dem, const terrain::Grid<Vector3f>& normals, int x, int row) {
   const float dx = static_cast<float>(dem.geo().cell_size_x());
   const float dy = static_cast<float>(dem.geo().cell_size_y());
-  const Vector3f X = position(dem, x, row, dx, dy);
   const Vector3f& N = normals(x, row);
   float best = kInfinity;
   // The far vertices of the 12 triangles are the 8 neighbours.
@@ -137,12 +169,12 @@ float tsa_at(const HeightField& dem, const terrain::Grid<Vector3f>& normals, int
       if (dr == 0 && dc == 0) continue;
       const int vx = x + dc, vr = row + dr;
       if (vx < 0 || vr < 0 || vx >= dem.width() || vr >= dem.height()) continue;
-      const Vector3f P = position(dem, vx, vr, dx, dy);
+      const Vector3f P_minus_X = offset(dem, x, row, dc, dr, dx, dy);
       const Vector3f& M = normals(vx, vr);
       // Paper eq. (3): the sphere tangent at X (centre X + tN) that touches
       // the tangent plane (P, M) has t = ((X - P) . M) / (1 - N . M).
       const float denominator = 1.0f - N.dot(M);
-      const float numerator = (X - P).dot(M);
+      const float numerator = -P_minus_X.dot(M);
       if (denominator <= 1e-7f || numerator <= 0.0f) continue;  // no bound from this plane
       best = std::min(best, numerator / denominator);
     }
@@ -162,31 +194,55 @@ HeightField tangent_sphere_accessibility(const HeightField& dem) {
 
 namespace {
 
-void validate(const HeightField& dem, const CoverOptions& o) {
+// Checks of the DEM's shape and georeference, for the whole DEM or a header.
+void validate_grid(int width, int height, const terrain::GeoReference& geo, const CoverOptions& o) {
   o.validate();
-  require(dem.width() >= 3 && dem.height() >= 3, "the DEM must be at least 3 x 3 cells");
-  require(dem.geo().north_up() && dem.geo().cell_size_x() > 0 && dem.geo().cell_size_y() > 0,
+  require(width >= 3 && height >= 3, "the DEM must be at least 3 x 3 cells");
+  require(geo.north_up() && geo.cell_size_x() > 0 && geo.cell_size_y() > 0,
           "the DEM must be north-up with positive cell sizes; warp it with drift import");
-  require(!terrain::is_geographic(dem.geo().crs_wkt),
+  require(!terrain::is_geographic(geo.crs_wkt),
           "the DEM is in degrees; the descriptor needs metres: run drift import first");
-  const int n = region_in_cells(o, dem.geo().cell_size_x());
+  const int n = region_in_cells(o, geo.cell_size_x());
   require(n <= 256, "the smoothing region is " + std::to_string(n) +
                         " cells on this DEM (over 256): lower --region or resample the DEM");
+}
+
+std::string nodata_message(std::size_t nodata) {
+  return "the DEM has " + std::to_string(nodata) +
+         " nodata cells; drift import fills them (run it first)";
+}
+
+// Bytes a cell of the grid worked on (the DEM or a window of it) at the
+// descriptor's peak, the TSA step: the DEM, the smoothed field and the TSA (4
+// each) and the normals (12); later steps hold the DEM, the smoothed field,
+// the TSA, t and t smoothed (20). The smoothing's prefix sums are chunk-sized
+// (16 bytes a cell of kSmoothChunk + 2n rows a thread), counted apart.
+// Measured: a 3072^2 DEM in blocks of 2048 (windows of 2204^2) peaked 148 MB
+// above a 32^2 one, where this counts 140 MB.
+constexpr std::uint64_t kCoverBytesPerCell = 24;
+
+std::uint64_t smoothing_bytes(int width, int region) {
+  const std::uint64_t threads = std::max(1, tbb::this_task_arena::max_concurrency());
+  return threads * (kSmoothChunk + 2 * std::uint64_t(region)) * (width + 2 * region + 1) * 16;
+}
+
+void validate(const HeightField& dem, const CoverOptions& o) {
+  validate_grid(dem.width(), dem.height(), dem.geo(), o);
   std::size_t nodata = 0;
   for (float v : dem.values()) nodata += std::isnan(v) ? 1 : 0;
-  require(nodata == 0, "the DEM has " + std::to_string(nodata) +
-                           " nodata cells; drift import fills them (run it first)");
-  // The smoothed field, the TSA, the descriptor and two working grids.
-  require_memory(dem.size() * sizeof(float) * 6,
+  require(nodata == 0, nodata_message(nodata));
+  require_memory(dem.size() * kCoverBytesPerCell +
+                     smoothing_bytes(dem.width(), region_in_cells(o, dem.geo().cell_size_x())),
                  "the snow cover of a " + std::to_string(dem.width()) + " x " +
                      std::to_string(dem.height()) + " DEM",
                  "crop or resample the DEM first (drift import --crop, --resample)");
 }
 
-bool in_southern_hemisphere(const HeightField& dem, Hemisphere hemisphere) {
+bool in_southern_hemisphere(const terrain::GeoReference& geo, int width, int height,
+                            Hemisphere hemisphere) {
   if (hemisphere != Hemisphere::Auto) return hemisphere == Hemisphere::South;
-  if (dem.geo().crs_wkt.empty()) return false;
-  return terrain::centre_lonlat(dem.geo(), dem.width(), dem.height())[1] < 0.0;
+  if (geo.crs_wkt.empty()) return false;
+  return terrain::centre_lonlat(geo, width, height)[1] < 0.0;
 }
 
 // Altitude factor a(z) (docs/snow.md, Steps, 4): (z / z_max)^2, or a smooth step
@@ -206,12 +262,11 @@ struct Altitude {
 };
 
 // Steps 3-4: transfer g (eq. 4) and altitude on the snow amount; t = 1 - snow.
+// z_max is the whole DEM's highest height (a window's would differ).
 HeightField descriptor_from_accessibility(const HeightField& dem, const HeightField& tsa,
-                                          const CoverOptions& o) {
+                                          const CoverOptions& o, float z_max) {
   const float r = static_cast<float>(radius_in_metres(o, dem.geo().cell_size_x()));
   const float b = static_cast<float>(o.floor);
-  float z_max = -kInfinity;
-  for (float v : dem.values()) z_max = std::max(z_max, v);
   const Altitude altitude{z_max, o};
   HeightField t(dem.width(), dem.height(), 0.0f, dem.geo());
   t.geo().nodata = std::nullopt;
@@ -232,9 +287,8 @@ float triangle_phi(const HeightField& smoothed, int x, int row, const std::array
                    float sun_y, float theta1) {
   const float dx = static_cast<float>(smoothed.geo().cell_size_x());
   const float dy = static_cast<float>(smoothed.geo().cell_size_y());
-  const Vector3f X = position(smoothed, x, row, dx, dy);
-  const Vector3f a = position(smoothed, x + tri[0], row + tri[1], dx, dy) - X;
-  const Vector3f c = position(smoothed, x + tri[2], row + tri[3], dx, dy) - X;
+  const Vector3f a = offset(smoothed, x, row, tri[0], tri[1], dx, dy);
+  const Vector3f c = offset(smoothed, x, row, tri[2], tri[3], dx, dy);
   const Vector3f m = a.cross(c);  // the face normal, up or down (sign below)
   const float h2 = m.x() * m.x() + m.y() * m.y();
   if (h2 <= 1e-12f * m.squaredNorm()) return 1.0f;
@@ -282,10 +336,17 @@ void CoverOptions::validate() const {
                            "(-inf, inf) m");
 }
 
-CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {
-  validate(dem, o);
+namespace {
+
+// Steps 1-6 on `dem`, the whole DEM or a window of it with a halo
+// (snow_cover_to_files): z_max and the hemisphere are the whole DEM's. Every
+// step reads the DEM through its own cells and the clamped border only, so a
+// window's cells farther than cover_halo from its inner edges get the whole
+// DEM's bits.
+CoverResult cover_grid(const HeightField& dem, const CoverOptions& o, float z_max, bool southern,
+                       const ProgressFn& progress) {
   CoverResult result;
-  result.southern = in_southern_hemisphere(dem, o.hemisphere);
+  result.southern = southern;
   // 1. Smoothing (paper sec. 4.1 lines 1-3), k times over the region in cells.
   progress(0.0, "smoothing");
   const int n = region_in_cells(o, dem.geo().cell_size_x());
@@ -299,11 +360,134 @@ CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const Prog
   if (!progress(0.7, "accessibility")) throw Cancelled();
   // 3-4. Transfer and altitude (lines 6-7; docs/snow.md, Steps, 4); 5. smooth t
   // once (line 9).
-  HeightField t = smooth(descriptor_from_accessibility(dem, result.accessibility, o), 1);
+  HeightField t = smooth(descriptor_from_accessibility(dem, result.accessibility, o, z_max), 1);
   // 6. Sun (lines 10-15).
   if (o.sun_range_deg > 0.0) t = apply_sun(t, smoothed, o, result.southern);
   progress(1.0, "");
   result.descriptor = std::move(t);
+  return result;
+}
+
+}  // namespace
+
+int cover_halo(const CoverOptions& o, double cell_m) {
+  // k smoothing passes reach n cells each; the normals (Horn, 3 x 3) and the
+  // TSA's neighbour normals 2 more; the smoothing of t 1 more (the sun step
+  // reads the smoothed field 1 cell around, within that).
+  return o.iterations * region_in_cells(o, cell_m) + 3;
+}
+
+CoverResult snow_cover(const HeightField& dem, const CoverOptions& o, const ProgressFn& progress) {
+  validate(dem, o);
+  float z_max = -kInfinity;
+  for (float v : dem.values()) z_max = std::max(z_max, v);
+  return cover_grid(dem, o, z_max,
+                    in_southern_hemisphere(dem.geo(), dem.width(), dem.height(), o.hemisphere),
+                    progress);
+}
+
+CoverFilesResult snow_cover_to_files(const CoverFiles& files, const CoverOptions& o,
+                                     const ProgressFn& progress) {
+  terrain::RasterBlockReader reader(files.dem);
+  const int width = reader.width(), height = reader.height();
+  const terrain::GeoReference& geo = reader.geo();
+  validate_grid(width, height, geo, o);
+  const double cell = geo.cell_size_x();
+  const int block = terrain::block_cells(files.block, kCoverBlock);
+  const int halo = cover_halo(o, cell), n = region_in_cells(o, cell);
+  // The largest window: a block with its halo on every side.
+  const int side_x = std::min(width, block + 2 * halo), side_y = std::min(height, block + 2 * halo);
+  const std::uint64_t window_cells = std::uint64_t(side_x) * side_y;
+  require_memory(
+      window_cells * kCoverBytesPerCell + smoothing_bytes(side_x, n) +
+          std::uint64_t(std::min(block, width)) * std::min(block, height) * sizeof(float) +
+          kGdalCacheBytes,
+      "the snow cover of a " + std::to_string(width) + " x " + std::to_string(height) +
+          " DEM in blocks of " + std::to_string(block) + " cells (windows of " +
+          std::to_string(side_x) + " x " + std::to_string(side_y) + " with a " +
+          std::to_string(halo) + "-cell halo)",
+      "give a smaller --block, or a smaller --region or --iterations");
+  const int bx_count = (width + block - 1) / block, by_count = (height + block - 1) / block;
+  const double blocks = double(bx_count) * by_count;
+  // Pass 1: the DEM's highest cell (the altitude factor's z_max) and its
+  // nodata, block by block.
+  CoverFilesResult result;
+  result.width = width, result.height = height, result.block = block, result.halo = halo;
+  result.cell_m = cell;
+  float z_max = -kInfinity;
+  std::size_t nodata = 0;
+  for (int j = 0; j < by_count; ++j)
+    for (int i = 0; i < bx_count; ++i) {
+      const int bx = i * block, by = j * block;
+      const std::vector<float> cells =
+          reader.read(bx, by, std::min(block, width - bx), std::min(block, height - by));
+      for (float v : cells) {
+        if (std::isnan(v))
+          ++nodata;
+        else
+          z_max = std::max(z_max, v);
+      }
+      if (!progress(0.05 * (j * bx_count + i + 1) / blocks, "heights")) throw Cancelled();
+    }
+  require(nodata == 0, nodata_message(nodata));
+  result.southern = in_southern_hemisphere(geo, width, height, o.hemisphere);
+  // Pass 2: each block from its window.
+  using terrain::RasterBlockWriter;
+  std::unique_ptr<RasterBlockWriter> cover, descriptor, accessibility;
+  if (!files.cover.empty())
+    cover = std::make_unique<RasterBlockWriter>(files.cover, width, height, geo,
+                                                terrain::WriteOptions{"snow cover (1 - t)", ""});
+  if (!files.descriptor.empty())
+    descriptor = std::make_unique<RasterBlockWriter>(
+        files.descriptor, width, height, geo,
+        terrain::WriteOptions{"snow descriptor t (0 snow, 1 rock)", ""});
+  if (!files.accessibility.empty())
+    accessibility = std::make_unique<RasterBlockWriter>(
+        files.accessibility, width, height, geo,
+        terrain::WriteOptions{"tangent sphere accessibility", "m"});
+  std::vector<float> out;
+  double cover_sum = 0.0;
+  for (int j = 0; j < by_count; ++j)
+    for (int i = 0; i < bx_count; ++i) {
+      const int bx = i * block, by = j * block;
+      const int bw = std::min(block, width - bx), bh = std::min(block, height - by);
+      const int x0 = std::max(0, bx - halo), y0 = std::max(0, by - halo);
+      const int x1 = std::min(width, bx + bw + halo), y1 = std::min(height, by + bh + halo);
+      HeightField window(x1 - x0, y1 - y0, 0.0f, geo);
+      {
+        std::vector<float> cells = reader.read(x0, y0, x1 - x0, y1 - y0);
+        std::copy(cells.begin(), cells.end(), window.values().begin());
+      }
+      auto& gt = window.geo().geotransform;
+      gt[0] += x0 * gt[1], gt[3] += y0 * gt[5];
+      const double done = 0.05 + 0.95 * (j * bx_count + i) / blocks;
+      const CoverResult r = cover_grid(window, o, z_max, result.southern,
+                                       scaled_progress(progress, done, done + 0.95 / blocks));
+      const auto put = [&](RasterBlockWriter* writer, const HeightField& grid, bool one_minus) {
+        if (!writer && !one_minus) return;
+        out.resize(static_cast<std::size_t>(bw) * bh);
+        double sum = 0.0;
+        for (int y = 0; y < bh; ++y) {
+          double row_sum = 0.0;
+          for (int x = 0; x < bw; ++x) {
+            const float v = grid(bx - x0 + x, by - y0 + y);
+            const float value = one_minus ? 1.0f - v : v;
+            out[static_cast<std::size_t>(y) * bw + x] = value;
+            row_sum += value;
+          }
+          sum += row_sum;
+        }
+        if (one_minus) cover_sum += sum;
+        if (writer) writer->write(bx, by, bw, bh, out.data());
+      };
+      put(cover.get(), r.descriptor, true);
+      put(descriptor.get(), r.descriptor, false);
+      put(accessibility.get(), r.accessibility, false);
+    }
+  for (auto* writer : {cover.get(), descriptor.get(), accessibility.get()})
+    if (writer) writer->finish();
+  result.mean_cover = cover_sum / (double(width) * height);
+  progress(1.0, "");
   return result;
 }
 

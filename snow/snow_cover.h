@@ -20,6 +20,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <optional>
 
 #include "snow/cover_options.h"
@@ -69,5 +70,37 @@ struct CoverResult {
 // rotated DEM, or options out of range.
 CoverResult snow_cover(const terrain::HeightField& dem, const CoverOptions& options,
                        const ProgressFn& progress = no_progress);
+
+// The halo a block needs so that its cells get the whole DEM's bits: k n
+// (k smoothing passes over the region n, in cells) + 3 (the normals' 3 x 3, the
+// TSA's neighbour normals, the smoothing of t).
+int cover_halo(const CoverOptions& o, double cell_m);
+
+// The descriptor block by block, for DEMs larger than memory: a first pass
+// reads the DEM a block at a time for its highest cell (the altitude factor's
+// z_max) and its nodata; the second reads each block with cover_halo cells
+// around it, runs steps 1-6 on that window and writes the block of each
+// output (tiled float32 GeoTIFFs, terrain/raster_blocks.h; through the open
+// OutputSet if any). The outputs hold the bits snow_cover gives on the whole
+// DEM, whatever the block size and thread count
+// (tests/snow/snow_cover_tiled_test.cpp). Memory: a window of
+// (block + 2 halo)^2 cells at 24 bytes, the smoothing's prefix sums and
+// GDAL's cache, checked (DRIFT_MEMORY_LIMIT) before any work.
+constexpr int kCoverBlock = 2048;
+struct CoverFiles {
+  std::filesystem::path dem;            // the DEM (any raster GDAL reads, in metres)
+  std::filesystem::path cover;          // 1 - t (empty: not written)
+  std::filesystem::path descriptor;     // t (empty: not written)
+  std::filesystem::path accessibility;  // TSA in metres (empty: not written)
+  int block = 0;  // cells a side; 0: DRIFT_BLOCK_CELLS if set, else kCoverBlock
+};
+struct CoverFilesResult {
+  int width = 0, height = 0, block = 0, halo = 0;
+  double cell_m = 0.0;  // the DEM's cell size
+  bool southern = false;
+  double mean_cover = 0.0;  // mean of 1 - t over the DEM
+};
+CoverFilesResult snow_cover_to_files(const CoverFiles& files, const CoverOptions& options,
+                                     const ProgressFn& progress = no_progress);
 
 }  // namespace drift::snow

@@ -1,13 +1,16 @@
 #include "terrain/raster_blocks.h"
 
 #include <gdal_priv.h>
+#include <ogr_spatialref.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <string>
 
+#include "terrain/atomic_file.h"
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
 
@@ -102,6 +105,97 @@ HeightField RasterBlockReader::read_coarse(int max_side) const {
       if (v == nd) v = std::numeric_limits<float>::quiet_NaN();
   }
   return coarse;
+}
+
+namespace {
+
+// GDAL's reasons never say that the output's folder is gone (as write_geotiff).
+std::string write_reason(const std::filesystem::path& path, const std::string& gdal) {
+  std::error_code ec;
+  const std::filesystem::path folder = path.parent_path().empty() ? "." : path.parent_path();
+  return std::filesystem::is_directory(folder, ec) ? gdal : write_failure_reason(path, 0);
+}
+
+}  // namespace
+
+struct RasterBlockWriter::Dataset {
+  GDALDataset* ds = nullptr;
+  GDALRasterBand* band = nullptr;
+  ~Dataset() {
+    if (ds) GDALClose(GDALDataset::ToHandle(ds));
+  }
+};
+
+RasterBlockWriter::RasterBlockWriter(const std::filesystem::path& path, int width, int height,
+                                     const GeoReference& geo, const WriteOptions& options)
+    : path_(path), ds_(std::make_unique<Dataset>()), width_(width), height_(height) {
+  ensure_gdal();
+  if (width < 1 || height < 1) throw Error("cannot write '" + path.string() + "': it is empty");
+  file_ = std::make_unique<AtomicFile>(path);
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  if (!driver) throw Error("GDAL has no GTiff driver; reinstall libgdal");
+  GDALSetCacheMax64(std::min<GIntBig>(GDALGetCacheMax64(), kGdalCacheBytes));
+  CPLStringList co;
+  co.SetNameValue("COMPRESS", "DEFLATE");
+  co.SetNameValue("PREDICTOR", "3");
+  co.SetNameValue("BIGTIFF", "IF_SAFER");
+  co.SetNameValue("TILED", "YES");
+  ds_->ds = driver->Create(file_->temp_path().c_str(), width, height, 1, GDT_Float32, co.List());
+  if (!ds_->ds)
+    throw Error("cannot create '" + path.string() +
+                "': " + write_reason(path, last_gdal_message()));
+  double gt[6];
+  std::copy(geo.geotransform.begin(), geo.geotransform.end(), gt);
+  ds_->ds->SetGeoTransform(gt);
+  if (!geo.crs_wkt.empty()) {
+    OGRSpatialReference srs;
+    if (srs.importFromWkt(geo.crs_wkt.c_str()) == OGRERR_NONE) ds_->ds->SetSpatialRef(&srs);
+  }
+  ds_->band = ds_->ds->GetRasterBand(1);
+  ds_->band->SetNoDataValue(std::numeric_limits<double>::quiet_NaN());
+  if (!options.description.empty()) ds_->band->SetDescription(options.description.c_str());
+  if (!options.units.empty()) ds_->band->SetUnitType(options.units.c_str());
+}
+
+RasterBlockWriter::~RasterBlockWriter() = default;
+
+void RasterBlockWriter::write(int x, int y, int w, int h, const float* cells) {
+  if (!ds_->ds || w < 1 || h < 1 || x < 0 || y < 0 || x + w > width_ || y + h > height_) {
+    throw Error("internal: block " + std::to_string(w) + "x" + std::to_string(h) + "+" +
+                std::to_string(x) + "+" + std::to_string(y) + " lies outside '" + path_.string() +
+                "'");
+  }
+  const CPLErr err = ds_->band->RasterIO(GF_Write, x, y, w, h, const_cast<float*>(cells), w, h,
+                                         GDT_Float32, 0, 0, nullptr);
+  if (err != CE_None) {
+    throw Error("cannot write '" + path_.string() +
+                "': " + write_reason(path_, last_gdal_message() + " (disk full or not writable?)"));
+  }
+}
+
+void RasterBlockWriter::finish() {
+  // GDAL 3.6's GDALClose returns nothing: watch the error state across it.
+  CPLErrorReset();
+  GDALClose(GDALDataset::ToHandle(ds_->ds));
+  ds_->ds = nullptr;
+  if (CPLGetLastErrorType() == CE_Failure) {
+    throw Error("cannot write '" + path_.string() +
+                "': " + write_reason(path_, last_gdal_message() + " (disk full or not writable?)"));
+  }
+  file_->commit();
+}
+
+int block_cells(int requested, int fallback) {
+  if (requested > 0) return requested;
+  const char* env = std::getenv("DRIFT_BLOCK_CELLS");
+  if (!env || !*env) return fallback;
+  char* end = nullptr;
+  const long v = std::strtol(env, &end, 10);
+  if (*end != '\0' || v < 16 || v > 1048576) {
+    throw Error("DRIFT_BLOCK_CELLS='" + std::string(env) +
+                "' is no block size: give a whole number of cells in [16, 1048576], or unset it");
+  }
+  return static_cast<int>(v);
 }
 
 }  // namespace drift::terrain

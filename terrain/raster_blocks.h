@@ -14,7 +14,13 @@
 
 #include "terrain/grid.h"
 
+namespace drift {
+class AtomicFile;
+}
+
 namespace drift::terrain {
+
+struct WriteOptions;
 
 class RasterBlockReader {
  public:
@@ -49,5 +55,45 @@ class RasterBlockReader {
   int width_ = 0, height_ = 0;
   GeoReference geo_;
 };
+
+// Writing a float32 GeoTIFF a block at a time: the tiled stages' output
+// (drift import, snow cover) on rasters larger than memory. Internally tiled
+// 256 x 256, DEFLATE with the floating-point predictor, BigTIFF when large,
+// NaN declared nodata, the georeference kept: what write_geotiff
+// (terrain/raster_io.h) writes, cell for cell. Written through AtomicFile, so
+// within an OutputSet the set's temporary file is written and nothing reaches
+// the target before the set commits. GDAL's block cache (held to 64 MiB, as
+// RasterBlockReader holds it) carries the dirty tiles to disk: memory stays
+// bounded by the blocks in flight, not the raster. Not thread-safe.
+class RasterBlockWriter {
+ public:
+  // Creates the file; throws drift::Error naming it if it cannot be.
+  RasterBlockWriter(const std::filesystem::path& path, int width, int height,
+                    const GeoReference& geo, const WriteOptions& options);
+  ~RasterBlockWriter();  // an unfinished file is removed (AtomicFile)
+  RasterBlockWriter(const RasterBlockWriter&) = delete;
+  RasterBlockWriter& operator=(const RasterBlockWriter&) = delete;
+
+  // Cells [x, x + w) x [y, y + h) from `cells` (row-major, w x h).
+  void write(int x, int y, int w, int h, const float* cells);
+  // Flushes and closes the file and commits it (to the open OutputSet's
+  // temporary file if there is one); throws drift::Error on a failed write.
+  void finish();
+
+ private:
+  struct Dataset;
+  // Declared before the dataset: the dataset closes before an unfinished
+  // file is removed.
+  std::unique_ptr<AtomicFile> file_;
+  std::filesystem::path path_;
+  std::unique_ptr<Dataset> ds_;
+  int width_ = 0, height_ = 0;
+};
+
+// The cell count a side of the blocks the tiled stages work in: `requested`
+// if > 0, else DRIFT_BLOCK_CELLS if set (tests force small blocks through it),
+// else `fallback`. Throws drift::Error naming DRIFT_BLOCK_CELLS if it is not a
+// whole number in [16, 1048576].
+int block_cells(int requested, int fallback);
 
 }  // namespace drift::terrain
