@@ -131,7 +131,9 @@ TEST(MemoryEstimate, SoilDemGridHoldsTheDocumentedBound) {
   const Measured m = run_measured("soil s.toml -o o.ply", d);
   EXPECT_EQ(m.status, 1) << m.log;
   EXPECT_NE(m.log.find("6400 x 6400 columns; at most 4096"), std::string::npos) << m.log;
-  if (!kSanitized) EXPECT_LT(m.peak, 400.0 * 1048576) << "refused before allocating";
+  if (!kSanitized) {
+    EXPECT_LT(m.peak, 400.0 * 1048576) << "refused before allocating";
+  }
 }
 
 TEST(MemoryEstimate, RastersOfImportSnowCoverAndMarks) {

@@ -158,7 +158,9 @@ SoilScenario push_scenario(int n, const SoilOptions& options) {
   sc.soil.push_back(
       {"ground",
        {{PrimitiveKind::Cuboid, {L / 2, L / 2, 0.125 * L}, {L / 2, L / 2, 0.125 * L}}},
-       {0, 0, 0}});
+       {0, 0, 0},
+       false,
+       {}});
   RigidObject block;
   block.name = "blade";
   block.primitives = {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.05 * L, 0.3 * L, 0.15 * L}}};
@@ -173,10 +175,14 @@ SoilScenario pour_block_scenario(int n, const SoilOptions& options) {
   const double L = n * sc.shape.voxel_size;
   sc.bodies.push_back({"block",
                        {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.12 * L, 0.12 * L, 0.15 * L}}},
-                       {{0.0, {0.5 * L, 0.5 * L, 0.15 * L}}}});
+                       {{0.0, {0.5 * L, 0.5 * L, 0.15 * L}}},
+                       {0, 0, 0},
+                       {}});
   sc.soil.push_back({"column",
                      {{PrimitiveKind::Cylinder, {0, 0, 0}, {0.18 * L, 0, 0.2 * L}}},
-                     {0.5 * L, 0.5 * L, 0.72 * L}});
+                     {0.5 * L, 0.5 * L, 0.72 * L},
+                     false,
+                     {}});
   return sc;
 }
 
