@@ -47,26 +47,8 @@ WORK=$(cd "$WORK" && pwd)
 DEM=$PWD/out/yarigatake_utm.tif
 [ -f "$DEM" ] || "$DRIFT" import data/yarigatake_gsi_dem10b_jgd2000.tif -o "$DEM"
 
-# The plain-ground variant of data/scenes/default.toml: its sun, sky and
-# default camera; grey Lambertian ground; the DEM alone (no ground beyond it,
-# which the Cycles mesh does not have).
-cat > "$WORK/plain.toml" <<EOF
-[terrain]
-raster = "$DEM"
-color = [0.3, 0.3, 0.3]
-roughness = 0
-surround_reach = 0
-[sun]
-azimuth = 110
-elevation = 28
-irradiance = 3.0
-[sky]
-visibility = 120
-[render]
-width = $W
-height = $H
-max_depth = 4
-EOF
+# The plain-ground variant of data/scenes/default.toml.
+scripts/plain-ground-scene.sh "$DEM" "$W" "$H" > "$WORK/plain.toml"
 
 # Wall seconds and max RSS (MiB) of a command, into the named variables.
 measure() {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstring>
 
 #include "terrain/grid.h"
 
@@ -18,6 +19,16 @@ terrain::HeightField dem_from(int n, double cell, double offset, F f) {
     for (int x = 0; x < n; ++x)
       dem(x, row) = static_cast<float>(f((x + offset) * cell, -((row + offset) * cell)));
   return dem;
+}
+
+// Cells whose bits differ (NaN equals NaN), or -1 for another shape: block
+// by block against one pass, bit for bit.
+inline long differing_cells(const terrain::HeightField& a, const terrain::HeightField& b) {
+  if (a.width() != b.width() || a.height() != b.height()) return -1;
+  long n = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    n += std::memcmp(&a.values()[i], &b.values()[i], sizeof(float)) != 0;
+  return n;
 }
 
 // A flat n x n ground at height z, `cell` metres a cell, placed at UTM-sized

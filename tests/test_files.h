@@ -23,6 +23,16 @@ inline std::filesystem::path test_dir(const std::string& group) {
   return d;
 }
 
+// The folder test_dir(group) of the running test case, made empty on the
+// case's first call only, so helpers can name files in it without passing it.
+inline std::filesystem::path case_dir(const std::string& group) {
+  static std::string test;
+  static std::filesystem::path folder;
+  const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  if (name != test) test = name, folder = test_dir(group);
+  return folder;
+}
+
 // The file's bytes ("" if it cannot be read).
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream f(p, std::ios::binary);

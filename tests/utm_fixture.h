@@ -12,16 +12,19 @@
 
 namespace drift::testing {
 
-// WGS 84 / UTM zone 53N (Yarigatake's), EPSG:32653, as WKT.
-inline std::string utm53_wkt() {
+// The CRS of an EPSG code as WKT.
+inline std::string wkt_of_epsg(int epsg) {
   OGRSpatialReference srs;
-  srs.importFromEPSG(32653);
+  srs.importFromEPSG(epsg);
   char* wkt = nullptr;
   srs.exportToWkt(&wkt);
   std::string out = wkt;
   CPLFree(wkt);
   return out;
 }
+
+// WGS 84 / UTM zone 53N (Yarigatake's), EPSG:32653, as WKT.
+inline std::string utm53_wkt() { return wkt_of_epsg(32653); }
 
 // A width x height DEM of `cell` metres, north up, its north-west corner at
 // (west, north) in `crs_wkt` (empty: none), z = f(col, row), written as

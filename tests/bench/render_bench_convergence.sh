@@ -53,21 +53,7 @@ seed = 1
 EOF
 
 # The plain-ground variant of the default scene (scripts/compare-cycles.sh).
-cat > "$work/plain.toml" <<EOF
-[terrain]
-raster = "$root/out/yarigatake_utm.tif"
-color = [0.3, 0.3, 0.3]
-roughness = 0
-surround_reach = 0
-[sun]
-azimuth = 110
-elevation = 28
-irradiance = 3.0
-[sky]
-visibility = 120
-[render]
-max_depth = 4
-EOF
+"$root/scripts/plain-ground-scene.sh" "$root/out/yarigatake_utm.tif" > "$work/plain.toml"
 
 scene_file() {
   case "$1" in

@@ -17,7 +17,9 @@
 #include "snow/snow_cover.h"
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
 #include "tests/test_files.h"
+#include "tests/utm_fixture.h"
 
 using namespace drift::snow;
 using drift::terrain::HeightField;
@@ -25,24 +27,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The test case's folder, made empty once per test case.
-fs::path dir() {
-  static std::string test;
-  static fs::path folder;
-  const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  if (name != test) test = name, folder = drift::testing::test_dir("drift_snow_cover_tiled");
-  return folder;
-}
+using drift::testing::differing_cells;
 
-std::string wkt_of(int epsg) {
-  OGRSpatialReference srs;
-  srs.importFromEPSG(epsg);
-  char* wkt = nullptr;
-  srs.exportToWkt(&wkt);
-  std::string s(wkt);
-  CPLFree(wkt);
-  return s;
-}
+fs::path dir() { return drift::testing::case_dir("drift_snow_cover_tiled"); }
 
 // w x h cells of `cell` m in UTM (zone 33, north or south) of ridges, bowls
 // and a plateau: heights with full float mantissas, concave and convex ground
@@ -53,7 +40,7 @@ std::string wkt_of(int epsg) {
 fs::path relief(int w, int h, double cell, bool south, const std::string& name,
                 double base = 1800.0) {
   HeightField g(w, h, 0.0f, drift::terrain::local_georeference(cell));
-  g.geo().crs_wkt = wkt_of(south ? 32733 : 32633);
+  g.geo().crs_wkt = drift::testing::wkt_of_epsg(south ? 32733 : 32633);
   g.geo().geotransform = {500000.0, cell, 0.0, south ? 5200000.0 : 5100000.0, 0.0, -cell};
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -78,14 +65,6 @@ HeightField read_any(const fs::path& path) {
                                   GDT_Float32, 0, 0);
   GDALClose(ds);
   return err == CE_None ? g : HeightField{};
-}
-
-long differing_cells(const HeightField& a, const HeightField& b) {
-  if (a.width() != b.width() || a.height() != b.height()) return -1;
-  long n = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    n += std::memcmp(&a.values()[i], &b.values()[i], sizeof(float)) != 0;
-  return n;
 }
 
 // The tiled outputs at `block` against snow_cover on the whole DEM.

@@ -14,6 +14,7 @@
 #include "terrain/import.h"
 #include "terrain/raster_blocks.h"
 #include "terrain/raster_io.h"
+#include "tests/dem_fixture.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -21,24 +22,10 @@ using namespace drift::terrain;
 
 namespace {
 
-fs::path data(const char* name) { return fs::path(DRIFT_SOURCE_DIR) / "data" / name; }
-// The test case's folder, made empty once per test case.
-fs::path dir() {
-  static std::string test;
-  static fs::path folder;
-  const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  if (name != test) test = name, folder = drift::testing::test_dir("drift_import_tiled");
-  return folder;
-}
+using drift::testing::differing_cells;
 
-// Cells that differ in their bits (NaN == NaN), or -1 for another shape.
-long differing_cells(const HeightField& a, const HeightField& b) {
-  if (a.width() != b.width() || a.height() != b.height()) return -1;
-  long n = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    n += std::memcmp(&a.values()[i], &b.values()[i], sizeof(float)) != 0;
-  return n;
-}
+fs::path data(const char* name) { return fs::path(DRIFT_SOURCE_DIR) / "data" / name; }
+fs::path dir() { return drift::testing::case_dir("drift_import_tiled"); }
 
 // The one-pass import against the tiled one at `block`.
 void expect_tiled_is_one_pass(const fs::path& dem, ImportOptions o, int block, const char* name) {
