@@ -47,7 +47,7 @@ TEST(MeshCli, CropAsGlbLiesOnTheDemsCells) {
   // Origin (in the file's extras) at cell (10, 5)'s centre; positions metres from it, z up.
   const Eigen::Vector3d origin(700105.0, 4000245.0, 0.0);
   float top = 0;
-  Eigen::Vector3f peak;
+  Eigen::Vector3f peak = Eigen::Vector3f::Zero();
   for (const auto& p : m.positions) {
     if (p.z() > top) top = p.z(), peak = p;
   }
