@@ -382,16 +382,34 @@ void ImportOptions::validate() const {
   }
 }
 
-ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
+namespace {
+
+// What both imports start with: the options checked, the header read (clear
+// errors for bad files), a row across the bands within memory, and the warp
+// planned.
+struct ImportStart {
+  RasterHeader header;
+  WarpPlan plan;
+};
+ImportStart start_import(const fs::path& path, const ImportOptions& o,
+                         std::vector<std::string>& report) {
   o.validate();
-  const RasterHeader header = read_raster_header(path);  // clear errors for bad files
+  ImportStart start{read_raster_header(path), {}};
+  const RasterHeader& header = start.header;
   require_row_across_bands_memory(
       static_cast<std::uint64_t>(header.width), header.bands,
       GDALGetDataTypeSizeBytes(GDALGetDataTypeByName(header.data_type.c_str())), path);
+  report.push_back("read " + path.string() + ": " + header.driver + ", " +
+                   std::to_string(header.width) + " x " + std::to_string(header.height));
+  start.plan = plan_warp(path, header, o, report);
+  return start;
+}
+
+}  // namespace
+
+ImportResult import_dem(const fs::path& path, const ImportOptions& o) {
   ImportResult result;
-  result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
-                          std::to_string(header.width) + " x " + std::to_string(header.height));
-  const WarpPlan plan = plan_warp(path, header, o, result.report);
+  const auto [header, plan] = start_import(path, o, result.report);
   require_warp_memory(header, o, plan, path);
   result.grid = warp_to_grid(path, plan, o);
   result.report.push_back("grid " + std::to_string(result.grid.width()) + " x " +
@@ -456,15 +474,8 @@ bool block_filled_exactly(const std::vector<std::uint32_t>& ring, const Window& 
 
 ImportFileResult import_dem_to_file(const fs::path& path, const fs::path& output,
                                     const ImportOptions& o, const ProgressFn& progress) {
-  o.validate();
-  const RasterHeader header = read_raster_header(path);
-  require_row_across_bands_memory(
-      static_cast<std::uint64_t>(header.width), header.bands,
-      GDALGetDataTypeSizeBytes(GDALGetDataTypeByName(header.data_type.c_str())), path);
   ImportFileResult result;
-  result.report.push_back("read " + path.string() + ": " + header.driver + ", " +
-                          std::to_string(header.width) + " x " + std::to_string(header.height));
-  const WarpPlan plan = plan_warp(path, header, o, result.report);
+  const auto [header, plan] = start_import(path, o, result.report);
   require_warp_memory(header, o, plan, path, true);
   Warped warped;
   open_warped(warped, path, plan, o);
