@@ -14,6 +14,7 @@
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
 #include "tests/dem_fixture.h"
+#include "tests/utm_fixture.h"
 
 using namespace drift::snow;
 using drift::terrain::HeightField;
@@ -48,16 +49,7 @@ CoverOptions plain_with_radius(double radius_m) {
   return o;
 }
 
-// A UTM WKT for the given EPSG code.
-std::string wkt_of(int epsg) {
-  OGRSpatialReference srs;
-  srs.importFromEPSG(epsg);
-  char* text = nullptr;
-  srs.exportToWkt(&text);
-  std::string wkt = text;
-  CPLFree(text);
-  return wkt;
-}
+using drift::testing::wkt_of_epsg;
 
 }  // namespace
 
@@ -153,7 +145,7 @@ TEST(Cover, ShadySlopesKeepMoreSnowThanSunnyOnes) {
   o.sun_range_deg = 60.0;
   o.radius_m = 5000.0;
   auto mean_snow = [&](HeightField dem, int epsg) {
-    dem.geo().crs_wkt = epsg ? wkt_of(epsg) : std::string();
+    dem.geo().crs_wkt = epsg ? wkt_of_epsg(epsg) : std::string();
     dem.geo().geotransform[0] = 500000.0;  // inside the UTM zone
     dem.geo().geotransform[3] = epsg == 32754 ? 6000000.0 : 4000000.0;
     const HeightField t = snow_cover(dem, o).descriptor;
@@ -186,7 +178,7 @@ TEST(Cover, RejectsBadInput) {
   holes(3, 3) = NAN;
   EXPECT_THROW(snow_cover(holes, o), drift::Error);
   HeightField degrees = b;
-  degrees.geo().crs_wkt = wkt_of(4326);
+  degrees.geo().crs_wkt = wkt_of_epsg(4326);
   EXPECT_THROW(snow_cover(degrees, o), drift::Error);
 }
 
@@ -195,7 +187,7 @@ TEST(SnowCoverCommand, KeepsTheGeoreferenceAndRefusesNonsense) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   HeightField dem = bowl(40, 50.0, 3000.0, 1500.0);
-  dem.geo().crs_wkt = wkt_of(32653);
+  dem.geo().crs_wkt = wkt_of_epsg(32653);
   dem.geo().geotransform = {600000.0, 50.0, 0.0, 4030000.0, 0.0, -50.0};
   drift::terrain::write_geotiff(dem, dir / "dem.tif");
   const std::string drift = DRIFT_EXECUTABLE;
