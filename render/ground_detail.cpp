@@ -328,11 +328,31 @@ void triplanar_detail(const GroundDetail& d, const Planes& planes, double x, dou
   joints = std::clamp(1.0f + dark, 0.2f, 2.0f);
   if (d.bump > 0.0f) {
     out.normal = (normal - tilt).normalized();
-    out.roughness = std::min(std::hypot(out.roughness, std::atan(std::sqrt(lost))), kMaxRoughness);
+    out.roughness = lean_roughness(out.roughness, lost);
   }
 }
 
 }  // namespace
+
+float lean_roughness(float roughness, float lost_slope_variance) {
+  // atan(t), t >= 0, as Cephes' atanf (Moshier 1989): reduced to |x| <=
+  // tan(pi/8) by atan t = pi/2 - atan(1/t) and atan t = pi/4 +
+  // atan((t - 1)/(t + 1)), then an odd polynomial of degree 9.
+  const float t = std::sqrt(std::max(lost_slope_variance, 0.0f));
+  float x = t, base = 0.0f;
+  if (t > 2.414213562373095f) {
+    x = -1.0f / t, base = std::numbers::pi_v<float> / 2;
+  } else if (t > 0.4142135623730950f) {
+    x = (t - 1.0f) / (t + 1.0f), base = std::numbers::pi_v<float> / 4;
+  }
+  const float z = x * x;
+  const float sigma = base +
+                      (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z -
+                       3.33329491539e-1f) *
+                          z * x +
+                      x;
+  return std::min(std::sqrt(roughness * roughness + sigma * sigma), kMaxRoughness);
+}
 
 float relief_scale(const GroundDetail& detail, double cell) {
   return cell > 0.0 ? std::min(detail.scale, static_cast<float>(cell)) : detail.scale;
@@ -357,8 +377,7 @@ DetailedGround ground_detail(const Material& material, double x, double y, doubl
       const Eigen::Vector3f base = normal / normal.z();
       out.normal =
           Eigen::Vector3f(base.x() - s.slope.x(), base.y() - s.slope.y(), 1.0f).normalized();
-      const float sigma = std::atan(std::sqrt(s.lost_variance));
-      out.roughness = std::min(std::hypot(material.roughness, sigma), kMaxRoughness);
+      out.roughness = lean_roughness(material.roughness, s.lost_variance);
     }
   }
   if (d.variation > 0.0f) {

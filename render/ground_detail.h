@@ -52,6 +52,13 @@ struct DetailedGround {
 DetailedGround ground_detail(const Material& material, double x, double y, double z,
                              const Eigen::Vector3f& normal, double footprint, double cell = 0.0);
 
+// A roughness (Oren-Nayar sigma, radians) with the relief's slope variance
+// that a footprint filtered away added (LEAN mapping: facets tilted by its
+// rms slope, in quadrature): min(hypot(roughness, atan(sqrt(variance))),
+// kMaxRoughness), with an arctangent good to 2e-7 rad in place of libm's
+// (2.4 % of the default frame's paths).
+float lean_roughness(float roughness, float lost_slope_variance);
+
 // The largest wavelength of the relief (m) on a DEM of cells `cell` m (0: not
 // known, the preset's scale).
 float relief_scale(const GroundDetail& detail, double cell);

@@ -39,8 +39,13 @@ void PhysicalSky::coordinates(const Eigen::Vector3f& dir, int elevations, int az
   fe = elevation_to_v(l) * (elevations - 1);
   // Azimuth relative to the sun's, folded (the sky is symmetric about the
   // sun's vertical plane).
-  float rel = std::abs(
-      std::remainder(std::atan2(dir.x(), dir.y()) - sun_azimuth_, 2.0f * static_cast<float>(kPi)));
+  // Both angles lie in [-pi, pi], so one turn added or taken brings the
+  // difference into [-pi, pi] (std::remainder was a libm call a lookup).
+  constexpr float pi = static_cast<float>(kPi), turn = 2.0f * pi;
+  float rel = std::atan2(dir.x(), dir.y()) - sun_azimuth_;
+  if (rel > pi) rel -= turn;
+  if (rel < -pi) rel += turn;
+  rel = std::min(std::abs(rel), pi);
   fa = rel / static_cast<float>(kPi) * (azimuths - 1);
 }
 

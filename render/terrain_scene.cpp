@@ -508,12 +508,15 @@ Eigen::Vector3f TerrainScene::surround_normal(unsigned grid, float u, float v) c
 
 namespace {
 
-// The nearest hit of a ray from o along d (geomID invalid: none).
-RTCRayHit nearest_hit(RTCScene scene, const Eigen::Vector3f& o, const Eigen::Vector3f& d) {
-  const HeightRay ray(o, d);
+// The nearest hit of a ray from o along d (geomID invalid: none). The ray is
+// prepared for the height field only where there is one (the grid geometry
+// has no use for it: 1.3 % of the default frame).
+RTCRayHit nearest_hit(RTCScene scene, bool height_field, const Eigen::Vector3f& o,
+                      const Eigen::Vector3f& d) {
+  std::optional<HeightRay> ray;
   HeightContext context;
   rtcInitIntersectContext(&context.context);
-  context.ray = &ray;
+  if (height_field) context.ray = &ray.emplace(o, d);
   RTCRayHit rh = nearest_ray_hit(o, d);
   rtcIntersect1(scene, &context.context, &rh);
   return rh;
@@ -522,12 +525,13 @@ RTCRayHit nearest_hit(RTCScene scene, const Eigen::Vector3f& o, const Eigen::Vec
 }  // namespace
 
 bool TerrainScene::hits(const Eigen::Vector3f& o, const Eigen::Vector3f& d) const {
-  return nearest_hit(embree_->scene, o, d).hit.geomID != RTC_INVALID_GEOMETRY_ID;
+  return nearest_hit(embree_->scene, blocks_ != nullptr, o, d).hit.geomID !=
+         RTC_INVALID_GEOMETRY_ID;
 }
 
 float TerrainScene::hit_distance(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                                  Eigen::Vector3f* normal) const {
-  const RTCRayHit rh = nearest_hit(embree_->scene, o, d);
+  const RTCRayHit rh = nearest_hit(embree_->scene, blocks_ != nullptr, o, d);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::numeric_limits<float>::infinity();
   if (normal) {
     const Eigen::Vector3f n = Eigen::Vector3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z).normalized();
@@ -539,7 +543,7 @@ float TerrainScene::hit_distance(const Eigen::Vector3f& o, const Eigen::Vector3f
 bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
                              const RayCone& cone) const {
   if (recorder_) recorder_->traced(o, d, std::numeric_limits<float>::infinity(), false);
-  const RTCRayHit rh = nearest_hit(embree_->scene, o, d);
+  const RTCRayHit rh = nearest_hit(embree_->scene, blocks_ != nullptr, o, d);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;
@@ -622,10 +626,10 @@ Eigen::Vector3f TerrainScene::shade_mesh_hit(unsigned geometry, unsigned triangl
 bool TerrainScene::occluded(const Eigen::Vector3f& o, const Eigen::Vector3f& d,
                             float max_distance) const {
   if (recorder_) recorder_->traced(o, d, max_distance, true);
-  const HeightRay prepared(o, d);
+  std::optional<HeightRay> prepared;
   HeightContext context;
   rtcInitIntersectContext(&context.context);
-  context.ray = &prepared;
+  if (blocks_) context.ray = &prepared.emplace(o, d);
   RTCRay ray{};
   ray.org_x = o.x(), ray.org_y = o.y(), ray.org_z = o.z();
   ray.dir_x = d.x(), ray.dir_y = d.y(), ray.dir_z = d.z();
