@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <numbers>
 
+#include "render/fast_math.h"
 #include "render/procedural_noise.h"
 #include "terrain/hash.h"
 
@@ -335,22 +336,7 @@ void triplanar_detail(const GroundDetail& d, const Planes& planes, double x, dou
 }  // namespace
 
 float lean_roughness(float roughness, float lost_slope_variance) {
-  // atan(t), t >= 0, as Cephes' atanf (Moshier 1989): reduced to |x| <=
-  // tan(pi/8) by atan t = pi/2 - atan(1/t) and atan t = pi/4 +
-  // atan((t - 1)/(t + 1)), then an odd polynomial of degree 9.
-  const float t = std::sqrt(std::max(lost_slope_variance, 0.0f));
-  float x = t, base = 0.0f;
-  if (t > 2.414213562373095f) {
-    x = -1.0f / t, base = std::numbers::pi_v<float> / 2;
-  } else if (t > 0.4142135623730950f) {
-    x = (t - 1.0f) / (t + 1.0f), base = std::numbers::pi_v<float> / 4;
-  }
-  const float z = x * x;
-  const float sigma = base +
-                      (((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z -
-                       3.33329491539e-1f) *
-                          z * x +
-                      x;
+  const float sigma = fast_atan_positive(std::sqrt(std::max(lost_slope_variance, 0.0f)));
   return std::min(std::sqrt(roughness * roughness + sigma * sigma), kMaxRoughness);
 }
 

@@ -55,8 +55,7 @@ DetailedGround ground_detail(const Material& material, double x, double y, doubl
 // A roughness (Oren-Nayar sigma, radians) with the relief's slope variance
 // that a footprint filtered away added (LEAN mapping: facets tilted by its
 // rms slope, in quadrature): min(hypot(roughness, atan(sqrt(variance))),
-// kMaxRoughness), with an arctangent good to 2e-7 rad in place of libm's
-// (2.4 % of the default frame's paths).
+// kMaxRoughness), with render/fast_math.h's arctangent.
 float lean_roughness(float roughness, float lost_slope_variance);
 
 // The largest wavelength of the relief (m) on a DEM of cells `cell` m (0: not

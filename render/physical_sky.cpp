@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "render/fast_math.h"
 #include "terrain/bilinear.h"
 
 namespace drift::render {
@@ -35,14 +36,14 @@ T lerp(const T& a, const T& b, float t) {
 
 void PhysicalSky::coordinates(const Eigen::Vector3f& dir, int elevations, int azimuths, float& fe,
                               float& fa) const {
-  const float l = std::asin(std::clamp(dir.z(), -1.0f, 1.0f));
+  const float l = fast_asin(dir.z());
   fe = elevation_to_v(l) * (elevations - 1);
   // Azimuth relative to the sun's, folded (the sky is symmetric about the
   // sun's vertical plane).
   // Both angles lie in [-pi, pi], so one turn added or taken brings the
   // difference into [-pi, pi] (std::remainder was a libm call a lookup).
   constexpr float pi = static_cast<float>(kPi), turn = 2.0f * pi;
-  float rel = std::atan2(dir.x(), dir.y()) - sun_azimuth_;
+  float rel = fast_atan2(dir.x(), dir.y()) - sun_azimuth_;
   if (rel > pi) rel -= turn;
   if (rel < -pi) rel += turn;
   rel = std::min(std::abs(rel), pi);

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "render/color.h"
+#include "render/fast_math.h"
 
 namespace drift::render {
 
@@ -86,8 +87,8 @@ bool SkySampler::sample(float u1, float u2, Sample& s) const {
 
 float SkySampler::pdf(const Eigen::Vector3f& dir) const {
   const float z = std::clamp(dir.z(), -1.0f, 1.0f);
-  const float theta = std::acos(z);
-  float phi = std::atan2(dir.y(), dir.x());
+  const float theta = fast_acos(z);
+  float phi = fast_atan2(dir.y(), dir.x());
   if (phi < 0.0f) phi += 2.0f * kPi;
   const float sin_t = std::sqrt((1.0f - z) * (1.0f + z));  // sin(acos z), no third call
   if (!(sin_t > 0.0f)) return 0.0f;

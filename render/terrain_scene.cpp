@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "render/embree_ray.h"
+#include "render/fast_math.h"
 #include "render/ground_detail.h"
 #include "render/paged_terrain.h"
 #include "render/snow_flakes.h"
@@ -573,7 +574,7 @@ Eigen::Vector3f TerrainScene::shade_terrain_hit(Hit& hit, const RayCone& cone,
   // vertical exaggeration (n ~ (-k Zx, -k Zy, 1)).
   Relief relief;
   relief.altitude = static_cast<float>(world.z() / exaggeration_);
-  relief.slope_deg = std::atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
+  relief.slope_deg = fast_atan2(n.head<2>().norm(), std::abs(n.z()) * exaggeration_) *
                      terrain::kDegreesPerRadian<float>;
   relief.z = world.z();
   relief.ray = hit.direction;
