@@ -88,17 +88,20 @@ std::vector<double> gaussian_mean(const std::vector<double>& v, int w, int h) {
   return out;
 }
 
+// Each metric with its name: metric_name and parse_metric read the one list.
+struct NamedMetric {
+  CompareMetric metric;
+  const char* name;
+};
+constexpr NamedMetric kMetrics[] = {{CompareMetric::Rmse, "rmse"},
+                                    {CompareMetric::RelMse, "relmse"},
+                                    {CompareMetric::Ssim, "ssim"}};
+
 }  // namespace
 
 const char* metric_name(CompareMetric metric) {
-  switch (metric) {
-    case CompareMetric::Rmse:
-      return "rmse";
-    case CompareMetric::RelMse:
-      return "relmse";
-    case CompareMetric::Ssim:
-      return "ssim";
-  }
+  for (const NamedMetric& m : kMetrics)
+    if (m.metric == metric) return m.name;
   return "?";
 }
 
@@ -106,9 +109,8 @@ CompareMetric parse_metric(const std::string& name) {
   std::string n = name;
   std::transform(n.begin(), n.end(), n.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (n == "rmse") return CompareMetric::Rmse;
-  if (n == "relmse") return CompareMetric::RelMse;
-  if (n == "ssim") return CompareMetric::Ssim;
+  for (const NamedMetric& m : kMetrics)
+    if (n == m.name) return m.metric;
   throw Error("unknown metric '" + name + "'; use rmse, relmse or ssim");
 }
 

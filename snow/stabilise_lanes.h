@@ -15,27 +15,20 @@
 
 namespace drift::snow::kernel {
 
-// (Spelled out per width: GCC ignores a vector_size that depends on a
-// template parameter in an alias.)
+// kN lanes of each element type. (A typedef: GCC ignores a vector_size that
+// depends on a template parameter in an alias declaration, not in a typedef.)
 template <int kN>
-struct LaneTypes;
-template <>
-struct LaneTypes<2> {
-  using Values = double __attribute__((vector_size(16)));
-  using Mask = std::int64_t __attribute__((vector_size(16)));
-  using Bytes = std::uint8_t __attribute__((vector_size(2)));
-  using Floats = float __attribute__((vector_size(8)));
-};
-template <>
-struct LaneTypes<4> {
-  using Values = double __attribute__((vector_size(32)));
-  using Mask = std::int64_t __attribute__((vector_size(32)));
-  using Bytes = std::uint8_t __attribute__((vector_size(4)));
-  using Floats = float __attribute__((vector_size(16)));
+struct LaneTypes {
+  typedef double Values __attribute__((vector_size(kN * sizeof(double))));
+  typedef std::int64_t Mask __attribute__((vector_size(kN * sizeof(std::int64_t))));
+  typedef std::uint8_t Bytes __attribute__((vector_size(kN * sizeof(std::uint8_t))));
+  typedef float Floats __attribute__((vector_size(kN * sizeof(float))));
 };
 using Lanes2 = LaneTypes<2>::Values;
 using Lanes4 = LaneTypes<4>::Values;
 static_assert(sizeof(Lanes2) == 16 && sizeof(Lanes4) == 32);
+static_assert(sizeof(LaneTypes<4>::Mask) == 32 && sizeof(LaneTypes<4>::Bytes) == 4 &&
+              sizeof(LaneTypes<4>::Floats) == 16);
 // A comparison's result: bool for one cell, a lane mask for lanes.
 template <class T>
 using MaskOf = decltype(T{} > 0.0);

@@ -24,13 +24,20 @@ constexpr GIntBig kGdalCacheBytes = GIntBig{64} << 20;
 
 }  // namespace
 
-struct RasterBlockReader::Dataset {
+// An open GDAL dataset and its one band, closed with it: the reader's and the
+// writer's handle.
+struct GdalBand {
   GDALDataset* ds = nullptr;
   GDALRasterBand* band = nullptr;
-  ~Dataset() {
+  GdalBand() = default;
+  GdalBand(const GdalBand&) = delete;
+  GdalBand& operator=(const GdalBand&) = delete;
+  ~GdalBand() {
     if (ds) GDALClose(GDALDataset::ToHandle(ds));
   }
 };
+
+struct RasterBlockReader::Dataset : GdalBand {};
 
 RasterBlockReader::RasterBlockReader(const std::filesystem::path& path)
     : ds_(std::make_unique<Dataset>()), path_(path) {
@@ -118,13 +125,7 @@ std::string write_reason(const std::filesystem::path& path, const std::string& g
 
 }  // namespace
 
-struct RasterBlockWriter::Dataset {
-  GDALDataset* ds = nullptr;
-  GDALRasterBand* band = nullptr;
-  ~Dataset() {
-    if (ds) GDALClose(GDALDataset::ToHandle(ds));
-  }
-};
+struct RasterBlockWriter::Dataset : GdalBand {};
 
 RasterBlockWriter::RasterBlockWriter(const std::filesystem::path& path, int width, int height,
                                      const GeoReference& geo, const WriteOptions& options)

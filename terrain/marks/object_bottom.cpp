@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace drift::marks {
 
 CellWindow footprint_window(const CellTriangles& triangles, int margin, int grid_w, int grid_h) {
@@ -30,15 +29,12 @@ namespace {
 // at the integer points inside it (edges inclusive, so triangles sharing an
 // edge leave no gap); the lowest value wins.
 class CpuBottomRasteriser final : public BottomRasteriser {
- public:
-  void render(const CellTriangles& tris, BottomMap& map) override {
-    const CellWindow& w = map.window;
-    map.z.assign(static_cast<std::size_t>(w.width) * w.height, BottomMap::kNone);
+ private:
+  void lower(const CellTriangles& tris, BottomMap& map) override {
     for (std::size_t t = 0; t + 2 < tris.size(); t += 3)
       draw(tris[t], tris[t + 1], tris[t + 2], map);
   }
 
- private:
   static void draw(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                    BottomMap& map) {
     const CellWindow& w = map.window;

@@ -53,8 +53,15 @@ class BottomRasteriser {
  public:
   virtual ~BottomRasteriser() = default;
   // Fills map.z over map.window (set by the caller) with the lowest of the
-  // triangles above each cell centre.
-  virtual void render(const CellTriangles& triangles, BottomMap& map) = 0;
+  // triangles above each cell centre, kNone where there is none.
+  void render(const CellTriangles& triangles, BottomMap& map) {
+    map.z.assign(static_cast<std::size_t>(map.window.width) * map.window.height, BottomMap::kNone);
+    lower(triangles, map);
+  }
+
+ private:
+  // Lowers map.z (every cell kNone when called) to the triangles' bottom.
+  virtual void lower(const CellTriangles& triangles, BottomMap& map) = 0;
 };
 
 // Throws drift::Error if OSMesa cannot make a context (OpenGL only).

@@ -3,10 +3,9 @@
 // renderer shared with snowfall (terrain/offscreen). Depths are 32-bit floats
 // measured from the object's lowest point, so they keep sub-millimetre
 // precision whatever the ground's altitude.
-#include "terrain/marks/object_bottom.h"
-
 #include <algorithm>
 
+#include "terrain/marks/object_bottom.h"
 #include "terrain/mesh.h"
 #include "terrain/offscreen/depth_map.h"
 #include "terrain/offscreen/osmesa_depth_renderer.h"
@@ -16,10 +15,9 @@ namespace drift::marks {
 namespace {
 
 class OsmesaBottomRasteriser final : public BottomRasteriser {
- public:
-  void render(const CellTriangles& tris, BottomMap& map) override {
+ private:
+  void lower(const CellTriangles& tris, BottomMap& map) override {
     const CellWindow& w = map.window;
-    map.z.assign(static_cast<std::size_t>(w.width) * w.height, BottomMap::kNone);
     if (tris.empty() || w.empty()) return;
     double z_lo = 1e300, z_hi = -1e300;
     for (const Eigen::Vector3d& p : tris)
@@ -50,7 +48,6 @@ class OsmesaBottomRasteriser final : public BottomRasteriser {
     }
   }
 
- private:
   terrain::OsmesaDepthRenderer renderer_;
   terrain::Mesh mesh_;
 };

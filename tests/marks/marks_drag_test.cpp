@@ -10,10 +10,8 @@
 namespace drift::marks {
 namespace {
 
-using testing::at_cell;
-using testing::flat;
-using testing::only;
-using testing::sphere;
+// The shapes and grounds of tests/marks/shapes.h.
+using namespace testing;
 
 constexpr double kCell = 0.01, kRadius = 0.06, kDepth = 0.02;
 constexpr int kWidth = 160, kHeight = 48, kRow = 24, kStart = 20, kSteps = 10, kStride = 10;

@@ -17,13 +17,8 @@
 namespace drift::marks {
 namespace {
 
-using testing::at_cell;
-using testing::bottom_at;
-using testing::box;
-using testing::flat;
-using testing::inside;
-using testing::only;
-using testing::sphere;
+// The shapes and grounds of tests/marks/shapes.h.
+using namespace testing;
 
 const Eigen::Quaterniond kId = Eigen::Quaterniond::Identity();
 

@@ -13,11 +13,8 @@
 namespace drift::marks {
 namespace {
 
-using testing::at_cell;
-using testing::flat;
-using testing::only;
-using testing::sphere;
-using testing::volume;
+// The shapes and grounds of tests/marks/shapes.h.
+using namespace testing;
 
 constexpr double kCell = 0.01;    // 1 cm cells
 constexpr double kRadius = 0.06;  // a 12 cm ball

@@ -33,6 +33,12 @@ fs::path make_dem(const fs::path& d) {
   });
 }
 
+// The last run in d was refused: its log names `what` and `out` was not written.
+void expect_refused(const fs::path& d, const std::string& what, const fs::path& out) {
+  EXPECT_NE(drift_log(d).find(what), std::string::npos) << drift_log(d);
+  EXPECT_FALSE(fs::exists(out)) << out;
+}
+
 }  // namespace
 
 TEST(MeshCli, CropAsGlbLiesOnTheDemsCells) {
@@ -92,8 +98,7 @@ TEST(MeshCli, DecimateKeepsEveryCellWithinTheBound) {
   EXPECT_LE(worst, 0.01);
   EXPECT_EQ(mesh(dem, "--decimate 1 --step 2", d / "b.glb", d), 2);
   EXPECT_EQ(mesh(dem, "--decimate=-1", d / "b.glb", d), 2);
-  EXPECT_NE(drift_log(d).find("--decimate"), std::string::npos) << drift_log(d);
-  EXPECT_FALSE(fs::exists(d / "b.glb"));
+  expect_refused(d, "--decimate", d / "b.glb");
 }
 
 TEST(MeshCli, UsageErrorsExitTwo) {
@@ -107,8 +112,7 @@ TEST(MeshCli, UsageErrorsExitTwo) {
   EXPECT_EQ(run_drift("mesh -o " + (d / "a.glb").string(), d), 2);
   // A box beside the DEM is bad input (exit 1), naming the fix.
   EXPECT_EQ(mesh(dem, "--crop 0,0,10,10", d / "a.glb", d), 1);
-  EXPECT_NE(drift_log(d).find("drift info"), std::string::npos) << drift_log(d);
-  EXPECT_FALSE(fs::exists(d / "a.glb"));
+  expect_refused(d, "drift info", d / "a.glb");
 }
 
 TEST(MeshCli, AttributeNamesThatWouldBreakTheFileAreRefused) {
@@ -124,8 +128,7 @@ TEST(MeshCli, AttributeNamesThatWouldBreakTheFileAreRefused) {
     SCOPED_TRACE(attributes);
     for (const char* out : {"m.ply", "m.glb"}) {
       EXPECT_EQ(run_drift("mesh " + dem.string() + attributes + " -o " + (d / out).string(), d), 2);
-      EXPECT_NE(drift_log(d).find("--attribute"), std::string::npos) << drift_log(d);
-      EXPECT_FALSE(fs::exists(d / out));
+      expect_refused(d, "--attribute", d / out);
     }
   }
   EXPECT_EQ(run_drift("mesh " + dem.string() + a + "snow_depth2=" + dem.string() + " -o " +
@@ -202,6 +205,5 @@ TEST(MeshCli, SnowObjectsOtherThanPlyAreRefusedNamingThePly) {
       1);
   EXPECT_NE(drift_log(d).find("snowy.glb' has no per-vertex snow"), std::string::npos)
       << drift_log(d);
-  EXPECT_NE(drift_log(d).find("--mesh-out OBJECTS.ply"), std::string::npos);
-  EXPECT_FALSE(fs::exists(d / "f.png"));
+  expect_refused(d, "--mesh-out OBJECTS.ply", d / "f.png");
 }

@@ -30,12 +30,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using drift::testing::put;
-using drift::testing::slurp;
+using namespace drift::testing;
+using Result = RunResult;
 
 fs::path test_dir() { return drift::testing::test_dir("drift_outputs_cli"); }
-
-using Result = drift::testing::RunResult;
 
 std::vector<std::string> split(const std::string& args) {
   std::istringstream in(args);

@@ -22,12 +22,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-using drift::testing::put;
-using drift::testing::slurp;
+using namespace drift::testing;
+using Result = RunResult;
 
 fs::path test_dir() { return drift::testing::test_dir("drift_refusals_cli"); }
-
-using Result = drift::testing::RunResult;
 
 // Runs drift (at most 60 s: a hang fails the test rather than the suite) with
 // the environment assignments in `env` and returns its status and output.

@@ -49,13 +49,7 @@ TEST(SolarPosition, EquinoxAndSolsticeDeclination) {
 
 TEST(SolarPosition, JulianDayOfMeeus) {
   // Meeus 1991, example 7.a: 1957 October 4.81 -> JD 2436116.31.
-  LocalTime t;
-  t.year = 1957;
-  t.month = 10;
-  t.day = 4;
-  t.hour = 19;
-  t.minute = 26;
-  t.second = 24.0;
+  const LocalTime t{.year = 1957, .month = 10, .day = 4, .hour = 19, .minute = 26, .second = 24.0};
   EXPECT_NEAR(julian_day(t), 2436116.31, 1e-6);
 }
 
