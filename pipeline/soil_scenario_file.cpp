@@ -284,11 +284,19 @@ void read_bodies(const toml::table& root, const std::filesystem::path& file,
     Section s(t, "body", file, kDoc);
     soil::RigidObject b;
     b.name = s.string("name").value_or("body");
-    // A closed triangle mesh (OBJ, in the body's frame, z up unless
-    // mesh_y_up), voxelised at half a voxel; with or without primitives.
+    // A closed triangle mesh (any format read_mesh takes, in the body's
+    // frame; up as the format defines it unless mesh_y_up says), voxelised at
+    // half a voxel; with or without primitives. read_mesh (not read_obj for
+    // every extension) so that a glTF is read as one and its buffers pass the
+    // input checks: a buffer on /dev/zero is refused naming the device, where
+    // the OBJ reader had parsed the JSON as an OBJ "with no faces".
     if (const auto mesh = s.string("mesh")) {
+      const bool up_given = t->contains("mesh_y_up");
+      const bool y_up = s.boolean("mesh_y_up", false);
       const terrain::Mesh m =
-          terrain::read_obj(file.parent_path() / *mesh, s.boolean("mesh_y_up", false));
+          terrain::read_mesh(file.parent_path() / *mesh, !up_given ? terrain::UpAxis::Auto
+                                                         : y_up    ? terrain::UpAxis::Y
+                                                                   : terrain::UpAxis::Z);
       try {
         b.mesh = std::make_shared<soil::SolidMesh>(m, 0.5 * sc.shape.voxel_size, b.name);
       } catch (const Error& e) {

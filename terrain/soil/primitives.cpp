@@ -32,6 +32,42 @@ bool Primitive::inside(const Vector3d& p) const {
   return false;
 }
 
+namespace {
+double segment_distance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                        const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (p - (a + t * ab)).norm();
+}
+}  // namespace
+
+bool Primitive::misses_ball(const Vector3d& p, double r) const {
+  const Vector3d q = p - center;
+  switch (kind) {
+    case PrimitiveKind::Sphere:
+      return q.norm() > size.x() + r;
+    case PrimitiveKind::Ellipsoid:
+      // |x / s| >= 1 + r / min(s) gives |(q + d) / s| >= 1 for |d| <= r.
+      return q.cwiseQuotient(size).norm() > 1.0 + r / size.minCoeff();
+    case PrimitiveKind::Cuboid:
+      return (q.cwiseAbs() - size).cwiseMax(0.0).norm() > r;
+    case PrimitiveKind::Cylinder:
+      return Eigen::Vector2d(std::max(0.0, std::hypot(q.x(), q.y()) - size.x()),
+                             std::max(0.0, std::abs(q.z()) - size.z()))
+                 .norm() > r;
+    case PrimitiveKind::Cone: {
+      // The cone's half-section in (radius, height): a triangle.
+      const Eigen::Vector2d x(std::hypot(q.x(), q.y()), q.z());
+      if (x.y() >= 0 && x.y() <= size.z() && x.x() <= size.x() * (1.0 - x.y() / size.z()))
+        return false;
+      const Eigen::Vector2d o(0, 0), base(size.x(), 0), apex(0, size.z());
+      return std::min({segment_distance(x, o, base), segment_distance(x, base, apex),
+                       segment_distance(x, o, apex)}) > r;
+    }
+  }
+  return false;
+}
+
 Vector3d Primitive::lower() const {
   switch (kind) {
     case PrimitiveKind::Sphere:
@@ -209,6 +245,84 @@ double sampled_share(const Vector3d& lo, const Vector3d& hi, const Inside& insid
         in += inside(lo + step.cwiseProduct(Vector3d(i + 0.5, j + 0.5, k + 0.5)));
   return static_cast<double>(in) / (n * n * n);
 }
+
+using Polygon = std::vector<Vector3d>;
+
+// Keeps the part of each face of a convex polyhedron with q[axis] * side <=
+// bound and closes the cut with a cap face (outward, counter-clockwise seen
+// from outside). Faces are counter-clockwise seen from outside.
+void clip_polyhedron(std::vector<Polygon>& faces, int axis, double side, double bound) {
+  std::vector<Polygon> kept;
+  Polygon cut;  // the points on the plane: the cap's corners
+  for (const Polygon& f : faces) {
+    Polygon out;
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const Vector3d& a = f[i];
+      const Vector3d& b = f[(i + 1) % f.size()];
+      const double da = side * a[axis] - bound, db = side * b[axis] - bound;
+      if (da <= 0) out.push_back(a);
+      if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+        Vector3d m = a + (b - a) * (da / (da - db));
+        m[axis] = side * bound;  // on the plane exactly
+        out.push_back(m);
+        cut.push_back(m);
+      } else if (da == 0) {
+        cut.push_back(a);
+      }
+    }
+    if (out.size() >= 3) kept.push_back(std::move(out));
+  }
+  if (cut.size() >= 3) {
+    // Counter-clockwise about the outward normal side * e_axis: (u, v, n)
+    // right-handed.
+    const int u = side > 0 ? (axis + 1) % 3 : (axis + 2) % 3;
+    const int v = side > 0 ? (axis + 2) % 3 : (axis + 1) % 3;
+    Vector3d mid = Vector3d::Zero();
+    for (const Vector3d& p : cut) mid += p;
+    mid /= static_cast<double>(cut.size());
+    std::sort(cut.begin(), cut.end(), [&](const Vector3d& a, const Vector3d& b) {
+      return std::atan2(a[v] - mid[v], a[u] - mid[u]) < std::atan2(b[v] - mid[v], b[u] - mid[u]);
+    });
+    kept.push_back(std::move(cut));
+  }
+  faces = std::move(kept);
+}
+
+// Volume of a closed polyhedron of outward faces (divergence theorem: a fan
+// of tetrahedra from the origin over every face).
+double polyhedron_volume(const std::vector<Polygon>& faces) {
+  double v = 0;
+  for (const Polygon& f : faces)
+    for (std::size_t i = 1; i + 1 < f.size(); ++i) v += f[0].dot(f[i].cross(f[i + 1]));
+  return v / 6.0;
+}
+
+// Exact share of the world box [lo, hi] inside one cuboid of a turned body
+// (issue 33's follow-up: a turning blade's coverage was sampled 4 x 4 x 4):
+// the box, turned into the body's frame, is a convex polyhedron; clipped by
+// the cuboid's six planes it is their intersection, whose volume the
+// divergence theorem gives. Coordinates relative to the box's centre, so
+// the sums keep double precision.
+double cuboid_share(const Primitive& p, const Pose& pose, const Vector3d& lo, const Vector3d& hi) {
+  const Vector3d mid = 0.5 * (lo + hi);
+  const Vector3d centre = p.center - pose.to_body(mid);  // the cuboid's, from the box's centre
+  Vector3d c[8];
+  for (int k = 0; k < 8; ++k) {
+    const Vector3d w((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
+                     (k & 4) ? hi.z() : lo.z());
+    c[k] = pose.rotation.transpose() * (w - mid);
+  }
+  // The box's faces, counter-clockwise seen from outside (a rotation keeps that).
+  std::vector<Polygon> faces = {{c[0], c[4], c[6], c[2]}, {c[1], c[3], c[7], c[5]},
+                                {c[0], c[1], c[5], c[4]}, {c[2], c[6], c[7], c[3]},
+                                {c[0], c[2], c[3], c[1]}, {c[4], c[5], c[7], c[6]}};
+  for (int a = 0; a < 3 && !faces.empty(); ++a) {
+    clip_polyhedron(faces, a, 1.0, centre[a] + p.size[a]);
+    if (!faces.empty()) clip_polyhedron(faces, a, -1.0, -(centre[a] - p.size[a]));
+  }
+  const double box = (hi - lo).prod();
+  return std::clamp(polyhedron_volume(faces) / box, 0.0, 1.0);
+}
 }  // namespace
 
 double coverage(const std::vector<Primitive>& prims, const Vector3d& pos, const Vector3d& lo,
@@ -319,10 +433,12 @@ VoxelBox voxel_box(const PlacedSolid& solid, const terrain::Grid3Shape& shape) {
   return voxel_box_of(lo, hi, shape);
 }
 
-double coverage(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi) {
-  if (plain(solid)) return coverage(*solid.primitives, solid.pose.position, lo, hi);
-  // The box's corners in the body frame: a convex primitive holding all of
-  // them holds the (rotated) box.
+namespace {
+// How a world box lies against a turned solid: 1 wholly inside, 0 wholly
+// outside, -1 undecided; `only` is the one primitive that touches it (if
+// just one does and no mesh does).
+int classify(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi,
+             const Primitive*& only) {
   Vector3d corners[8], blo = Vector3d::Constant(1e300), bhi = Vector3d::Constant(-1e300);
   for (int c = 0; c < 8; ++c) {
     corners[c] = solid.pose.to_body(
@@ -330,23 +446,65 @@ double coverage(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi
     blo = blo.cwiseMin(corners[c]);
     bhi = bhi.cwiseMax(corners[c]);
   }
-  bool touches = solid.mesh && (solid.mesh->lower().array() < bhi.array()).all() &&
-                 (solid.mesh->upper().array() > blo.array()).all();
+  // The mesh's solid is its cells (solid_mesh.h): exact by their box test.
+  const int mesh = solid.mesh ? solid.mesh->classify(blo, bhi) : 0;
+  if (mesh == 1) return 1;
+  int touching = mesh != 0 ? 2 : 0;
+  only = nullptr;
+  const Vector3d centre = solid.pose.to_body(0.5 * (lo + hi));
+  const double radius = 0.5 * (hi - lo).norm();
   for (const Primitive& p : *solid.primitives) {
-    if (!box_touches(p, blo, bhi)) continue;
-    touches = true;
-    bool all = true;
+    if (!box_touches(p, blo, bhi) || p.misses_ball(centre, radius)) continue;
+    bool all = true;  // a convex primitive holding all eight corners holds the box
     for (const Vector3d& c : corners) all = all && p.inside(c);
-    if (all) return 1.0;
+    if (all) return 1;
+    only = &p;
+    ++touching;
   }
-  if (!touches) return 0.0;
-  return sampled_share(lo, hi, [&](const Vector3d& world) {
-    const Vector3d q = solid.pose.to_body(world);
-    bool inside = solid.mesh && solid.mesh->inside(q);
-    for (const Primitive& p : *solid.primitives)
-      if (inside || (inside = p.inside(q))) break;
-    return inside;
-  });
+  if (touching == 0) return 0;
+  if (touching != 1) only = nullptr;
+  return -1;
+}
+}  // namespace
+
+double refined_share(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi, int depth,
+                     double* undecided) {
+  const Primitive* only = nullptr;
+  const int c = classify(solid, lo, hi, only);
+  if (c >= 0) return c;
+  if (only && only->kind == PrimitiveKind::Cuboid) return cuboid_share(*only, solid.pose, lo, hi);
+  if (depth == 0) {
+    // Undecided at the finest level: the share at its 2 x 2 x 2 sub-box
+    // centres, off by at most the box's whole volume.
+    if (undecided) *undecided += 1.0;
+    int in = 0;
+    for (int k = 0; k < 8; ++k) {
+      const Vector3d f(0.25 + 0.5 * (k & 1), 0.25 + 0.5 * ((k >> 1) & 1), 0.25 + 0.5 * (k >> 2));
+      const Vector3d q = solid.pose.to_body(lo + (hi - lo).cwiseProduct(f));
+      bool inside = solid.mesh && solid.mesh->inside(q);
+      for (const Primitive& p : *solid.primitives)
+        if (inside || (inside = p.inside(q))) break;
+      in += inside;
+    }
+    return in / 8.0;
+  }
+  const Vector3d mid = 0.5 * (lo + hi);
+  double sum = 0;
+  for (int k = 0; k < 8; ++k) {
+    const Vector3d a((k & 1) ? mid.x() : lo.x(), (k & 2) ? mid.y() : lo.y(),
+                     (k & 4) ? mid.z() : lo.z());
+    const Vector3d b((k & 1) ? hi.x() : mid.x(), (k & 2) ? hi.y() : mid.y(),
+                     (k & 4) ? hi.z() : mid.z());
+    double u = 0;
+    sum += refined_share(solid, a, b, depth - 1, undecided ? &u : nullptr);
+    if (undecided) *undecided += u / 8.0;
+  }
+  return sum / 8.0;
+}
+
+double coverage(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi) {
+  if (plain(solid)) return coverage(*solid.primitives, solid.pose.position, lo, hi);
+  return refined_share(solid, lo, hi, kRefineDepth);
 }
 
 void for_each_covered_voxel(const PlacedSolid& solid, const terrain::Grid3Shape& shape,

@@ -36,7 +36,9 @@ struct Primitive {
   Eigen::Vector3d size{1, 1, 1};
 
   bool inside(const Eigen::Vector3d& p) const;  // p relative to the object's position
-  Eigen::Vector3d lower() const;                // bounding box
+  // True if no point within r of p is inside (conservative for the ellipsoid).
+  bool misses_ball(const Eigen::Vector3d& p, double r) const;
+  Eigen::Vector3d lower() const;  // bounding box
   Eigen::Vector3d upper() const;
 };
 
@@ -108,9 +110,24 @@ VoxelBox voxel_box(const std::vector<Primitive>& primitives, const Eigen::Vector
                    const terrain::Grid3Shape& shape);
 VoxelBox voxel_box(const PlacedSolid& solid, const terrain::Grid3Shape& shape);
 // Fraction of the world box [lo, hi] inside a placed solid: as above when it
-// is not rotated and has no mesh, else 4 x 4 x 4 samples (1 if one convex
-// primitive holds all eight corners).
+// is not rotated and has no mesh, else refined_share(..., kRefineDepth).
 double coverage(const PlacedSolid& solid, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
+// The share of the world box [lo, hi] inside a turned (or mesh) solid,
+// converging to the exact one (issue 33's follow-up; before, 4 x 4 x 4
+// samples): a box is wholly inside if one convex primitive holds its eight
+// corners (turned into the body's frame), wholly outside if its bounding ball
+// misses every primitive (Primitive::misses_ball) and it overlaps none of the
+// mesh's solid cells (the mesh's solid, SolidMesh::classify), and exact where only one cuboid
+// meets it (the box clipped by the cuboid's planes, its volume by the
+// divergence theorem); otherwise it is split in eight, `depth` times, and a
+// box still undecided at the end takes the share of its 2 x 2 x 2 sub-box
+// centres. The error is at most the undecided boxes' volume, added to
+// `*undecided` as a fraction of [lo, hi] when given: it halves with each
+// level (the boxes a surface crosses), and is 0 for a lone turned cuboid.
+inline constexpr int kRefineDepth = 3;
+double refined_share(const PlacedSolid& solid, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                     int depth, double* undecided = nullptr);
 
 // Calls fill(i, c) for each voxel i (an index of `shape`) in the voxel box of
 // `primitives` at `position` that they cover by a fraction c > 0. Parallel

@@ -98,3 +98,30 @@ bool SolidMesh::inside(const Eigen::Vector3d& p) const {
 }
 
 }  // namespace drift::soil
+
+namespace drift::soil {
+
+int SolidMesh::classify(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const {
+  int a[3], b[3];
+  bool outside_grid = false;
+  for (int d = 0; d < 3; ++d) {
+    a[d] = static_cast<int>(std::floor((lo[d] - lo_[d]) / cell_));
+    b[d] = static_cast<int>(std::floor((hi[d] - lo_[d]) / cell_));
+    if (b[d] < 0 || a[d] >= n_[d]) return 0;
+    if (a[d] < 0 || b[d] >= n_[d]) outside_grid = true;  // part of the box lies off the grid
+    a[d] = std::max(a[d], 0);
+    b[d] = std::min(b[d], n_[d] - 1);
+  }
+  bool any = false, all = !outside_grid;
+  for (int k = a[2]; k <= b[2]; ++k)
+    for (int j = a[1]; j <= b[1]; ++j)
+      for (int i = a[0]; i <= b[0]; ++i) {
+        const bool s = solid_[(static_cast<std::size_t>(k) * n_[1] + j) * n_[0] + i] != 0;
+        any = any || s;
+        all = all && s;
+        if (any && !all) return -1;
+      }
+  return all ? 1 : any ? -1 : 0;
+}
+
+}  // namespace drift::soil

@@ -27,6 +27,9 @@ class SolidMesh {
   SolidMesh(const terrain::Mesh& mesh, double cell, const std::string& name);
 
   bool inside(const Eigen::Vector3d& p) const;  // p in the body's frame
+  // The body-frame box [lo, hi] against the solid cells: 1 if every cell it
+  // overlaps is solid, 0 if none is, -1 if some are.
+  int classify(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
   const Eigen::Vector3d& lower() const { return lo_; }
   const Eigen::Vector3d& upper() const { return hi_; }
   std::uint64_t solid_cells() const { return solid_cells_; }

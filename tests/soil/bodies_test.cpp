@@ -71,8 +71,13 @@ BodyRun run_and_check(SoilSimulation& sim, int steps, const Eigen::Vector3d& hal
           }
           if (!voxel_inside_box(g, x, y, z, pose, half)) continue;
           ++r.inside;
-          // No soil (a rounding trace at most) and a full collision field.
-          if (std::abs(s.rho[i]) <= 1e-6f && s.psi[i] >= 1.0f - 1e-6f) continue;
+          // A full collision field and no soil but in the sliver of the
+          // voxel the body leaves: coverage is exact (primitives.h,
+          // refined_share), so a voxel whose corners shrunk by 1 % a side
+          // lie inside may be covered only 0.9999 (before, its 4 x 4 x 4
+          // samples all fell inside: 1), at least 0.94 (1 - 0.98^3), and
+          // soil may lie in the rest (a rounding trace more at most).
+          if (s.psi[i] >= 0.94f && s.rho[i] <= 1.0f - s.psi[i] + 1e-6f) continue;
           ADD_FAILURE() << "soil " << s.rho[i] << " and body " << s.psi[i] << " inside the body at "
                         << x << ", " << y << ", " << z << " step " << step;
           return r;

@@ -345,3 +345,30 @@ TEST(SoilCli, SoilBodyMoistureAndATurningMeshBody) {
                   },
                   d / "bad.ply");
 }
+
+// A mesh body given as glTF is read as glTF (before, every body mesh went
+// through the OBJ reader, which parsed the JSON as an OBJ "with no faces"):
+// a glTF box runs, and one whose buffer is a device is refused naming the
+// scenario's mesh file and the device.
+TEST(SoilCli, GltfMeshBodyIsReadAndItsDeviceBufferRefused) {
+  const fs::path d = dir();
+  std::ofstream(d / "box.obj") << box_obj(0.3, 0.5, 0.2);
+  drift::terrain::write_mesh(drift::terrain::read_obj(d / "box.obj"), d / "box.gltf");
+  std::string scenario = kTurningScenario;
+  scenario.replace(scenario.find("box.obj"), 7, "box.gltf");
+  std::ofstream(d / "g.toml") << scenario;
+  ASSERT_EQ(run((d / "g.toml").string() + " -o " + (d / "soil.ply").string(), d), 0) << output(d);
+  std::ifstream in(d / "box.gltf");
+  std::string gltf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto uri = gltf.find("\"uri\":\"");
+  ASSERT_NE(uri, std::string::npos) << gltf.substr(0, 200);
+  gltf.replace(uri, gltf.find('"', uri + 7) + 1 - uri, "\"uri\":\"/dev/zero\"");
+  std::ofstream(d / "device.gltf") << gltf;
+  fs::remove(d / "soil.ply");
+  expect_refusals(d, scenario, {{"mesh = \"box.gltf\"", "mesh = \"device.gltf\"", "device.gltf"}},
+                  d / "soil.ply");
+  const std::string why = output(d);
+  EXPECT_NE(why.find("/dev/zero"), std::string::npos) << why;
+  EXPECT_NE(why.find("device"), std::string::npos) << why;
+  EXPECT_EQ(why.find("no faces"), std::string::npos) << why;
+}
