@@ -198,6 +198,7 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   StabiliseOptions ground_rule = stabilise;
   ground_rule.tolerance = options.ground_tolerance;
   ground_rule.coarse_levels = options.coarse_levels;
+  ground_rule.direct = options.direct_stabilise;
   const StabiliseReport gr = stabilise_grid(scene.ground, snow, scene.dx, scene.dy, ground_rule,
                                             scaled_progress(report, 0.65, 0.95));
   result.ground_iterations = gr.iterations;

@@ -29,6 +29,9 @@ struct SnowfallOptions {
   // The coarse-to-fine start of the ground's stabilisation (stabilise_grid.h
   // StabiliseOptions::coarse_levels); 0: the passes on the grid alone.
   int coarse_levels = 0;
+  // The ground settled in one step (StabiliseOptions::direct) instead of by
+  // the passes: `--stabilise direct`.
+  bool direct_stabilise = false;
 
   // Throws drift::Error naming the parameter, its value and the valid range.
   void validate() const;
