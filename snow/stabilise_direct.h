@@ -17,7 +17,7 @@
 //     or steeper, then down ground or snow steeper than repose (the steepest
 //     excess, strictly down, so no loops), and stops at the first cell where
 //     nothing is steeper than repose: where the passes would stop it;
-//  3. there it is heaped as the cone of slope k (Prigozhin 1994, 1996: a heap
+//  3. there it is heaped as the cone of slope k (Prigozhin 1994; Prigozhin 1996: a heap
 //     fed at a point grows as the repose-limited surface over what lies below
 //     it) over the connected cells where the cone stands above the surface,
 //     its apex found by bisection so that it holds exactly the snow.
