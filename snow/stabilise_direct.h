@@ -1,7 +1,7 @@
 // Snow stabilisation in one step (issue 36, item 3): the state at rest computed
 // directly instead of by passes, at a cost near linear in the area
-// (O(N log N): one Dijkstra, one walk down per loose cell, memoised, and a
-// bisection per heap), with the mass exact to rounding and no pair of
+// (O(N log N): one Dijkstra, one walk down per loose cell, memoised, and one
+// priority flood over each heap's cells), with the mass exact to rounding and no pair of
 // 8-neighbours steeper than the angle of repose where the higher holds snow.
 //
 // The passes (snow/stabilise_grid.h) shift a slope standing at repose only as
@@ -13,20 +13,23 @@
 //     point, by Dijkstra from the lowest labels; each is final when popped).
 //     Snow on ground steeper than repose is cut down to what the snow below
 //     it holds up; snow at rest is not touched;
-//  2. the snow cut off, H - E, runs down the cut surface while it is at repose
-//     or steeper, then down ground or snow steeper than repose (the steepest
-//     excess, strictly down, so no loops), and stops at the first cell where
-//     nothing is steeper than repose: where the passes would stop it;
+//  2. the snow cut off, H - E, runs down over cut cells while the cut surface
+//     falls at repose or steeper, elsewhere only down ground or snow steeper
+//     than repose (the steepest excess, strictly down, so no loops), and stops
+//     where nothing is steeper: where the passes would stop it (a column's cut
+//     snow stays on the column);
 //  3. there it is heaped as the cone of slope k (Prigozhin 1994; Prigozhin 1996: a heap
 //     fed at a point grows as the repose-limited surface over what lies below
 //     it) over the connected cells where the cone stands above the surface,
-//     its apex found by bisection so that it holds exactly the snow.
+//     its apex found exactly by one priority flood (heap_at); where the cone
+//     would reach over a pass onto lower ground, it is heaped up to the pass
+//     and the rest spills on.
 // Why the result stands at rest: E does (its definition), a cone does (its
 // slope is k along every 8-neighbour step, the same metric), and the maximum
 // of two surfaces at rest over the same ground is at rest, taken over the
 // cone's connected region (its neighbours outside are at least as high as the
 // cone). So the state is at rest by construction, in every direction, up to
-// the bisection's rounding (1e-9 m), not up to a tolerance the passes reach.
+// 1e-7 m (what a heap may step over a pass), not up to the passes' 1 mm.
 //
 // It is a different path to rest, so not the passes' state: snow runs down
 // the steepest way instead of spreading among every lower neighbour, and it
