@@ -32,6 +32,10 @@ struct SnowfallOptions {
   // The ground settled in one step (StabiliseOptions::direct) instead of by
   // the passes: `--stabilise direct`.
   bool direct_stabilise = false;
+  // > 0: the ground's occlusion swept on blocks of this many cells a side,
+  // each with its halo (snow/occlusion_blocks.h; the same bits as one pass);
+  // ground alone, by the sweep. 0: one pass.
+  int block = 0;
 
   // Throws drift::Error naming the parameter, its value and the valid range.
   void validate() const;
