@@ -27,6 +27,8 @@ struct SnowfallCommand {
   std::vector<double> direction{snow::SnowfallOptions{}.azimuth_deg,
                                 snow::SnowfallOptions{}.elevation_deg};
   std::string occlusion = "sweep";
+  std::string stabilise = "passes";
+  int block = 0;
   unsigned long long seed = snow::SnowfallOptions{}.seed;
   // The table's flags (snow/snowfall_parameters.h); only those given override
   // SnowfallOptions{}'s defaults.
@@ -59,6 +61,9 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   o.seed = c.seed;
   o.occlusion.terrain =
       c.occlusion == "opengl" ? snow::TerrainOcclusion::OpenGL : snow::TerrainOcclusion::Sweep;
+  o.direct_stabilise = c.stabilise == "direct";
+  if (c.block < 0) usage_error("--block takes a number of cells, 0 or more");
+  o.block = c.block;
   if (!c.mesh_out.empty() && c.objects.empty())
     usage_error("--mesh-out needs --objects (there are no objects to write)");
   // Before reading anything large; the ranges live in SnowfallOptions::validate().
@@ -130,6 +135,15 @@ void add_snowfall_command(CLI::App& root) {
   sub->add_option("--occlusion", c->occlusion,
                   "how the ground occludes: sweep (horizon sweep) or opengl (OSMesa depth map)")
       ->check(CLI::IsMember({"sweep", "opengl"}))
+      ->capture_default_str();
+  sub->add_option("--stabilise", c->stabilise,
+                  "how the ground's snow comes to rest: passes (paper 003's rule, many passes) "
+                  "or direct (in one step, near-linear cost; docs/snowfall.md)")
+      ->check(CLI::IsMember({"passes", "direct"}))
+      ->capture_default_str();
+  sub->add_option("--block", c->block,
+                  "sweep the ground's occlusion on blocks of N cells a side with their halo "
+                  "(the same result; ground without objects, --occlusion sweep); 0: one pass")
       ->capture_default_str();
   c->parameters.add_to(*sub);
   add_seed_option(*sub, c->seed);

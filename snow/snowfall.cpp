@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "snow/occlusion_blocks.h"
 #include "snow/snowfall_directions.h"
 #include "snow/snowfall_parameters.h"
 #include "snow/stabilise_grid.h"
@@ -169,8 +170,11 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   const SnowScene scene = make_snow_scene(ground, objects, options.mesh_max_edge);
   const auto dirs = jittered_directions(options.azimuth_deg, options.elevation_deg,
                                         options.spread_deg, options.maps, options.seed);
+  const bool blocks = options.block > 0 && scene.meshes.empty() &&
+                      options.occlusion.terrain == TerrainOcclusion::Sweep;
   SnowProbability prob =
-      snow_probability(scene, dirs, options.occlusion, scaled_progress(report, 0.0, 0.6));
+      blocks ? ground_probability_in_blocks(scene, dirs, options.block, options.occlusion)
+             : snow_probability(scene, dirs, options.occlusion, scaled_progress(report, 0.0, 0.6));
   const double amount = options.rate_m_per_h * options.hours;  // m on open flat ground
   const double cell_area = scene.dx * scene.dy;
   StabiliseOptions stabilise{options.repose_deg, options.tolerance, options.max_iterations};
@@ -198,6 +202,7 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   StabiliseOptions ground_rule = stabilise;
   ground_rule.tolerance = options.ground_tolerance;
   ground_rule.coarse_levels = options.coarse_levels;
+  ground_rule.direct = options.direct_stabilise;
   const StabiliseReport gr = stabilise_grid(scene.ground, snow, scene.dx, scene.dy, ground_rule,
                                             scaled_progress(report, 0.65, 0.95));
   result.ground_iterations = gr.iterations;

@@ -29,6 +29,13 @@ struct SnowfallOptions {
   // The coarse-to-fine start of the ground's stabilisation (stabilise_grid.h
   // StabiliseOptions::coarse_levels); 0: the passes on the grid alone.
   int coarse_levels = 0;
+  // The ground settled in one step (StabiliseOptions::direct) instead of by
+  // the passes: `--stabilise direct`.
+  bool direct_stabilise = false;
+  // > 0: the ground's occlusion swept on blocks of this many cells a side,
+  // each with its halo (snow/occlusion_blocks.h; the same bits as one pass);
+  // ground alone, by the sweep. 0: one pass.
+  int block = 0;
 
   // Throws drift::Error naming the parameter, its value and the valid range.
   void validate() const;

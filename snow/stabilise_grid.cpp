@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "snow/stabilise_cells.h"
+#include "snow/stabilise_direct.h"
 #include "snow/stabilise_levels.h"
 #include "snow/stabilise_settle.h"
 #include "terrain/angles.h"
@@ -420,6 +421,20 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
     throw Error("the angle of repose of snow must lie in (0, 90) degrees");
   if (ground.width() != snow.width() || ground.height() != snow.height())
     throw Error("stabilise_grid: the ground and the snow grids differ in size");
+  if (options.direct) {
+    // Drained surface (then loads) 8, marks 1, resting cell 4, cut list and
+    // its loose snow 12 at worst, a queue entry 16 a cell at worst.
+    require_memory(snow.size() * 41, "snow stabilisation's workspace (direct)",
+                   "use a smaller or coarser ground raster");
+    progress(0.0, "stabilising snow");
+    settle_at_rest(ground, snow, dx, dy, terrain::tan_degrees(options.repose_deg));
+    StabiliseReport report;
+    report.converged = max_repose_excess(ground, snow, dx, dy, options.repose_deg,
+                                         options.tolerance) <= options.tolerance;
+    report.level_passes = {0};
+    progress(1.0, "stabilising snow");
+    return report;
+  }
   // The passes' workspace, and the shortcut's: envelope (then load), loose
   // snow (kept for the cut cells, a grid's worth at worst) and resting cell
   // (doubles and indices), marks, and a queue entry a cell at worst.

@@ -67,6 +67,13 @@ struct StabiliseOptions {
   // cm from the passes' own (one level: RMS 2.3 cm at 1024^2), see
   // docs/snowfall.md.
   int coarse_levels = 0;
+  // The state at rest in one step (snow/stabilise_direct.h) instead of the
+  // passes: near-linear cost, mass exact, at rest in every direction by
+  // construction, a different path to rest (docs/snowfall.md gives its
+  // distance to the passes' state). max_iterations, shortcut, coarse_levels
+  // and tolerance's pass criterion do not apply; tolerance still decides the
+  // report's `converged` (no pair steeper than repose by more than it).
+  bool direct = false;
 };
 
 struct StabiliseReport {

@@ -67,11 +67,13 @@ BENCHMARK(BM_SnowProbability)
     ->UseRealTime();
 
 // Args: grid size, coarse levels (StabiliseOptions::coarse_levels; 0: the
-// default, the passes and their shortcut alone).
+// default, the passes and their shortcut alone), 1 = the one-step solver
+// (StabiliseOptions::direct, snow/stabilise_direct.h) instead of the passes.
 void BM_StabiliseGround(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   StabiliseOptions options;
   options.coarse_levels = static_cast<int>(state.range(1));
+  options.direct = state.range(2) != 0;
   const SnowScene scene = make_snow_scene(mountains(n), {}, 0.0);
   const auto p = snow_probability(scene, jittered_directions(300.0, 55.0, 8.0, 4, 1)).ground;
   StabiliseReport r;
@@ -92,8 +94,9 @@ void BM_StabiliseGround(benchmark::State& state) {
   state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
 }
 BENCHMARK(BM_StabiliseGround)
-    ->ArgNames({"n", "coarse_levels"})
-    ->ArgsProduct({{256, 1024, 4096}, {0, 1}})
+    ->ArgNames({"n", "coarse_levels", "direct"})
+    ->ArgsProduct({{256, 1024, 4096}, {0, 1}, {0}})
+    ->ArgsProduct({{256, 1024, 4096, 8192}, {0}, {1}})
     ->Unit(benchmark::kSecond)
     ->Iterations(1)
     ->UseRealTime();

@@ -1,0 +1,277 @@
+#include "snow/stabilise_direct.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <limits>
+#include <queue>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "terrain/error.h"
+
+namespace drift::snow {
+
+namespace {
+
+constexpr std::array<int, 8> kDx{-1, 0, 1, -1, 1, -1, 0, 1};
+constexpr std::array<int, 8> kDy{-1, -1, -1, 0, 0, 1, 1, 1};
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+// Snow on ground as flat arrays, with the repose drop k d to each neighbour.
+class Field {
+ public:
+  Field(const terrain::Grid<float>& ground, terrain::Grid<double>& snow, double dx, double dy,
+        double k)
+      : g_(ground.values().data()),
+        h_(snow.values().data()),
+        w_(snow.width()),
+        ht_(snow.height()),
+        dx_(dx),
+        dy_(dy),
+        diag_(std::hypot(dx, dy)),
+        k_(k) {
+    for (int n = 0; n < 8; ++n) {
+      drop_[n] = k * std::hypot(kDx[n] * dx, kDy[n] * dy);
+      offset_[n] = static_cast<std::ptrdiff_t>(kDy[n]) * w_ + kDx[n];
+    }
+  }
+  std::size_t cells() const { return static_cast<std::size_t>(w_) * ht_; }
+  double ground(std::size_t i) const { return g_[i]; }
+  double& snow(std::size_t i) const { return h_[i]; }
+  double surface(std::size_t i) const { return static_cast<double>(g_[i]) + h_[i]; }
+  // Calls fn(neighbour, direction) for the 8-neighbours inside the grid, in a fixed order.
+  template <class Fn>
+  void neighbours(std::size_t i, const Fn& fn) const {
+    const int x = static_cast<int>(i % w_), y = static_cast<int>(i / w_);
+    for (int n = 0; n < 8; ++n) {
+      const int nx = x + kDx[n], ny = y + kDy[n];
+      if (nx >= 0 && ny >= 0 && nx < w_ && ny < ht_) fn(i + offset_[n], n);
+    }
+  }
+  double drop(int n) const { return drop_[n]; }
+  // The cone's drop from its apex p to i: k x the 8-neighbour path distance
+  // (diagonal steps, then straight ones), so that it falls by exactly drop(n)
+  // or less along every step.
+  double cone_drop(std::size_t p, std::size_t i) const {
+    const long ax = std::labs(static_cast<long>(i % w_) - static_cast<long>(p % w_));
+    const long ay = std::labs(static_cast<long>(i / w_) - static_cast<long>(p / w_));
+    const long m = std::min(ax, ay);
+    return k_ * (m * diag_ + (ax - m) * dx_ + (ay - m) * dy_);
+  }
+
+ private:
+  const float* g_;
+  double* h_;
+  int w_, ht_;
+  double dx_, dy_, diag_, k_;
+  std::array<double, 8> drop_{};
+  std::array<std::ptrdiff_t, 8> offset_{};
+};
+
+// Step 1: the drained surface (greatest fixed point of E = min(H, max(ground,
+// min_n E(n) + k d))). Labels only fall, and a label set from a popped one is
+// higher than it, so each is final when popped (Dijkstra).
+std::vector<double> drained_surface(const Field& f) {
+  std::vector<double> e(f.cells());
+  for (std::size_t i = 0; i < e.size(); ++i) e[i] = f.surface(i);
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    if (!(f.snow(i) > 0.0)) continue;
+    double limit = e[i];
+    f.neighbours(i, [&](std::size_t n, int k) { limit = std::min(limit, e[n] + f.drop(k)); });
+    limit = std::max(limit, f.ground(i));
+    if (limit < e[i]) e[i] = limit, queue.push({limit, i});
+  }
+  // Lowered cells are relaxed only once popped, from their final label; cells
+  // never lowered were checked against their neighbours above.
+  while (!queue.empty()) {
+    const auto [v, i] = queue.top();
+    queue.pop();
+    if (v > e[i]) continue;
+    f.neighbours(i, [&](std::size_t n, int k) {
+      if (!(f.snow(n) > 0.0)) return;
+      const double limit = std::max(v + f.drop(7 - k), f.ground(n));
+      if (limit < e[n]) e[n] = limit, queue.push({limit, n});
+    });
+  }
+  return e;
+}
+
+// Step 2: the next cell down, or kNone where the snow stops. From a cut cell
+// it runs on over cut cells while the cut surface falls at repose or steeper
+// (what lay above them is gone), and anywhere only where the surface falls
+// more steeply than repose; so snow cut from a column stays on it (to be
+// heaped there as a cone), and snow cut from a slope gathers at the foot of
+// the cut.
+std::uint32_t next_down(const Field& f, std::size_t i, const std::vector<std::uint8_t>* cut) {
+  double best = -std::numeric_limits<double>::infinity();
+  std::size_t next = i;
+  const double hi = f.surface(i);
+  f.neighbours(i, [&](std::size_t n, int k) {
+    const double hn = f.surface(n), excess = hi - hn - f.drop(k);
+    if (hn < hi && excess > best) best = excess, next = n;  // strictly down: no loop
+  });
+  if (next == i) return kNone;
+  const double slack = 1e-9 * (1.0 + std::abs(hi));  // the cut's own rounding
+  const bool on_cut = cut && (*cut)[i] && (*cut)[next];
+  const bool moves = on_cut ? best >= -slack : best > slack;
+  return moves ? static_cast<std::uint32_t>(next) : kNone;
+}
+
+std::uint32_t resting_cell(const Field& f, std::size_t i, const std::vector<std::uint8_t>& cut,
+                           std::vector<std::uint32_t>& rest, std::vector<std::uint32_t>& path) {
+  path.clear();
+  std::size_t c = i;
+  while (rest[c] == kNone) {
+    path.push_back(static_cast<std::uint32_t>(c));
+    const std::uint32_t next = next_down(f, c, &cut);
+    if (next == kNone) {
+      rest[c] = static_cast<std::uint32_t>(c);
+      break;
+    }
+    c = next;
+  }
+  for (std::uint32_t p : path) rest[p] = rest[c];
+  return rest[c];
+}
+
+// Step 3: heaps `mass` at p as the cone of slope k over the surface, over the
+// connected cells around p where it stands above it. A cell c lies under the
+// cone of apex T where T > t(c) = H(c) + k d(p, c), and joins p's region once T
+// passes J(c), the least over paths from p of the largest t on the path. So
+// the cells are flooded from p in ascending J (a priority flood, each cell
+// once): with m cells joined whose t sum to S, the cone of apex T holds m T -
+// S until the next joins, and the apex holding `mass` is found exactly, in one
+// flood over the region (no bisection).
+//
+// Where a cell joins through a pass higher than itself (J(c) > t(c)), the
+// volume would jump: the snow spills over the pass. The cone is then heaped
+// up to the pass and the rest runs on from that cell (returned), as snow
+// spills over a pass.
+struct Spill {
+  double mass = 0.0;
+  std::size_t from = 0;
+};
+
+Spill heap_at(const Field& f, std::size_t p, double mass, std::vector<std::uint8_t>& seen,
+              std::vector<std::size_t>& region) {
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> flood;
+  std::vector<std::size_t> touched;
+  auto t_of = [&](std::size_t c) { return f.surface(c) + f.cone_drop(p, c); };
+  region.clear();
+  flood.push({f.surface(p), p}), seen[p] = 1, touched.push_back(p);
+  double sum_t = 0.0, apex = 0.0;
+  Spill spill;
+  for (;;) {
+    if (flood.empty()) {  // the whole grid joined
+      apex = (mass + sum_t) / static_cast<double>(region.size());
+      break;
+    }
+    const auto [j, c] = flood.top();
+    const double m = static_cast<double>(region.size());
+    if (!region.empty() && m * j - sum_t >= mass) {  // the apex lies before c joins
+      apex = (mass + sum_t) / m;
+      break;
+    }
+    const double t = t_of(c);
+    if (!region.empty() && j - t > 1e-7 * (1.0 + std::abs(j))) {  // c joins over a pass: spill
+      apex = j;
+      spill.mass = mass - (m * j - sum_t);
+      spill.from = c;
+      mass -= spill.mass;
+      break;
+    }
+    flood.pop();
+    region.push_back(c), sum_t += t;
+    f.neighbours(c, [&](std::size_t n, int) {
+      if (!seen[n]) seen[n] = 1, touched.push_back(n), flood.push({std::max(j, t_of(n)), n});
+    });
+  }
+  for (std::size_t c : touched) seen[c] = 0;
+  double total = 0.0;
+  for (std::size_t c : region) {
+    // Layers under 1 nm (rounding at the region's rim) are left to the apex
+    // cell, so that no film is left on a face steeper than repose.
+    double add = apex - t_of(c);
+    if (!(add > 1e-9)) add = 0.0;
+    f.snow(c) += add, total += add;
+  }
+  f.snow(p) += mass - total;  // the rounding, to the apex cell
+  return spill;
+}
+
+// Where snow set down at i on the surface as it is now comes to rest (the
+// cells below have been heaped since the cut, so no memo).
+std::size_t runs_to(const Field& f, std::size_t i) {
+  for (;;) {
+    const std::uint32_t next = next_down(f, i, nullptr);
+    if (next == kNone) return i;
+    i = next;
+  }
+}
+
+}  // namespace
+
+DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
+                            double dx, double dy, double tan_repose) {
+  if (ground.width() != snow.width() || ground.height() != snow.height())
+    throw Error("settle_at_rest: ground and snow grids differ in size");
+  if (snow.size() >= kNone)
+    throw Error("settle_at_rest: more than 2^32 - 1 cells; settle the raster in parts");
+  const Field f(ground, snow, dx, dy, tan_repose);
+  DirectReport report;
+  // The drained surface's array holds each resting cell's load once the cut is made.
+  std::vector<double> drained_then_load = drained_surface(f);
+  std::vector<std::uint8_t> cut(f.cells(), 0);
+  std::vector<std::uint32_t> cut_cells;
+  std::vector<double> loose;
+  for (std::size_t i = 0; i < f.cells(); ++i) {
+    if (!(drained_then_load[i] < f.surface(i))) continue;
+    const double before = f.snow(i);
+    f.snow(i) = std::max(drained_then_load[i] - f.ground(i), 0.0);
+    loose.push_back(before - f.snow(i));
+    cut[i] = 1;
+    cut_cells.push_back(static_cast<std::uint32_t>(i));
+  }
+  std::vector<double>& load = drained_then_load;
+  std::fill(load.begin(), load.end(), 0.0);
+  std::vector<std::uint32_t> rest(f.cells(), kNone), path, heaps;
+  for (std::size_t c = 0; c < cut_cells.size(); ++c) {
+    const std::uint32_t r = resting_cell(f, cut_cells[c], cut, rest, path);
+    if (load[r] == 0.0) heaps.push_back(r);
+    load[r] += loose[c];
+    report.loose += loose[c];
+  }
+  // Heaps in ascending cell order; spilled snow queued at its new resting
+  // cell (a fixed order, so the same bits on any machine).
+  std::set<std::size_t> queue(heaps.begin(), heaps.end());
+  std::vector<std::uint8_t>& seen = cut;  // from here heap_at's marks, all clear
+  std::fill(seen.begin(), seen.end(), std::uint8_t{0});
+  std::vector<std::size_t> region;
+  while (!queue.empty()) {
+    const std::size_t p = *queue.begin();
+    queue.erase(queue.begin());
+    const double mass = load[p];
+    load[p] = 0.0;
+    if (!(mass > 0.0)) continue;
+    const Spill spill = heap_at(f, p, mass, seen, region);
+    if (spill.mass > 0.0) {
+      ++report.spills;
+      std::size_t r = runs_to(f, spill.from);
+      if (r == p) r = spill.from;  // back into its own heap: rest where it spilled
+      load[r] += spill.mass;
+      queue.insert(r);
+    }
+  }
+  report.cut_cells = cut_cells.size();
+  report.heaps = heaps.size();
+  return report;
+}
+
+}  // namespace drift::snow

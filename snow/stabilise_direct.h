@@ -1,0 +1,60 @@
+// Snow stabilisation in one step (issue 36, item 3): the state at rest computed
+// directly instead of by passes, at a cost near linear in the area
+// (O(N log N): one Dijkstra, one walk down per loose cell, memoised, and one
+// priority flood over each heap's cells), with the mass exact to rounding and no pair of
+// 8-neighbours steeper than the angle of repose where the higher holds snow.
+//
+// The passes (snow/stabilise_grid.h) shift a slope standing at repose only as
+// fast as a diffusion (O(L^2) passes for a slope L cells long); this solver
+// instead builds the state at rest from two surfaces that each stand at rest:
+//  1. the drained surface E: the highest surface under today's (H = ground +
+//     snow) at rest, E(i) = min(H(i), max(ground(i), min_n E(n) + k d)), k =
+//     tan(repose), d the distance to the 8-neighbour n (the greatest fixed
+//     point, by Dijkstra from the lowest labels; each is final when popped).
+//     Snow on ground steeper than repose is cut down to what the snow below
+//     it holds up; snow at rest is not touched;
+//  2. the snow cut off, H - E, runs down over cut cells while the cut surface
+//     falls at repose or steeper, elsewhere only down ground or snow steeper
+//     than repose (the steepest excess, strictly down, so no loops), and stops
+//     where nothing is steeper: where the passes would stop it (a column's cut
+//     snow stays on the column);
+//  3. there it is heaped as the cone of slope k (Prigozhin 1994; Prigozhin 1996: a heap
+//     fed at a point grows as the repose-limited surface over what lies below
+//     it) over the connected cells where the cone stands above the surface,
+//     its apex found exactly by one priority flood (heap_at); where the cone
+//     would reach over a pass onto lower ground, it is heaped up to the pass
+//     and the rest spills on.
+// Why the result stands at rest: E does (its definition), a cone does (its
+// slope is k along every 8-neighbour step, the same metric), and the maximum
+// of two surfaces at rest over the same ground is at rest, taken over the
+// cone's connected region (its neighbours outside are at least as high as the
+// cone). So the state is at rest by construction, in every direction, up to
+// 1e-7 m (what a heap may step over a pass), not up to the passes' 1 mm.
+//
+// It is a different path to rest, so not the passes' state: snow runs down
+// the steepest way instead of spreading among every lower neighbour, and it
+// heaps where it first stops instead of creeping on. docs/snowfall.md gives
+// the distance to the passes' state measured on the benchmark field.
+// Everything runs in a fixed order on one thread: the same bits for any
+// thread count.
+#pragma once
+
+#include <cstddef>
+
+#include "terrain/grid.h"
+
+namespace drift::snow {
+
+struct DirectReport {
+  std::size_t cut_cells = 0;  // cells the drained surface cut
+  std::size_t heaps = 0;      // cells where cut snow came to rest
+  std::size_t spills = 0;     // heaps that filled up to a pass and spilled over it
+  double loose = 0.0;         // m of snow x cells moved
+};
+
+// ground: heights (m); snow: depth (m), updated in place; dx, dy: cell sizes
+// (m); tan_repose = tan(angle of repose).
+DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
+                            double dx, double dy, double tan_repose);
+
+}  // namespace drift::snow
