@@ -58,7 +58,7 @@ struct RenderOptions {
   std::string from, to;  // --from/--to X,Y,Z in the CRS
   std::string map_box;
   double cell = 0.0;
-  std::string memory_budget;  // --memory-budget BYTES: the terrain out of core
+  std::string memory_budget;     // --memory-budget BYTES: the terrain out of core
   bool full_resolution = false;  // --full-resolution: no level of detail out of core
 };
 
