@@ -58,7 +58,8 @@ struct RenderOptions {
   std::string from, to;  // --from/--to X,Y,Z in the CRS
   std::string map_box;
   double cell = 0.0;
-  std::string memory_budget;  // --memory-budget BYTES: the terrain out of core
+  std::string memory_budget;     // --memory-budget BYTES: the terrain out of core
+  bool full_resolution = false;  // --full-resolution: no level of detail out of core
 };
 
 // X,Y,Z (CRS metres) of --from or --to.
@@ -327,10 +328,13 @@ void print_cache(const render::PagedTerrain& paged, double setup_seconds) {
   const render::BlockCacheStats c = paged.cache_stats();
   std::printf(
       "terrain cache: %llu hits, %llu misses, %s read in pages (%s in the opening scan), "
-      "peak resident %s of a %s budget; scene set-up %.1f s\n",
+      "peak resident %s of a %s budget (%s of it held outside the pages: bounds, coarse "
+      "levels, BVH); scene set-up %.1f s\n",
       static_cast<unsigned long long>(c.hits), static_cast<unsigned long long>(c.misses),
       human_bytes(c.bytes_read).c_str(), human_bytes(paged.scan_bytes()).c_str(),
-      human_bytes(c.peak_resident).c_str(), human_bytes(paged.budget()).c_str(), setup_seconds);
+      human_bytes(c.peak_resident + paged.held_bytes()).c_str(),
+      human_bytes(paged.budget() + paged.held_bytes()).c_str(),
+      human_bytes(paged.held_bytes()).c_str(), setup_seconds);
 }
 
 // --set NAME=VALUE, each a usage error unless NAME can name a variable.
@@ -395,6 +399,13 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const render::Camera camera =
       scene.input.camera ? *scene.input.camera : render::default_camera(embree_scene);
+  if (paged && !o.full_resolution) {
+    // Out of core, distant ground at coarser levels by the pixel's footprint
+    // (docs/rendering.md, "Level of detail by footprint").
+    const render::CameraRays rays =
+        render::make_camera_rays(embree_scene, camera, scene.settings.width, scene.settings.height);
+    scene_holder->set_lod({rays.eye, rays.footprint_spread()});
+  }
   render::RenderStats stats;
   render::Image image = render::render_image(embree_scene, scene.input, camera, scene.settings,
                                              terminal_progress("render"), &stats);
@@ -494,7 +505,10 @@ void add_render_command(CLI::App& root) {
   sub->add_option("--memory-budget", o->memory_budget,
                   "render the terrain out of core: read its full-resolution heights in pages "
                   "(e.g. from a VRT or tiled GeoTIFF of any size) through a cache of at most "
-                  "BYTES (e.g. 4G, 512M; docs/rendering.md)");
+                  "BYTES (e.g. 4G, 512M; docs/rendering.md); distant ground is traced at "
+                  "coarser levels by the pixel's footprint");
+  sub->add_flag("--full-resolution", o->full_resolution,
+                "with --memory-budget: trace every cell at full resolution (no level of detail)");
   add_seed_option(*sub, o->seed);
 }
 

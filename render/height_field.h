@@ -22,6 +22,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -67,11 +68,15 @@ struct HeightHit {
 // (render/paged_terrain.h reads them on demand; issue 36 item 2): square pages
 // of page_cells() cells, a multiple of HeightFieldBlocks::kBlock, each holding
 // its (page_cells() + 1)^2 vertices (one shared row and column with the next
-// page), so every block lies in one page.
+// page), so every block lies in one page, and the lower levels of the
+// min-max tree over them (HeightFieldBlocks::page_tree: the tree below the
+// blocks lives in the pages, not in memory).
 struct HeightPage {
   int c0 = 0, r0 = 0;      // the page's first vertex
   std::size_t stride = 0;  // floats a row
   const float* z = nullptr;
+  const float* tree = nullptr;  // page_tree()'s nodes (none: the tree is in memory)
+  int tree_side = 0;            // leaves a side of the page (page_cells / kLeaf)
   float at(int c, int r) const { return z[static_cast<std::size_t>(r - r0) * stride + (c - c0)]; }
 };
 class HeightSource {
@@ -82,6 +87,21 @@ class HeightSource {
   virtual HeightPage page(int page_x, int page_y, std::shared_ptr<const void>& pin) const = 0;
 };
 
+// The level of detail of a frame (issue 36 item 2; docs/rendering.md, "Level
+// of detail by footprint"): where the camera's pixel cone is wider than a few
+// cells the surface's vertices slide onto coarser surfaces (every 8th and
+// every 16th vertex, triangulated as the full grid is), continuously with
+// the distance, so that no ray needs the full-resolution page of a distant
+// block and nothing pops as the camera moves. A vertex's height depends on
+// the vertex and the view alone (never on the ray or the cache), so shared
+// edges agree bit for bit (no cracks) and shadow and bounce rays meet the
+// surface the camera rays met.
+struct LodView {
+  Eigen::Vector3f eye{0, 0, 0};  // the camera (local frame)
+  float spread = 0.0f;           // the pixel cone's width a metre (radians a pixel); 0: off
+  float bias = 0.0f;             // added to the level (>0: coarser sooner)
+};
+
 class HeightFieldBlocks {
  public:
   struct MinMax {
@@ -90,21 +110,51 @@ class HeightFieldBlocks {
   static constexpr int kLeaf = 4;                             // cells a side of a min-max leaf
   static constexpr int kBlockLevels = 3;                      // min-max levels inside a block
   static constexpr int kBlock = kLeaf << (kBlockLevels - 1);  // cells a side of a block
+  // The coarse levels' spacing: level 3 takes every 8th vertex, level 4
+  // every 16th (kBlock: a block's corners), so every coarse cell a block's
+  // vertices interpolate lies in the block and the block's min-max bounds
+  // the coarse surfaces too.
+  static constexpr int kCoarse = 8;
+  // The level (log2 of the footprint in cells) below which a vertex is at
+  // full resolution; from there it morphs to level 3 by kFullBelow + 1 and
+  // to level 4 by kFullBelow + 2.
+  static constexpr float kFullBelow = 2.0f;
 
   // Builds the min-max levels over `grid` (kept by pointer: it must outlive this).
   explicit HeightFieldBlocks(const HeightGrid& grid);
   // Heights read from `source` instead (`grid` gives the frame; its z stays
-  // empty), over leaves min-max computed beforehand (kLeaf x kLeaf cells
-  // each, row-major, every vertex of their cells included). Both must
-  // outlive this.
-  HeightFieldBlocks(const HeightGrid& grid, const HeightSource& source, std::vector<MinMax> leaves);
+  // empty): in memory only the blocks' min-max (kBlock x kBlock cells each,
+  // row-major, every vertex of their cells included) and the coarse samples
+  // (coarse_columns() x coarse_rows(), row-major; see coarse_sample());
+  // the tree below the blocks comes with each page (page_tree). `grid` and
+  // `source` must outlive this. `group`: blocks a side of one Embree
+  // primitive (Embree's BVH then holds group^2 times fewer primitives).
+  HeightFieldBlocks(const HeightGrid& grid, const HeightSource& source,
+                    std::vector<MinMax> block_bounds, std::vector<float> coarse, int group = 1);
 
-  // Embree's primitives: blocks of kBlock x kBlock cells (fewer at the east
-  // and south edges).
-  unsigned block_count() const { return static_cast<unsigned>(blocks_x_ * blocks_y_); }
+  // The coarse samples' grid: vertex columns 0, 8, 16, ... and the last.
+  static int coarse_count(int vertices) { return (vertices - 2) / kCoarse + 2; }
+  // The vertex of coarse index i (of `vertices` a side).
+  static int coarse_vertex(int i, int vertices) { return std::min(i * kCoarse, vertices - 1); }
+  // The tree below the blocks of a page of `page_cells` cells whose heights
+  // are `z` (`stride` floats a row, cells_x x cells_y cells of it real):
+  // page_tree_floats(page_cells) floats.
+  static std::size_t page_tree_floats(int page_cells);
+  static void page_tree(const float* z, std::size_t stride, int page_cells, int cells_x,
+                        int cells_y, float* tree);
+
+  // The frame's level of detail (not while rays are traced). Off by default.
+  void set_lod(const LodView& view);
+  bool lod_on() const { return lod_.spread > 0.0f; }
+  // Vertex (c, r)'s height as the rays meet it (the level of detail's).
+  float height(int c, int r) const;
+
+  // Embree's primitives: groups of group x group blocks of kBlock x kBlock
+  // cells (fewer at the east and south edges).
+  unsigned block_count() const { return static_cast<unsigned>(groups_x_ * groups_y_); }
   void block_bounds(unsigned block, Eigen::Vector3f& lower, Eigen::Vector3f& upper) const;
 
-  // The nearest hit in `block` with tnear < t <= tfar: tfar becomes its
+  // The nearest hit in primitive `block` with tnear < t <= tfar: tfar becomes its
   // distance and `hit` its cell and triangle. False if none.
   bool intersect(unsigned block, const HeightRay& ray, float tnear, float& tfar,
                  HeightHit& hit) const;
@@ -115,7 +165,8 @@ class HeightFieldBlocks {
   // True if the ray meets the block's triangles with tnear < t <= tfar.
   bool occluded(unsigned block, const HeightRay& ray, float tnear, float tfar) const;
 
-  // Bytes of the min-max levels (the heights are the grid's).
+  // Bytes of the min-max levels and coarse samples held in memory (the
+  // heights are the grid's or the pages').
   std::size_t bytes() const;
 
  private:
@@ -123,13 +174,36 @@ class HeightFieldBlocks {
     int nx = 0, ny = 0, size = 0;  // nodes a side, cells a node side
     std::vector<MinMax> nodes;
   };
+  // One block's tree, local: [0] 4 x 4 leaves, [1] 2 x 2, [2] the block.
+  struct BlockTree {
+    MinMax leaf[4][4], mid[2][2], top;
+  };
+  // A block's heights and tree as one trace reads them.
+  struct BlockView {
+    HeightPage page;
+    BlockTree tree;
+    std::shared_ptr<const void> pin;
+    float z[(kBlock + 1) * (kBlock + 1)];  // the level of detail's heights (page.z then)
+  };
   void size_levels();
   void build_upper_levels();
-  // The heights of `block`: the grid's, or its page of the source.
-  HeightPage heights_of(unsigned block, std::shared_ptr<const void>& pin) const;
+  void build_coarse_from_grid();
+  // The heights and tree of block (bx, by): the grid's, its page's, or the
+  // level of detail's (computed from the coarse samples and, near the
+  // camera, the page).
+  void view_block(int bx, int by, BlockView& view) const;
+  float lod_level(int c, int r, float h4) const;
+  float coarse_height(int c, int r, int spacing) const;
+  float lod_height(int c, int r, const HeightPage* page) const;
+  // The level's range over the box of block (bx, by), widened by more than
+  // its rounding: lo above 3 needs no page, hi below kFullBelow is full resolution.
+  void block_levels(int bx, int by, float& lo, float& hi) const;
   template <bool kAnyHit>
-  bool trace(unsigned block, const HeightPage& page, const HeightRay& ray, float tnear, float& tfar,
+  bool trace(int bx, int by, const BlockView& view, const HeightRay& ray, float tnear, float& tfar,
              HeightHit& hit) const;
+  template <bool kAnyHit>
+  bool trace_group(unsigned group, const HeightRay& ray, float tnear, float& tfar,
+                   HeightHit& hit) const;
   // The leaf's triangles the ray can meet while inside the leaf's box, which
   // it enters at `enter` and leaves at `exit` (node_entry's distances): only
   // the cells under the ray's path across each row of cells, found from the
@@ -137,16 +211,23 @@ class HeightFieldBlocks {
   template <bool kAnyHit, bool kAllCells>
   bool trace_leaf(int leaf_x, int leaf_y, const HeightPage& page, const HeightRay& ray, float tnear,
                   float& tfar, float enter, float exit, HeightHit& hit) const;
-  // The ray's entry and exit distances of node (level, ix, iy) within
-  // [tnear, tfar] (widened by the slab slack); false if it misses.
-  bool node_entry(int level, int ix, int iy, const HeightRay& ray, float tnear, float tfar,
-                  float& entry, float& exit) const;
+  // The ray's entry and exit distances of the box of cells [c0, c0 + size) x
+  // [r0, r0 + size) (clipped to the field) between heights m within [tnear,
+  // tfar] (widened by the slab slack); false if it misses.
+  bool node_entry(int c0, int r0, int size, const MinMax& m, const HeightRay& ray, float tnear,
+                  float tfar, float& entry, float& exit) const;
 
   const HeightGrid* grid_;
   const HeightSource* source_ = nullptr;  // none: the heights are grid_->z
   int cells_x_ = 0, cells_y_ = 0;
   int blocks_x_ = 0, blocks_y_ = 0;
-  std::vector<Level> levels_;  // [0]: leaves of kLeaf cells; the last: blocks
+  int group_ = 1, groups_x_ = 0, groups_y_ = 0;
+  std::vector<Level> levels_;  // [0]: leaves of kLeaf cells; the last: blocks (paged: only it)
+  std::vector<float> coarse_;  // every kCoarse-th vertex and the last, row-major
+  int coarse_nx_ = 0, coarse_ny_ = 0;
+  LodView lod_;
+  float lod_offset_ = 0.0f;      // log2(spread / cell) + bias
+  unsigned lod_generation_ = 0;  // tells a thread's cached LOD blocks from an earlier view's
 };
 
 }  // namespace drift::render

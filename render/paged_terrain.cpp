@@ -16,7 +16,10 @@ namespace drift::render {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr int kLeaf = HeightFieldBlocks::kLeaf;
+// The scan's nodes: the height field's blocks (the tree below them comes
+// with each page, HeightFieldBlocks::page_tree).
+constexpr int kLeaf = HeightFieldBlocks::kBlock;
+constexpr int kCoarse = HeightFieldBlocks::kCoarse;
 
 }  // namespace
 
@@ -50,14 +53,31 @@ PagedTerrain::PagedTerrain(const std::filesystem::path& dem, std::uint64_t memor
   if (page_cells_ < HeightFieldBlocks::kBlock || page_cells_ % HeightFieldBlocks::kBlock != 0)
     throw Error("page size " + std::to_string(page_cells_) + " is not a multiple of " +
                 std::to_string(HeightFieldBlocks::kBlock) + " cells");
+  pages_x_ = (w - 2) / page_cells_ + 1;
+  pages_y_ = (h - 2) / page_cells_ + 1;
+  // What stays in memory counts against the budget too (issue 36): the
+  // blocks' min-max, the coarse samples and Embree's BVH over the groups of
+  // blocks; the pages get the rest.
+  const std::uint64_t blocks =
+      static_cast<std::uint64_t>((w - 2) / kLeaf + 1) * ((h - 2) / kLeaf + 1);
+  const std::uint64_t groups =
+      static_cast<std::uint64_t>((w - 2) / (kLeaf * kGroup) + 1) * ((h - 2) / (kLeaf * kGroup) + 1);
+  held_bytes_ = blocks * sizeof(HeightFieldBlocks::MinMax) +
+                static_cast<std::uint64_t>(HeightFieldBlocks::coarse_count(w)) *
+                    HeightFieldBlocks::coarse_count(h) * sizeof(float) +
+                groups * kBvhBytesAGroup;
+  if (memory_budget < held_bytes_ + page_bytes())
+    throw Error(name + ": a memory budget of " + std::to_string(memory_budget) +
+                " B cannot hold one block of " + std::to_string(page_bytes()) +
+                " B beside the bounds, coarse levels and BVH held in memory (" +
+                std::to_string(held_bytes_) + " B); give at least " +
+                std::to_string(held_bytes_ + page_bytes()) + " B");
   try {
-    cache_ = std::make_unique<BlockCache>(memory_budget, page_bytes(),
+    cache_ = std::make_unique<BlockCache>(memory_budget - held_bytes_, page_bytes(),
                                           [this](std::uint64_t key) { return load(key); });
   } catch (const Error& e) {
     throw Error(name + ": " + e.what());  // which render's budget, for which DEM
   }
-  pages_x_ = (w - 2) / page_cells_ + 1;
-  pages_y_ = (h - 2) / page_cells_ + 1;
   frame_.width = w;
   frame_.height = h;
   frame_.dx = static_cast<float>(geo.cell_size_x());
@@ -71,7 +91,7 @@ const terrain::GeoReference& PagedTerrain::geo() const { return reader_->geo(); 
 
 std::uint64_t PagedTerrain::page_bytes() const {
   const std::uint64_t side = static_cast<std::uint64_t>(page_cells_) + 1;
-  return side * side * sizeof(float);
+  return (side * side + HeightFieldBlocks::page_tree_floats(page_cells_)) * sizeof(float);
 }
 
 void PagedTerrain::scan() {
@@ -79,6 +99,8 @@ void PagedTerrain::scan() {
   const int cells_x = w - 1, cells_y = h - 1;
   const int leaves_x = (cells_x + kLeaf - 1) / kLeaf, leaves_y = (cells_y + kLeaf - 1) / kLeaf;
   leaves_.assign(static_cast<std::size_t>(leaves_x) * leaves_y, {kInf, -kInf});
+  const int coarse_x = HeightFieldBlocks::coarse_count(w);
+  coarse_.assign(static_cast<std::size_t>(coarse_x) * HeightFieldBlocks::coarse_count(h), 0.0f);
   // Strips of page_cells_ vertex rows [a, b), a a multiple of page_cells_, so
   // that a raster tiled in blocks of page_cells_ (or a divisor) decodes each
   // block once: a strip reaching one row into the next block row made GDAL
@@ -132,6 +154,14 @@ void PagedTerrain::scan() {
       for (int ix = 0; ix < leaves_x; ++ix)
         out.head[static_cast<std::size_t>(ix)] = minmax(ix, a, a);
     }
+    // The coarse samples (every kCoarse-th vertex and the last), raw.
+    for (int r = a; r < b; ++r) {
+      if (r % kCoarse != 0 && r != h - 1) continue;
+      const int j = r % kCoarse == 0 ? r / kCoarse : HeightFieldBlocks::coarse_count(h) - 1;
+      for (int i = 0; i < coarse_x; ++i)
+        coarse_[static_cast<std::size_t>(j) * coarse_x + i] =
+            z(HeightFieldBlocks::coarse_vertex(i, w), r);
+    }
     // The extremes, the first in row-major order on a tie.
     for (int r = a; r < b; ++r)
       for (int c = 0; c < w; ++c) {
@@ -180,6 +210,7 @@ void PagedTerrain::scan() {
     m.hi = m.hi == -kInf ? filled : m.hi * k - z0;
     if (nodata) m.hi = std::max(m.hi, filled);
   });
+  for (float& v : coarse_) v = (std::isnan(v) ? fill_ : v) * k - z0;  // as load() converts
   const auto vertex = [&](std::size_t i, float v) {
     const int c = static_cast<int>(i % w), r = static_cast<int>(i / w);
     return Eigen::Vector3f(frame_.x(c), frame_.y(r), v * k - z0);
@@ -199,14 +230,26 @@ std::vector<float> PagedTerrain::load(std::uint64_t key) const {
     const float h = std::isnan(v) ? lo : v;
     v = h * k - z0;
   }
-  return z;
+  // The page: the tree below its blocks, then its heights.
+  const std::size_t tree = HeightFieldBlocks::page_tree_floats(page_cells_);
+  std::vector<float> out(tree + z.size());
+  std::copy(z.begin(), z.end(), out.begin() + static_cast<std::ptrdiff_t>(tree));
+  HeightFieldBlocks::page_tree(out.data() + tree, static_cast<std::size_t>(c1 - c0 + 1),
+                               page_cells_, c1 - c0, r1 - r0, out.data());
+  return out;
 }
 
 HeightPage PagedTerrain::page(int page_x, int page_y, std::shared_ptr<const void>& pin) const {
   const std::uint64_t key = static_cast<std::uint64_t>(page_y) * pages_x_ + page_x;
   std::shared_ptr<const BlockCache::Block> block = cache_->get(key);
   const int c0 = page_x * page_cells_, c1 = std::min(c0 + page_cells_, frame_.width - 1);
-  HeightPage p{c0, page_y * page_cells_, static_cast<std::size_t>(c1 - c0 + 1), block->data()};
+  const std::size_t tree = HeightFieldBlocks::page_tree_floats(page_cells_);
+  HeightPage p{c0,
+               page_y * page_cells_,
+               static_cast<std::size_t>(c1 - c0 + 1),
+               block->data() + tree,
+               block->data(),
+               page_cells_ / HeightFieldBlocks::kLeaf};
   pin = std::move(block);
   return p;
 }

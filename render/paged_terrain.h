@@ -55,8 +55,19 @@ class PagedTerrain final : public HeightSource {
   Eigen::Vector3d origin() const { return origin_; }
   const terrain::GeoReference& geo() const;
   float exaggeration() const { return exaggeration_; }
-  // The min-max leaves of the scan (moved out once, to HeightFieldBlocks).
-  std::vector<HeightFieldBlocks::MinMax> take_leaves() { return std::move(leaves_); }
+  // Embree's primitives out of core: groups of kGroup x kGroup blocks (a
+  // BVH over 16 times fewer boxes), and what its BVH is counted at in the
+  // budget a group (Embree 3's BVH4 over user geometry: about 3 nodes of
+  // 4 boxes and a primitive reference a group, rounded up).
+  static constexpr int kGroup = 4;
+  static constexpr std::uint64_t kBvhBytesAGroup = 256;
+  // The blocks' min-max of the scan (HeightFieldBlocks::kBlock cells each)
+  // and the coarse samples, moved out once, to HeightFieldBlocks.
+  std::vector<HeightFieldBlocks::MinMax> take_block_bounds() { return std::move(leaves_); }
+  std::vector<float> take_coarse() { return std::move(coarse_); }
+  // Bytes held outside the pages and counted in the budget: block bounds,
+  // coarse samples and the BVH's allowance.
+  std::uint64_t held_bytes() const { return held_bytes_; }
   // Highest and lowest vertex (local), the first in row-major order on a tie.
   Eigen::Vector3f highest() const { return highest_; }
   Eigen::Vector3f lowest() const { return lowest_; }
@@ -85,7 +96,9 @@ class PagedTerrain final : public HeightSource {
   float z0_ = 0.0f;    // local z = h k - z0
   HeightGrid frame_;
   Eigen::Vector3d origin_{0, 0, 0};
-  std::vector<HeightFieldBlocks::MinMax> leaves_;
+  std::vector<HeightFieldBlocks::MinMax> leaves_;  // the blocks' min-max
+  std::vector<float> coarse_;
+  std::uint64_t held_bytes_ = 0;
   Eigen::Vector3f highest_{0, 0, 0}, lowest_{0, 0, 0};
   std::uint64_t scan_bytes_ = 0;
 };

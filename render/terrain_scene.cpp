@@ -218,7 +218,8 @@ void TerrainScene::build_paged(const SceneInput& input, PagedTerrain& paged) {
                            std::abs(static_cast<float>(paged.geo().cell_size_y())));
   coverage_ = coverage_channels(surface_);
   embree_->open();
-  blocks_ = std::make_unique<HeightFieldBlocks>(heights_, paged, paged.take_leaves());
+  blocks_ = std::make_unique<HeightFieldBlocks>(heights_, paged, paged.take_block_bounds(),
+                                                paged.take_coarse(), PagedTerrain::kGroup);
   attach_blocks();
   // The surround ring reads the DEM's whole edge from memory: not built here.
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
@@ -446,7 +447,10 @@ void TerrainScene::attach_mesh(const terrain::PlacedMesh& placed) {
 TerrainScene::~TerrainScene() = default;
 
 float TerrainScene::z_at(int c, int r) const {
-  return paged_ ? paged_->at(c, r) : heights_.at(c, r);
+  // The level of detail's heights where it is on (the geometry's, so the
+  // shading reads no page the rays did not need), else the DEM's.
+  if (paged_ || (blocks_ && blocks_->lod_on())) return blocks_->height(c, r);
+  return heights_.at(c, r);
 }
 
 float TerrainScene::height_at(float x, float y) const {
@@ -471,7 +475,7 @@ Eigen::Vector3f TerrainScene::smooth_normal(float px, float py) const {
   // so the same bits (the heights hold no NaN: fill_heights).
   const terrain::BilinearCell<float> c =
       terrain::clamped_cell((px - heights_.x0) / dx_, (heights_.y0 - py) / dy_, width_, height_);
-  if (paged_ || c.x0 < 1 || c.y0 < 1 || c.x1 + 1 >= width_ || c.y1 + 1 >= height_) {
+  if (paged_ || (blocks_ && blocks_->lod_on()) || c.x0 < 1 || c.y0 < 1 || c.x1 + 1 >= width_ || c.y1 + 1 >= height_) {
     auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
     return terrain::bilinear_blend(vn(c.x0, c.y0), vn(c.x1, c.y0), vn(c.x0, c.y1), vn(c.x1, c.y1),
                                    c.tx, c.ty)

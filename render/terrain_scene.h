@@ -97,6 +97,12 @@ class TerrainScene {
   // Bytes the terrain geometry holds: heights, min-max tree or float3
   // vertices (Embree's own BVH not included).
   std::size_t terrain_bytes() const;
+  // The frame's level of detail (render/height_field.h, LodView; issue 36):
+  // on the height field only (Embree's grid geometry is always full
+  // resolution); set before tracing, never while rays are traced.
+  void set_lod(const LodView& view) {
+    if (blocks_) blocks_->set_lod(view);
+  }
   // Every ray intersect() and occluded() trace goes to `recorder` too (none:
   // nullptr); for benchmarks, not to be changed while rays are traced.
   void record_rays(RayRecorder* recorder) { recorder_ = recorder; }

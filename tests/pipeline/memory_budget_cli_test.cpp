@@ -55,10 +55,10 @@ TEST(MemoryBudgetCli, TheSamePngAtAnyBudget) {
   const std::string s = scene(d).string();
   const std::string frame = " --size 40x24 --exposure 0 -o ";
   const Result small =
-      run_drift("render " + s + frame + (d / "small.png").string() + " --memory-budget 300K", d);
+      run_drift("render " + s + frame + (d / "small.png").string() + " --memory-budget 400K", d);
   ASSERT_EQ(small.status, 0) << small.log;
   EXPECT_NE(small.log.find("terrain cache: "), std::string::npos) << small.log;
-  EXPECT_NE(small.log.find("of a 300.0 KiB budget"), std::string::npos) << small.log;
+  EXPECT_NE(small.log.find("of a 400.0 KiB budget"), std::string::npos) << small.log;
   const Result large =
       run_drift("render " + s + frame + (d / "large.png").string() + " --memory-budget 64M", d);
   ASSERT_EQ(large.status, 0) << large.log;

@@ -65,6 +65,12 @@ fs::path tiled_dem() {
   return path;
 }
 
+// The budget of `pages` pages beside what the terrain holds in memory.
+std::uint64_t pages_budget(const fs::path& dem, std::uint64_t pages) {
+  const PagedTerrain probe(dem, std::uint64_t{1} << 30, 1.0f, kPage);
+  return probe.held_bytes() + pages * probe.page_bytes();
+}
+
 SceneInput bare_input() {
   SceneInput in;
   in.sun.elevation_deg = 25.0;
@@ -88,16 +94,18 @@ TEST(PagedTerrain, TracesTheSameHitsAsTheDemInCore) {
   SceneInput in = bare_input();
   in.terrain = drift::terrain::read_raster(dem);
   const TerrainScene core(in, TerrainGeometry::HeightField);
-  PagedTerrain paged(dem, 4 * (kPage + 1) * (kPage + 1) * sizeof(float), 1.0f, kPage);
+  PagedTerrain paged(dem, pages_budget(dem, 4), 1.0f, kPage);
   const TerrainScene out(bare_input(), paged);
   EXPECT_EQ(out.origin(), core.origin());
   EXPECT_EQ(out.highest_point(), core.highest_point());
   EXPECT_EQ(out.lowest_point(), core.lowest_point());
-  EXPECT_EQ(out.bottom(), core.bottom());
-  EXPECT_EQ(out.top(), core.top());
+  // Embree's boxes, padded by a millionth of their coordinates, are groups
+  // of blocks out of core: the scene's bounds differ by that padding.
+  EXPECT_NEAR(out.bottom(), core.bottom(), 1e-3f);
+  EXPECT_NEAR(out.top(), core.top(), 1e-3f);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  int hits = 0;
+  int hits = 0, ties = 0;
   for (int i = 0; i < 4000; ++i) {
     // From above the relief towards anywhere below, grazing rays included.
     const Eigen::Vector3f o(300.0f * u(rng), 220.0f * u(rng), 120.0f + 60.0f * u(rng));
@@ -109,12 +117,16 @@ TEST(PagedTerrain, TracesTheSameHitsAsTheDemInCore) {
     ASSERT_EQ(t_core, t_out) << "ray " << i;
     if (std::isfinite(t_core)) {
       ++hits;
-      ASSERT_EQ(n_core, n_out) << "ray " << i;
+      // Out of core Embree's primitives are groups of 4 x 4 blocks, tried
+      // nearest first: on a tie (a hit on an edge two blocks share, the same
+      // distance) the other block's triangle may be reported.
+      ties += !(n_core == n_out);
       const Eigen::Vector3f p = o + t_core * d;
       ASSERT_EQ(core.height_at(p.x(), p.y()), out.height_at(p.x(), p.y())) << "ray " << i;
     }
   }
   EXPECT_GT(hits, 2000);
+  EXPECT_LE(ties, hits / 200);
   const BlockCacheStats s = paged.cache_stats();
   EXPECT_LE(s.peak_resident, paged.budget());
   EXPECT_GT(s.misses, 70u);  // 10 x 7 pages, most read more than once
@@ -129,7 +141,7 @@ TEST(PagedTerrain, ImagesAreTheSameBitsAtAnyBudgetAndThreadCount) {
   const Camera camera = default_camera(core);
   const Image reference = render(core, in, camera, 2);
 
-  const std::uint64_t one_page = (kPage + 1) * (kPage + 1) * sizeof(float);
+  const std::uint64_t one_page = pages_budget(dem, 1);
   for (const std::uint64_t budget : {one_page, std::uint64_t{1} << 20}) {
     for (const int threads : {1, 2}) {
       PagedTerrain paged(dem, budget, 1.0f, kPage);
@@ -140,7 +152,7 @@ TEST(PagedTerrain, ImagesAreTheSameBitsAtAnyBudgetAndThreadCount) {
       EXPECT_TRUE(image.pixels == reference.pixels)
           << "budget " << budget << " B, " << threads << " thread(s)";
       const BlockCacheStats s = paged.cache_stats();
-      EXPECT_LE(s.peak_resident, budget);
+      EXPECT_LE(s.peak_resident + paged.held_bytes(), budget);
       if (budget == one_page)
         EXPECT_GT(s.misses, 70u);  // pages read again and again
       else
@@ -158,14 +170,18 @@ TEST(PagedTerrain, ScanGivesTheSameLeavesAtAnyStripAndThreadCount) {
   const fs::path dem = tiled_dem();
   std::vector<HeightFieldBlocks::MinMax> reference;
   Eigen::Vector3f highest, lowest;
+  std::vector<float> coarse;
   for (const int page : {256, 16, 32}) {
     for (const int threads : {1, 2}) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
       PagedTerrain paged(dem, std::uint64_t{1} << 20, 1.0f, page);
-      const std::vector<HeightFieldBlocks::MinMax> leaves = paged.take_leaves();
-      ASSERT_EQ(leaves.size(), std::size_t{75} * 55);  // 299 x 219 cells in leaves of 4
+      const std::vector<HeightFieldBlocks::MinMax> leaves = paged.take_block_bounds();
+      ASSERT_EQ(leaves.size(), std::size_t{19} * 14);  // 299 x 219 cells in blocks of 16
+      const std::vector<float> samples = paged.take_coarse();
+      ASSERT_EQ(samples.size(), std::size_t{39} * 29);  // every 8th vertex and the last
       if (reference.empty()) {
         reference = leaves;
+        coarse = samples;
         highest = paged.highest(), lowest = paged.lowest();
         continue;
       }
@@ -173,6 +189,7 @@ TEST(PagedTerrain, ScanGivesTheSameLeavesAtAnyStripAndThreadCount) {
         ASSERT_EQ(leaves[i].lo, reference[i].lo) << "leaf " << i << ", strips of " << page;
         ASSERT_EQ(leaves[i].hi, reference[i].hi) << "leaf " << i << ", strips of " << page;
       }
+      EXPECT_TRUE(samples == coarse) << "strips of " << page << ", " << threads;
       EXPECT_EQ(paged.highest(), highest) << "strips of " << page << ", " << threads;
       EXPECT_EQ(paged.lowest(), lowest) << "strips of " << page << ", " << threads;
       EXPECT_EQ(paged.scan_bytes(), std::uint64_t{kWidth} * kHeight * sizeof(float));
@@ -184,12 +201,13 @@ TEST(PagedTerrain, RefusesABudgetBelowOnePage) {
   const fs::path dem = tiled_dem();
   try {
     PagedTerrain paged(dem, 1000, 1.0f, kPage);
-    FAIL() << "a budget of 1000 B was taken for pages of 4356 B";
+    FAIL() << "a budget of 1000 B was taken for pages of 4996 B";
   } catch (const drift::Error& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("cannot hold one block"), std::string::npos) << what;
     EXPECT_NE(what.find(dem.string()), std::string::npos) << what;  // which DEM
-    EXPECT_NE(what.find("4356 B"), std::string::npos) << what;      // a page's size
+    EXPECT_NE(what.find("4996 B"), std::string::npos)
+        << what;  // a page's size: 33^2 heights, 80 nodes
   }
 }
 
@@ -200,4 +218,188 @@ TEST(PagedTerrain, NamesAMissingRaster) {
   } catch (const drift::Error& e) {
     EXPECT_NE(std::string(e.what()).find("drift_no_such_dem.vrt"), std::string::npos) << e.what();
   }
+}
+
+// ---------------------------------------------------------------------------
+// Level of detail by footprint (issue 36 item 2; render/height_field.h,
+// LodView): distant vertices slide onto the surfaces through every 8th and
+// 16th vertex, continuously with the camera, the same whatever the cache.
+
+namespace {
+
+// A camera low over the DEM's south edge looking north across it, so the
+// frame runs from full resolution to level 4; `bias` makes levels coarser.
+struct LodCase {
+  Camera camera;
+  LodView view;
+};
+LodCase lod_case(const TerrainScene& scene, int width, float bias) {
+  LodCase k;
+  const Eigen::Vector3d o = scene.origin();
+  k.camera.from = o + Eigen::Vector3d(0.0, -250.0, 120.0);
+  k.camera.to = o + Eigen::Vector3d(0.0, 200.0, 0.0);
+  k.camera.vertical_fov_deg = 40.0;
+  const CameraRays rays = make_camera_rays(scene, k.camera, width, width * 2 / 3);
+  k.view = {rays.eye, rays.footprint_spread(), bias};
+  return k;
+}
+
+Image lod_render(const TerrainScene& scene, const SceneInput& in, const Camera& camera,
+                 int threads) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  RenderSettings rs;
+  rs.width = 48;
+  rs.height = 32;
+  rs.samples_per_pixel = 2;
+  return render_image(scene, in, camera, rs);
+}
+
+double mean_abs_difference(const Image& a, const Image& b) {
+  double sum = 0, ref = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    sum += std::fabs(static_cast<double>(a.pixels[i]) - b.pixels[i]);
+    ref += std::fabs(static_cast<double>(b.pixels[i]));
+  }
+  return sum / ref;
+}
+
+}  // namespace
+
+// With LOD the frame stays within 5 % (mean absolute difference over the mean)
+// of full resolution, its depths within 0.5 % on 95 % of the pixels, and it
+// reads fewer pages.
+TEST(LevelOfDetail, RenderIsCloseToFullResolutionAndReadsFewerPages) {
+  const fs::path dem = tiled_dem();
+  const std::uint64_t budget = pages_budget(dem, 1);
+  const SceneInput in = bare_input();
+  PagedTerrain full_paged(dem, budget, 1.0f, kPage);
+  const TerrainScene full(in, full_paged);
+  PagedTerrain lod_paged(dem, budget, 1.0f, kPage);
+  TerrainScene lod(in, lod_paged);
+  const LodCase k = lod_case(lod, 48, 0.0f);
+  lod.set_lod(k.view);
+  const Image a = lod_render(full, in, k.camera, 2);
+  const Image b = lod_render(lod, in, k.camera, 2);
+  const double d = mean_abs_difference(b, a);
+  EXPECT_LT(d, 0.05);
+  EXPECT_GT(d, 0.0);  // the LOD is on
+  // Depths of the frame's pixel centres.
+  const CameraRays rays = make_camera_rays(full, k.camera, 96, 64);
+  int close = 0, hits = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 96; ++x) {
+      const Eigen::Vector3f dir = rays.direction(x + 0.5f, y + 0.5f);
+      const float ta = full.hit_distance(rays.eye, dir), tb = lod.hit_distance(rays.eye, dir);
+      if (!std::isfinite(ta)) continue;
+      ++hits;
+      close += std::isfinite(tb) && std::fabs(tb - ta) <= 0.005f * ta;
+    }
+  EXPECT_GT(hits, 3000);
+  EXPECT_GE(close, hits * 95 / 100) << close << " of " << hits;
+  EXPECT_LT(lod_paged.cache_stats().misses, full_paged.cache_stats().misses);
+}
+
+// The level depends on the view alone: the same bits at a budget of one page
+// or of all of them, on one thread or two.
+TEST(LevelOfDetail, ImagesAreTheSameBitsAtAnyBudgetAndThreadCount) {
+  const fs::path dem = tiled_dem();
+  Image reference;
+  for (const std::uint64_t pages : {1, 100}) {
+    for (const int threads : {1, 2}) {
+      PagedTerrain paged(dem, pages_budget(dem, pages), 1.0f, kPage);
+      const SceneInput in = bare_input();
+      TerrainScene scene(in, paged);
+      const LodCase k = lod_case(scene, 48, 1.0f);
+      scene.set_lod(k.view);
+      const Image image = lod_render(scene, in, k.camera, threads);
+      if (reference.pixels.empty()) {
+        reference = image;
+        continue;
+      }
+      EXPECT_TRUE(image.pixels == reference.pixels)
+          << pages << " page(s), " << threads << " thread(s)";
+    }
+  }
+}
+
+// A step of the camera moves every vertex's height by at most the level's
+// change times the height between the levels there (the morph): nothing pops.
+// The step changes any vertex's level by at most 0.01, so no vertex may move
+// by more than 2 % of the largest difference between adjacent levels.
+TEST(LevelOfDetail, ACameraStepMovesNoVertexByAJump) {
+  const fs::path dem = tiled_dem();
+  SceneInput in = bare_input();
+  in.terrain = drift::terrain::read_raster(dem);
+  const TerrainScene probe(in, TerrainGeometry::HeightField);
+  const LodCase k = lod_case(probe, 48, 1.0f);
+  HeightGrid grid;
+  grid.width = kWidth, grid.height = kHeight, grid.dx = 2.0f, grid.dy = 2.0f;
+  grid.z.resize(static_cast<std::size_t>(kWidth) * kHeight);
+  for (int r = 0; r < kHeight; ++r)
+    for (int c = 0; c < kWidth; ++c) {
+      const float v = in.terrain(c, r);
+      grid.z[static_cast<std::size_t>(r) * kWidth + c] = std::isnan(v) ? 860.0f : v;
+    }
+  grid.x0 = -299.0f, grid.y0 = 219.0f;
+  HeightFieldBlocks a(grid), b(grid);
+  // The nearest vertex is ~100 m away: a 0.5 m step changes levels by < 0.01.
+  const Eigen::Vector3f eye(0.0f, -320.0f, 1000.0f);
+  LodView va{eye, k.view.spread, 1.0f}, vb = va;
+  vb.eye += Eigen::Vector3f(0.3f, 0.4f, 0.0f);
+  a.set_lod(va);
+  b.set_lod(vb);
+  HeightFieldBlocks off(grid);
+  float largest_jump = 0.0f, largest_move = 0.0f;
+  int moved = 0;
+  for (int r = 0; r < kHeight; ++r)
+    for (int c = 0; c < kWidth; ++c) {
+      largest_jump = std::max(largest_jump, std::fabs(a.height(c, r) - off.height(c, r)));
+      const float m = std::fabs(a.height(c, r) - b.height(c, r));
+      largest_move = std::max(largest_move, m);
+      moved += m > 0.0f;
+    }
+  EXPECT_GT(largest_jump, 1.0f);  // the levels differ by metres here
+  EXPECT_GT(moved, 1000);         // and the step does move vertices
+  EXPECT_LE(largest_move, 0.02f * largest_jump) << largest_move << " of " << largest_jump;
+}
+
+// Where a full-resolution block meets one at a coarser level (and levels
+// meet each other) the surface has no crack: rays aimed at points on every
+// block edge, against the surface, all stop there (within the rounding).
+TEST(LevelOfDetail, RaysAimedAtLevelSeamsAllHit) {
+  const fs::path dem = tiled_dem();
+  SceneInput in = bare_input();
+  in.terrain = drift::terrain::read_raster(dem);
+  TerrainScene scene(in, TerrainGeometry::HeightField);
+  LodView view = lod_case(scene, 48, 0.0f).view;
+  view.spread *= 4.0f;  // levels 0 to 4 all within the DEM
+  scene.set_lod(view);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float x0 = -299.0f, y0 = 219.0f, cell = 2.0f;
+  constexpr int kB = HeightFieldBlocks::kBlock;
+  int rays = 0, passed = 0;
+  for (int edge = kB; edge < kWidth - 1; edge += kB)
+    for (int s = 0; s < 200; ++s) {
+      for (const bool vertical : {true, false}) {
+        if (!vertical && edge >= kHeight - 1) continue;
+        const float along = u(rng) * (vertical ? kHeight - 1 : kWidth - 1) * cell;
+        const float x = vertical ? x0 + edge * cell : x0 + along;
+        const float y = vertical ? y0 - along : y0 - edge * cell;
+        const Eigen::Vector3f target(x, y, scene.height_at(x, y));
+        // Against the surface's normal, tilted up to ~20 degrees: never
+        // grazing, so a target rounded a hair above the surface is met
+        // within millimetres of it.
+        const Eigen::Vector3f n = scene.smooth_normal(x, y);
+        const Eigen::Vector3f dir =
+            -(n + 0.35f * Eigen::Vector3f(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f))
+                 .normalized();
+        const Eigen::Vector3f o = target - 400.0f * dir;
+        const float t = scene.hit_distance(o, dir);
+        ++rays;
+        if (!(t <= 400.0f + 0.01f)) ++passed;
+      }
+    }
+  EXPECT_GT(rays, 5000);
+  EXPECT_EQ(passed, 0) << passed << " of " << rays << " rays passed a seam";
 }
