@@ -108,11 +108,12 @@ void BM_SnowfallWithObjects(benchmark::State& state) {
   std::size_t triangles = 0;
   for (const auto& o : objs) triangles += o.mesh.triangle_count();
   // 25 h from the west-north-west at 55 degrees: the defaults' 16 maps and 2 cm/h.
-  const SnowfallOptions o{.azimuth_deg = 300.0,
-                          .elevation_deg = 55.0,
-                          .spread_deg = 8.0,
-                          .hours = 25.0,
-                          .mesh_max_edge = 0.0};
+  SnowfallOptions o;
+  o.azimuth_deg = 300.0;
+  o.elevation_deg = 55.0;
+  o.spread_deg = 8.0;
+  o.hours = 25.0;
+  o.mesh_max_edge = 0.0;
   SnowfallResult r;
   for (auto _ : state) r = simulate_snowfall(ground, objs, o);
   state.counters["triangles"] = static_cast<double>(triangles);
