@@ -166,7 +166,7 @@ struct MarksSimulation::Impl {
     const CellWindow f = footprint_window(tris, 0, sim.heights_.width(), sim.heights_.height());
     const double diameter =
         2.0 * std::sqrt(static_cast<double>(f.width) * f.height / std::numbers::pi);
-    return static_cast<int>(std::ceil(heave * diameter)) + 1;
+    return static_cast<int>(std::ceil(kHeaveReach * heave * diameter)) + 1;
   }
   // The window's margin (cells): the options', widened by the heave's band so
   // that the heave is not cut short.
