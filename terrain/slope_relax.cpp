@@ -21,6 +21,9 @@ constexpr std::size_t kParallelTiles = 32;
 // Cells in a list below which a phase of run_cells runs on the calling thread.
 constexpr std::size_t kParallelCells = 8192;
 
+// touched_: a cell that gave or took less than SlopeRelaxOptions::settle (net).
+constexpr std::uint8_t kSettled = 2;
+
 }  // namespace
 
 void SlopeRelaxWorkspace::fit(int width, int height) {
@@ -30,7 +33,7 @@ void SlopeRelaxWorkspace::fit(int width, int height) {
   const std::size_t cells = static_cast<std::size_t>(width) * height;
   const std::size_t tiles = static_cast<std::size_t>(tiles_x_) * tiles_y_;
   take_.assign(cells, 0.0);
-  slot_.assign(cells, -1);
+  slot_.assign(cells, 0);
   active_.assign(cells, 0), touched_.assign(cells, 0), ever_.assign(cells, 0);
   stamp_.assign(cells, 0), stamp_now_ = 0;
   tile_active_.assign(tiles, 0), tile_touched_.assign(tiles, 0);
@@ -117,19 +120,23 @@ class SlopeRelaxer {
       }
       report.moved += pass(active, near_cells_);
       // After a pass: a cell is active if it or a neighbour gave or took.
+      // Only a cell whose height changed by more than `settle` keeps its
+      // neighbours active (kSettled: it moved less); every cell that moved is
+      // reported.
       touched.clear();
-      for (int c : near_cells_)
-        if (ws_.touched_[static_cast<std::size_t>(c)]) touched.push_back(c);
-      for (int c : touched) ws_.touched_[static_cast<std::size_t>(c)] = 0;
+      for (int c : near_cells_) {
+        const std::size_t i = static_cast<std::size_t>(c);
+        const std::uint8_t t = ws_.touched_[i];
+        if (!t) continue;
+        ws_.touched_[i] = 0;
+        if (!ws_.ever_[i]) ws_.ever_[i] = 1, moved.push_back(c);
+        if (t != kSettled) touched.push_back(c);
+      }
       // The slow tail of a slump moves the same cells pass after pass: then the
       // lists built from them are the same too (the same cells in the same
       // order, since each list is built from the one before).
       same = touched == was_touched;
       if (same) continue;
-      for (int c : touched) {
-        const std::size_t i = static_cast<std::size_t>(c);
-        if (!ws_.ever_[i]) ws_.ever_[i] = 1, moved.push_back(c);
-      }
       dilate(touched, active);
       std::swap(touched, was_touched);
     }
@@ -257,10 +264,14 @@ class SlopeRelaxer {
     const double room = std::max(h_[i] - floor(i), 0.0);
     double sum = 0.0, largest = 0.0;
     const double share = r.share == SlopeShare::Fraction ? r.fraction : 1.0;
+    // Branch-free (whether a pair counts is a coin toss for the predictor):
+    // a pair that does not count adds +0.0, which leaves the sums' bits as
+    // skipping it would.
+    const double tolerance = o_.tolerance;
     for (int k = 0; k < 8; ++k) {
-      if (e[k] <= o_.tolerance) continue;
-      sum += share * e[k];
-      largest = std::max(largest, e[k]);
+      const bool counts = e[k] > tolerance;
+      sum += counts ? share * e[k] : 0.0;
+      largest = std::max(largest, counts ? e[k] : 0.0);
     }
     double factor = 0.0;
     if (sum > 0.0) {
@@ -276,6 +287,9 @@ class SlopeRelaxer {
     ws_.post_[s] = r.share == SlopeShare::Fraction ? factor : 1.0;
     ws_.slot_[i] = static_cast<int>(s);
   }
+  // Giver slots start at 1: slot 0 (slot_'s "none") is a giver that offers
+  // nothing (excesses -inf, factors 0), so the interior loops below read
+  // every neighbour's slot without a branch.
   // Calls fn(s, e) for every giver (slot s) next to cell i with excess e
   // towards it.
   template <class Fn>
@@ -288,7 +302,7 @@ class SlopeRelaxer {
     for (int k = 0; k < 8; ++k) {
       if (!all && !has(x, y, k)) continue;
       const int s = slot[static_cast<std::ptrdiff_t>(i) + offset_[k]];
-      if (s < 0) continue;
+      if (s == 0) continue;
       const double e = excess[8 * static_cast<std::size_t>(s) + (7 - k)];
       if (e > tolerance) fn(static_cast<std::size_t>(s), e);
     }
@@ -297,10 +311,26 @@ class SlopeRelaxer {
   // offered from, its ceiling).
   double take_share(std::size_t i, int x, int y) const {
     double in = 0.0, largest = 0.0;
-    for_offers(i, x, y, [&](std::size_t s, double e) {
-      in += offer(s, e);
-      largest = std::max(largest, e);
-    });
+    if (interior(x, y)) {
+      // for_offers without branches (slot 0 offers nothing; +0.0 for a pair
+      // that does not count leaves the sums' bits as skipping it would).
+      const int* slot = ws_.slot_.data() + i;
+      const double* excess = ws_.excess_.data();
+      const double* mult = ws_.mult_.data();
+      const double tolerance = o_.tolerance;
+      for (int k = 0; k < 8; ++k) {
+        const auto s = static_cast<std::size_t>(slot[offset_[k]]);
+        const double e = excess[8 * s + (7 - k)];
+        const bool counts = e > tolerance;
+        in += counts ? mult[s] * e : 0.0;
+        largest = std::max(largest, counts ? e : 0.0);
+      }
+    } else {
+      for_offers(i, x, y, [&](std::size_t s, double e) {
+        in += offer(s, e);
+        largest = std::max(largest, e);
+      });
+    }
     if (!(in > 0.0)) return 0.0;
     const double room = ceiling(i) - h_[i];
     return std::min({1.0, 0.5 * largest / in, std::max(room, 0.0) / in});
@@ -315,26 +345,47 @@ class SlopeRelaxer {
     const int s = ws_.slot_[i];
     const double* take = ws_.take_.data();
     const double tolerance = o_.tolerance;
-    if (s >= 0 && ws_.factor_[static_cast<std::size_t>(s)] > 0.0) {
+    // Branch-free like take_share: a flow that does not happen adds +0.0 (the
+    // same bits as skipping it; the disturbance too, +0.0f).
+    if (s > 0 && ws_.factor_[static_cast<std::size_t>(s)] > 0.0) {
       const double* e = &ws_.excess_[8 * static_cast<std::size_t>(s)];
+      const double mult = ws_.mult_[static_cast<std::size_t>(s)];
+      const double post = ws_.post_[static_cast<std::size_t>(s)];
+      const bool all = interior(x, y);
       for (int k = 0; k < 8; ++k) {
-        if (e[k] <= tolerance) continue;
-        const double f = flow(static_cast<std::size_t>(s), e[k],
-                              take[static_cast<std::ptrdiff_t>(i) + offset_[k]]);
-        if (!(f > 0.0)) continue;
-        out += f, moved = true;
-        if (disturbed) *disturbed += static_cast<float>(f);
+        // Outside the grid e is -inf and the take is not read.
+        const double t =
+            all || e[k] > tolerance ? take[static_cast<std::ptrdiff_t>(i) + offset_[k]] : 0.0;
+        const double f = mult * e[k] * post * t;
+        const bool flows = e[k] > tolerance && f > 0.0;
+        out += flows ? f : 0.0, moved = moved || flows;
+        if (disturbed) *disturbed += flows ? static_cast<float>(f) : 0.0f;
       }
     }
-    if (ws_.take_[i] > 0.0)
+    const double take_i = ws_.take_[i];
+    if (take_i > 0.0 && interior(x, y)) {
+      const int* slot = ws_.slot_.data() + i;
+      const double* excess = ws_.excess_.data();
+      const double* mult = ws_.mult_.data();
+      const double* post = ws_.post_.data();
+      for (int k = 0; k < 8; ++k) {
+        const auto n = static_cast<std::size_t>(slot[offset_[k]]);
+        const double e = excess[8 * n + (7 - k)];
+        const double f = mult[n] * e * post[n] * take_i;
+        const bool flows = e > tolerance && f > 0.0;
+        in += flows ? f : 0.0, moved = moved || flows;
+        if (disturbed) *disturbed += flows ? static_cast<float>(f) : 0.0f;
+      }
+    } else if (take_i > 0.0) {
       for_offers(i, x, y, [&](std::size_t n, double e) {
-        const double f = flow(n, e, ws_.take_[i]);
+        const double f = flow(n, e, take_i);
         if (!(f > 0.0)) return;
         in += f, moved = true;
         if (disturbed) *disturbed += static_cast<float>(f);
       });
+    }
     h_[i] += in - out;
-    ws_.touched_[i] = moved;
+    ws_.touched_[i] = !moved ? 0 : o_.settle > 0.0 && in + out <= o_.settle ? kSettled : 1;
     return out;
   }
 
@@ -343,14 +394,16 @@ class SlopeRelaxer {
   // function of each cell alone, so the lists' order and the thread count do
   // not matter. Returns the height moved.
   double pass(const std::vector<int>& active, const std::vector<int>& near) {
-    if (ws_.excess_.size() < 8 * active.size()) {
-      ws_.excess_.resize(8 * active.size());
-      ws_.mult_.resize(active.size()), ws_.post_.resize(active.size());
-      ws_.factor_.resize(active.size());
+    const std::size_t slots = active.size() + 1;  // slot 0: nobody
+    if (ws_.excess_.size() < 8 * slots) {
+      ws_.excess_.resize(8 * slots);
+      ws_.mult_.resize(slots), ws_.post_.resize(slots), ws_.factor_.resize(slots);
+      std::fill_n(ws_.excess_.begin(), 8, -kInf);
+      ws_.mult_[0] = ws_.post_[0] = ws_.factor_[0] = 0.0;
     }
     for_each_index(active.size(), kParallelCells, [&](std::size_t s) {
       const auto i = static_cast<std::size_t>(active[s]);
-      if (giver(i)) give(s, i);
+      if (giver(i)) give(s + 1, i);
     });
     for_each_cell(near, [&](std::size_t i, int x, int y) { ws_.take_[i] = take_share(i, x, y); });
     gave_.assign(near.size(), 0.0);
@@ -358,7 +411,7 @@ class SlopeRelaxer {
       const int c = near[k];
       gave_[k] = change(static_cast<std::size_t>(c), c % w_, c / w_);
     });
-    for (int c : active) ws_.slot_[static_cast<std::size_t>(c)] = -1;
+    for (int c : active) ws_.slot_[static_cast<std::size_t>(c)] = 0;
     double moved = 0.0;
     for (double g : gave_) moved += g;
     return moved;

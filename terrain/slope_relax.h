@@ -71,6 +71,12 @@ struct SlopeRelaxOptions {
   double tolerance = 1e-6;    // m: a pair steeper than repose by less than this is stable
   int max_passes = 200;
   std::uint64_t seed = 0;  // for rules with `rough`: which cells stand steeper
+  // m: a cell whose height changes by no more than this in a pass (net of
+  // what it gives and takes) does not keep its neighbours active in the next
+  // (relax_slopes only; 0: any flow does). A region whose cells all move less
+  // has settled and drops out of the passes, while a bow wave still moving
+  // keeps its own cells going.
+  double settle = 0.0;
 };
 
 // Called after each pass with the passes so far and the share of the tiles still
@@ -106,7 +112,7 @@ class SlopeRelaxWorkspace {
   friend class SlopeRelaxer;
   int width_ = 0, height_ = 0, tiles_x_ = 0, tiles_y_ = 0;
   std::vector<double> take_;  // per taker: the share of its offers it takes this pass
-  std::vector<int> slot_;     // per cell: its place in this pass's givers, -1: not giving
+  std::vector<int> slot_;     // per cell: its place in this pass's givers from 1, 0: not giving
   // Per giver of a pass: its eight excesses, its factor (0: gives nothing),
   // its offers' factor and its flows'.
   std::vector<double> excess_, factor_, mult_, post_;

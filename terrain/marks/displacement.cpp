@@ -170,14 +170,17 @@ void displace_contact(Patch& p, const std::optional<Eigen::Vector2d>& drag, Disp
 // Heave (issue 32; docs/marks.md, "Mud's heave"): a press into a material of
 // heave H > 0 hands the volume on its ring (where spread_over_rings left it)
 // to a band of width W = H B beside the contact, B the footing's width
-// (footing_width): a free cell at distance d < W from the contact takes a
-// share in proportion to 1 - d / W, so the heave is highest at the wall and
-// runs out at W, the same in every direction (straight edges give even
+// (footing_width; the band reaches kHeaveReach W): a free cell at distance
+// d from the contact, x = d / (kHeaveReach W) < 1, takes a share in
+// proportion to 1 - smoothstep(x) = 1 - 3x^2 + 2x^3, so the heave is highest
+// at the wall and runs out with no slope left (a linear 1 - d / W ended in a
+// crease that a low sun drew as a ring around mud prints), the same in every
+// direction (straight edges give even
 // bands, round prints round ones). A drag keeps the paper's flow (its bow
 // wave goes ahead, not back into the trough).
 void spread_heave(Patch& p, const MaterialField& materials, double footing) {
   const int n = static_cast<int>(p.contact.size());
-  auto band = [&](int li) { return materials.at(p.global(li)).heave * footing; };
+  auto band = [&](int li) { return kHeaveReach * materials.at(p.global(li)).heave * footing; };
   double volume = 0.0;
   for (int li = 0; li < n; ++li)
     if (!p.contact[li] && p.pending[li] > 0.0 && p.outer[li] < band(li))
@@ -188,7 +191,8 @@ void spread_heave(Patch& p, const MaterialField& materials, double footing) {
   for (int li = 0; li < n; ++li) {
     const double w = band(li);
     if (p.contact[li] || !(p.outer[li] < w)) continue;
-    weight[li] = 1.0 - p.outer[li] / w;
+    const double x = p.outer[li] / w;
+    weight[li] = 1.0 - x * x * (3.0 - 2.0 * x);
     total += weight[li];
   }
   for (int li = 0; li < n; ++li)

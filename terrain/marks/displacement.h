@@ -42,6 +42,12 @@ struct DisplacementReport {
   std::vector<int> received;  // flat indices of the free cells that took material
 };
 
+// Mud's heave band reaches kHeaveReach x heave x the footing's width: its
+// smoothstep taper holds 90 % of the volume within 0.60 of its reach, where
+// the linear taper it replaced held it within 0.68, so the band is 1.13
+// times as long to stand as wide as before (a footing's width, heave 1).
+inline constexpr double kHeaveReach = 1.13;
+
 // heights: the whole field (m), updated in the bottom map's window.
 // drag: the horizontal motion in cell space (any length), or none when pressing.
 // disturbed (optional): accumulates |change| per cell. dx, dy: cell sizes (m).

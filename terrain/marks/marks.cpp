@@ -98,6 +98,13 @@ struct MarksSimulation::Impl {
     terrain::SlopeRelaxOptions o{sim.frame_.dx, sim.frame_.dy,
                                  1e-4 * std::min(sim.frame_.dx, sim.frame_.dy),
                                  sim.options_.erosion_passes, erosion_seed()};
+    // A cell that moves no more than a thousandth of a cell in a pass (10
+    // micrometres at 1 cm cells, far below what a render shows) stops keeping
+    // its neighbours active: the levees' slow tail drops out while the bow
+    // wave goes on (docs/marks.md, Performance: 1.2-1.4x a step, marks within
+    // 1.2 mm of relaxing every mover; 3e-3 of a cell left a long-held print's
+    // walls steeper than theta, MarksMemory).
+    o.settle = 1e-3 * std::min(sim.frame_.dx, sim.frame_.dy);
     std::vector<int> moved;
     terrain::relax_slopes(sim.heights_, std::move(seeds), cells, o, moved,
                           sim.options_.track_disturbed ? &sim.disturbed_ : nullptr, &workspace);
@@ -149,17 +156,26 @@ struct MarksSimulation::Impl {
     remember(held);
     return out;
   }
-  // The window's margin (cells): the options', widened by the heave's band
-  // (displacement.cpp: heave x the footing's width, at most the diameter of
-  // a disc of the footprint's area) so that the heave is not cut short.
-  int margin(const CellTriangles& tris) const {
+  // The heave's band (fine cells): heave x the footing's width, at most the
+  // diameter of a disc of the footprint's area (displacement.cpp), plus a
+  // cell; 0 without heave.
+  int heave_band(const CellTriangles& tris) const {
     double heave = 0.0;
     for (const Material& m : sim.materials_.table) heave = std::max(heave, m.heave);
-    if (!(heave > 0.0)) return sim.options_.margin;
+    if (!(heave > 0.0)) return 0;
     const CellWindow f = footprint_window(tris, 0, sim.heights_.width(), sim.heights_.height());
     const double diameter =
         2.0 * std::sqrt(static_cast<double>(f.width) * f.height / std::numbers::pi);
-    return sim.options_.margin + static_cast<int>(std::ceil(heave * diameter)) + 1;
+    return static_cast<int>(std::ceil(kHeaveReach * heave * diameter)) + 1;
+  }
+  // The window's margin (cells): the options', widened by the heave's band so
+  // that the heave is not cut short.
+  int margin(const CellTriangles& tris) const { return sim.options_.margin + heave_band(tris); }
+  // The same in blocks of `level` cells (multi-resolution, 3.6): the options'
+  // margin in blocks, as the paper's, and the heave's band, whose width is the
+  // footing's whatever the level, in blocks too.
+  int coarse_margin(const CellTriangles& tris, int level) const {
+    return sim.options_.margin + (heave_band(tris) + level - 1) / level;
   }
   // Paper 000, 3.3-3.5 on the full-resolution field: collision, displacement, erosion.
   BottomMap deform(const CellTriangles& tris, const MarkObject& object,
@@ -277,10 +293,10 @@ StepReport MarksSimulation::move(const ObjectShape& shape, const MarkObject& obj
         impl_->rasteriser->render(tris, fine);
         impl_->claim_material(impl_->below(fine), object);
       }
-      CoarseResult c =
-          deform_coarse(heights_, materials_, tris, level, frame_.dx, frame_.dy, options_.margin,
-                        options_.erosion_passes, *impl_->rasteriser, drag,
-                        options_.track_disturbed ? &disturbed_ : nullptr, impl_->erosion_seed());
+      CoarseResult c = deform_coarse(
+          heights_, materials_, tris, level, frame_.dx, frame_.dy,
+          impl_->coarse_margin(tris, level), options_.erosion_passes, *impl_->rasteriser, drag,
+          options_.track_disturbed ? &disturbed_ : nullptr, impl_->erosion_seed());
       const double area = frame_.dx * frame_.dy * level * level;
       report.collided += c.collided * area, report.displaced += c.displaced * area;
       report.compressed += c.compressed * area;

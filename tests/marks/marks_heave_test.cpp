@@ -26,14 +26,16 @@ struct Print {
 };
 
 // A square plate of half side `half` pressed kDepth into mud of `heave`,
-// held a step, lifted and left four steps to slump.
-Print press(double half, double heave) {
+// held a step, lifted and left four steps to slump; worked at `level`
+// (paper 000, 3.6: 1 full resolution, 2 half).
+Print press(double half, double heave, int level = 1) {
   MaterialField mud = testing::only("mud");
   mud.table[0].heave = heave;
   MarksSimulation sim(testing::flat(kSize, kCell, 1.0f), mud, {});
   const ObjectShape shape = ObjectShape::of(testing::box(half, half, 0.02));
   MarkObject object;
   object.motion = Motion::Place;
+  object.resolution = level;
   const double c = kSize / 2.0;
   Print out;
   Pose at{testing::at_cell(sim, c, c, 1.0 + 0.02 - kDepth), Eigen::Quaterniond::Identity()};
@@ -101,6 +103,18 @@ TEST(MarksHeave, WithoutHeaveTheRimStaysOnTheRing) {
   for (double v : ring.h.values()) top0 = std::max(top0, v - 1.0);
   for (double v : heave.h.values()) top1 = std::max(top1, v - 1.0);
   EXPECT_LT(top1, 0.5 * top0) << "heave top " << top1 << " m against the ring's " << top0;
+}
+
+// Multi-resolution (3.6): the coarse window is widened for the heave's band
+// as the full-resolution one is, so the heave at half resolution is as wide
+// as at full and not cut (heaped) at the window's edge; volume kept.
+TEST(MarksHeave, HalfResolutionKeepsTheHeavesWidth) {
+  const double half = 0.06;
+  const Print fine = press(half, 1.0), coarse = press(half, 1.0, 2);
+  const double wf = heave_width(fine.h, half), wc = heave_width(coarse.h, half);
+  RecordProperty("heave_widths_mm", std::to_string(wf * 1e3) + " " + std::to_string(wc * 1e3));
+  EXPECT_NEAR(wc / wf, 1.0, 0.2) << "heave widths " << wf << " m (full), " << wc << " m (half)";
+  EXPECT_NEAR(volume_change(coarse), 0.0, 1e-9);
 }
 
 }  // namespace
