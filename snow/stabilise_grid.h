@@ -43,6 +43,7 @@
 // on 2 x 2 blocks first; the passes on the grid still decide convergence.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "terrain/grid.h"
@@ -67,6 +68,9 @@ struct StabiliseOptions {
   // cm from the passes' own (one level: RMS 2.3 cm at 1024^2), see
   // docs/snowfall.md.
   int coarse_levels = 0;
+  // Bytes a cell the caller holds beside the workspace (snowfall: the ground,
+  // probability, facing and snow grids), counted in its memory checks.
+  std::uint64_t held_bytes_per_cell = 0;
 };
 
 struct StabiliseReport {
