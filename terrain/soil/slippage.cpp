@@ -292,7 +292,7 @@ void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
     for (int x = 0; x < shape_.nx; ++x) {
       const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
       for (int pile = 0; pile < kMaxPiles; ++pile) {
-        const int s = pile_span_[col * kMaxPiles + pile];
+        const int s = static_cast<int>(pile_span_[col * kMaxPiles + pile]);  // -1: none
         if (s >= 0) {
           slide_pile(x, y, pile, spans_.column(col)[s], k);
           continue;
@@ -430,7 +430,7 @@ void Slippage::apply(SoilState& state) {
       for (int pile = 0; pile < kMaxPiles; ++pile) {
         const std::size_t node = col * kMaxPiles + pile;
         out_from_[node] = -1;
-        const int s = pile_span_[node];
+        const int s = static_cast<int>(pile_span_[node]);  // -1: none
         if (s < 0) continue;
         float out = 0;
         for (int d = 0; d < kDirections; ++d) out += out_[slot(col, pile, d)].dh;
