@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <regex>
 #include <set>
@@ -649,9 +650,14 @@ void place_map(SceneFile& scene) {
   const double rows = std::round((box[3] - box[1]) / cell);
   constexpr int kMax = render::RenderSettings::kMaxSide;
   if (columns < 1 || rows < 1 || columns > kMax || rows > kMax) {
-    throw Error("the map of " + std::to_string(box[2] - box[0]) + " x " +
-                std::to_string(box[3] - box[1]) + " m at a cell of " + std::to_string(cell) +
-                " m would be " + std::to_string(columns) + " x " + std::to_string(rows) +
+    // %g: a box of 1e300 m had printed 301 digits (std::to_string's %f).
+    const auto g = [](double v) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%g", v);
+      return std::string(text);
+    };
+    throw Error("the map of " + g(box[2] - box[0]) + " x " + g(box[3] - box[1]) +
+                " m at a cell of " + g(cell) + " m would be " + g(columns) + " x " + g(rows) +
                 " pixels; give a cell (--cell or [camera] cell) that makes 1.." +
                 std::to_string(kMax) + " a side");
   }

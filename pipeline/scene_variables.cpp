@@ -33,10 +33,11 @@ struct Expansion {
       const auto value = values.find(name);
       if (!is_variable_name(name) || value == values.end())
         fail(node, key,
-             "unknown variable ${" + name +
-                 "}; define it in the file's [variables] table or "
-                 "give it with --set " +
-                 name + "=VALUE");
+             std::string("unknown variable ${")
+                 .append(name)
+                 .append("}; define it in the file's [variables] table or give it with --set ")
+                 .append(name)
+                 .append("=VALUE"));
       out.append(text, at, open - at).append(value->second);
       at = close + 1;
     }

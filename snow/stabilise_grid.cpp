@@ -365,7 +365,7 @@ class SnowPasses {
 template <class OnPass>
 StabiliseReport settle(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
                        const SettleGeometry& geo, int max_passes, bool shortcut,
-                       const OnPass& on_pass) {
+                       std::uint64_t held_bytes_per_cell, const OnPass& on_pass) {
   SnowPasses passes(ground, snow, geo.dx, geo.dy, geo.tan_repose, geo.tolerance);
   int last = 0;
   auto pause = [&](int p, double share) {
@@ -373,7 +373,20 @@ StabiliseReport settle(const terrain::Grid<float>& ground, terrain::Grid<double>
     return shortcut && p - last >= kTailPasses && share < kTailShare;
   };
   bool converged = false;
+  bool counted = false;
   while (!(converged = passes.run(max_passes, pause)) && passes.passes() < max_passes) {
+    // The shortcut's workspace, counted when it first runs (on ground that
+    // never slides it never does: counted up front, the estimate was 1.37
+    // times the peak): envelope (then load) and resting cell, 8 B each, the
+    // cut marks, and the loose snow, changed cells and queue entries of the
+    // cells it cuts (40 B each; a fifth of them counted, measured 1.05 of
+    // the peak on ground steeper than the repose; all of them would be 57 B).
+    if (!counted) {
+      require_memory(snow.size() * (held_bytes_per_cell + SnowPasses::bytes_per_cell() + 25),
+                     "snow stabilisation's workspace and its shortcut",
+                     "use a smaller or coarser ground raster");
+      counted = true;
+    }
     const auto changed = settle_unsupported(ground, snow, geo);
     shortcut = !changed.empty();
     last = passes.passes();
@@ -405,8 +418,8 @@ StabiliseReport settle_levels(const terrain::Grid<float>& ground, terrain::Grid<
             .level_passes;
     prolong_change(coarse.ground, before, coarse.snow, snow);
   }
-  StabiliseReport report =
-      settle(ground, snow, geo, options.max_iterations, options.shortcut, on_pass);
+  StabiliseReport report = settle(ground, snow, geo, options.max_iterations, options.shortcut,
+                                  options.held_bytes_per_cell, on_pass);
   level_passes.push_back(report.iterations);
   report.level_passes = std::move(level_passes);
   return report;
@@ -424,7 +437,8 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
   if (options.direct) {
     // Drained surface (then loads) 8, marks 1, resting cell 4, cut list and
     // its loose snow 12 at worst, a queue entry 16 a cell at worst.
-    require_memory(snow.size() * 41, "snow stabilisation's workspace (direct)",
+    require_memory(snow.size() * (options.held_bytes_per_cell + 41),
+                   "snow stabilisation's workspace (direct)",
                    "use a smaller or coarser ground raster");
     progress(0.0, "stabilising snow");
     settle_at_rest(ground, snow, dx, dy, terrain::tan_degrees(options.repose_deg));
@@ -435,16 +449,15 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
     progress(1.0, "stabilising snow");
     return report;
   }
-  // The passes' workspace, and the shortcut's: envelope (then load), loose
-  // snow (kept for the cut cells, a grid's worth at worst) and resting cell
-  // (doubles and indices), marks, and a queue entry a cell at worst.
-  const std::uint64_t shortcut_bytes = 3 * sizeof(double) + 1 + 16;
-  // The coarse levels' grids (ground, snow, its copy and change: 28 bytes a
-  // coarse cell, 7 a fine one; the levels below a quarter of that) are freed
-  // before the finer level's workspace is made; counted on top as a margin.
+  // The passes' workspace beside the caller's grids; the shortcut's is
+  // counted when it first runs (settle). The coarse levels' grids (ground,
+  // snow, its copy and change: 28 bytes a coarse cell, 7 a fine one; the
+  // levels below a quarter of that) are freed before the finer level's
+  // workspace is made; counted on top as a margin.
   const std::uint64_t coarse_bytes = options.coarse_levels > 0 ? 10 : 0;
-  require_memory(snow.size() * (SnowPasses::bytes_per_cell() + shortcut_bytes + coarse_bytes),
-                 "snow stabilisation's workspace", "use a smaller or coarser ground raster");
+  require_memory(
+      snow.size() * (options.held_bytes_per_cell + SnowPasses::bytes_per_cell() + coarse_bytes),
+      "snow stabilisation's workspace", "use a smaller or coarser ground raster");
   const SettleGeometry geo{dx, dy, terrain::tan_degrees(options.repose_deg), options.tolerance};
   if (options.coarse_levels < 0)
     throw Error("stabilise_grid: the number of coarse levels must be 0 or more");

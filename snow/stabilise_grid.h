@@ -43,6 +43,7 @@
 // on 2 x 2 blocks first; the passes on the grid still decide convergence.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "terrain/grid.h"
@@ -74,6 +75,9 @@ struct StabiliseOptions {
   // and tolerance's pass criterion do not apply; tolerance still decides the
   // report's `converged` (no pair steeper than repose by more than it).
   bool direct = false;
+  // Bytes a cell the caller holds beside the workspace (snowfall: the ground,
+  // probability, facing and snow grids), counted in its memory checks.
+  std::uint64_t held_bytes_per_cell = 0;
 };
 
 struct StabiliseReport {

@@ -292,6 +292,8 @@ void Slippage::compute_slices(const SoilType& soil, double gravity, double dt) {
     for (int x = 0; x < shape_.nx; ++x) {
       const std::size_t col = static_cast<std::size_t>(y) * shape_.nx + x;
       for (int pile = 0; pile < kMaxPiles; ++pile) {
+        // An int8_t span index, -1 for none: its sign is meant.
+        // NOLINTNEXTLINE(bugprone-signed-char-misuse)
         const int s = pile_span_[col * kMaxPiles + pile];
         if (s >= 0) {
           slide_pile(x, y, pile, spans_.column(col)[s], k);
@@ -430,6 +432,7 @@ void Slippage::apply(SoilState& state) {
       for (int pile = 0; pile < kMaxPiles; ++pile) {
         const std::size_t node = col * kMaxPiles + pile;
         out_from_[node] = -1;
+        // NOLINTNEXTLINE(bugprone-signed-char-misuse): an int8_t index, -1 none
         const int s = pile_span_[node];
         if (s < 0) continue;
         float out = 0;

@@ -108,4 +108,11 @@ TEST(MapRender, BoxAndCellChooseTheGridAndBadValuesAreRefused) {
             2);
   EXPECT_FALSE(fs::exists(d / "v.png"));
   EXPECT_FALSE(fs::exists(d / "v.pgw"));
+  // A box of 2e300 m: refused in a short message (it printed 301 digits).
+  EXPECT_EQ(run_drift("render " + (d / "view.toml").string() +
+                          " --map-box -1e300,-1e300,1e300,1e300 -o " + (d / "v.png").string(),
+                      d),
+            1);
+  EXPECT_NE(drift_log(d).find("the map of 2e+300 x 2e+300 m"), std::string::npos) << drift_log(d);
+  EXPECT_LT(drift_log(d).size(), 400u) << drift_log(d);
 }
