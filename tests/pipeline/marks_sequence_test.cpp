@@ -73,3 +73,38 @@ TEST(MarksSequence, ShortSequenceRendersThroughMakeWithTheCameraFixed) {
     changed += std::abs(a.pixels[i] - b.pixels[i]) > 0.05f;
   EXPECT_GT(changed, a.pixels.size() / 20) << changed << " of " << a.pixels.size() << " values";
 }
+
+// `make -C data/scenes soil_sequence`: a soil run's frames (drift soil
+// --frames, a surface mesh every 20 steps) each rendered as the scene's
+// object under the fixed camera of soil_sequence.toml. Short: 40 steps, 2
+// frames at 64x40, 1 spp. The camera is the same, the soil moved.
+TEST(SoilSequence, ShortSoilRunRendersThroughMakeWithTheCameraFixed) {
+  const fs::path d = test_dir("soil_sequence");
+  const std::string cmd =
+      "make -C " DRIFT_SOURCE_DIR "/data/scenes soil_sequence OUT=" + d.string() +
+      " DRIFT=" DRIFT_EXECUTABLE +
+      " SOIL_SEQ_FRAMES='00020 00040' SOIL_SEQ_RUN='--steps 40 --frame-every 20'"
+      " SOIL_SEQ='--size 64x40 --spp 1 --exposure 0' THREADS=2 > " +
+      (d / "make.txt").string() + " 2>&1";
+  const int raw = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << slurp(d / "make.txt");
+  const fs::path seq = d / "soil_sequence";
+  for (const char* f : {"frame_00020", "frame_00040"}) {
+    EXPECT_TRUE(fs::exists(seq / (std::string(f) + ".png"))) << f;
+    EXPECT_TRUE(fs::exists(seq / "frames" / (std::string(f) + ".ply"))) << f;
+  }
+  EXPECT_TRUE(fs::exists(d / "soil_sequence.png"));
+  const std::vector<double> first = numbers(camera_of(slurp(seq / "frame_00020.json"))),
+                            last = numbers(camera_of(slurp(seq / "frame_00040.json")));
+  ASSERT_EQ(first.size(), 3u + 9u + 16u);
+  ASSERT_EQ(first.size(), last.size());
+  for (std::size_t i = 0; i < first.size(); ++i) EXPECT_NEAR(first[i], last[i], 1e-6) << i;
+  // The column slumped between the frames: its top and flanks moved in the view.
+  const drift::render::Image a = drift::render::read_image(seq / "frame_00020.png"),
+                             b = drift::render::read_image(seq / "frame_00040.png");
+  ASSERT_EQ(a.pixels.size(), b.pixels.size());
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    changed += std::abs(a.pixels[i] - b.pixels[i]) > 0.05f;
+  EXPECT_GT(changed, a.pixels.size() / 50) << changed << " of " << a.pixels.size() << " values";
+}
