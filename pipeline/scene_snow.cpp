@@ -2,6 +2,7 @@
 // material mask for the snow material (cover), a height change that is also
 // the snow's thickness (depth), and the snowy objects, an attributed mesh of
 // the declared form terrain::products::kSnowyObjects (objects).
+#include <cctype>
 #include <optional>
 
 #include "pipeline/scene_products.h"
@@ -22,15 +23,18 @@ namespace products = terrain::products;
 // per-vertex snow attributes (the renderer shades by kSnowCoverage).
 void place_snowy_objects(SceneFile& scene, const std::filesystem::path& file) {
   std::vector<terrain::PlacedMesh>& meshes = scene.input.meshes;
-  // Any mesh format, as every object is read; but only PLY carries the
-  // per-vertex snow back: Assimp drops glTF's custom attributes (assimp#4830)
-  // and the other formats have none, so those are refused naming the fix.
-  const terrain::Mesh snowy = terrain::read_mesh(file);
-  if (file.extension() != ".ply" && !snowy.attribute(products::kSnowCoverage)) {
+  // Any mesh format, as every object is read; but only PLY and GLB carry the
+  // per-vertex snow back: Assimp drops glTF's custom attributes (assimp#4830),
+  // so a GLB is read by drift's own reader (terrain::read_glb), and the other
+  // formats, which have none, are refused naming the fix.
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const terrain::Mesh snowy = ext == ".glb" ? terrain::read_glb(file) : terrain::read_mesh(file);
+  if (ext != ".ply" && !snowy.attribute(products::kSnowCoverage)) {
     throw Error(
-        "'" + file.string() + "' has no per-vertex snow: only PLY keeps drift's " +
+        "'" + file.string() + "' has no per-vertex snow: only PLY and GLB keep drift's " +
         "attributes when read (Assimp drops glTF's custom attributes); give --snow-objects " +
-        "([snow] objects) the PLY of drift snow fall --mesh-out OBJECTS.ply");
+        "([snow] objects) the PLY or GLB of drift snow fall --mesh-out OBJECTS.ply");
   }
   std::vector<terrain::Mesh> parts = products::split_objects(snowy, products::kSnowyObjects, file);
   if (parts.size() != meshes.size()) {

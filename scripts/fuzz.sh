@@ -2,7 +2,7 @@
 # Fuzzes every reader of outside input (tests/fuzz/fuzz_targets.h) with libFuzzer:
 # builds the targets with clang, AddressSanitizer and UndefinedBehaviorSanitizer
 # into build-fuzz/ and runs each for SECONDS (default 60), niced.
-#   scripts/fuzz.sh [SECONDS] [TARGET...]   targets: raster scene objects track scenario obj ply image mesh
+#   scripts/fuzz.sh [SECONDS] [TARGET...]   targets: raster scene objects track scenario obj ply image mesh glb
 # The timeout (60 s per input) is wall-clock: generous, as a niced fuzzer on a
 # busy machine gets little CPU (a 2 s unit once took 24 s so). The targets run
 # with DRIFT_MEMORY_LIMIT=64M (tests/fuzz/fuzz_main.cpp): a single allocation
@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(raster scene objects track scenario obj ply image mesh); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(raster scene objects track scenario obj ply image mesh glb); fi
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRIFT_FUZZ=ON \
   -DDRIFT_BUILD_BENCHMARKS=OFF >/dev/null

@@ -88,6 +88,18 @@ std::uint64_t mesh_and_write_bytes(const std::filesystem::path& path, std::uint6
 // the origin in the CRS in the asset's extras ("drift_origin").
 void write_gltf(const Mesh& mesh, const std::filesystem::path& path);
 
+// Reads a GLB directly (terrain/mesh_glb.cpp), keeping what Assimp 5.2 drops
+// (assimp#4830): custom vertex attributes "_NAME" as attributes "name"
+// (write_gltf's "_SNOW_COVERAGE" -> "snow_coverage") and the origin in
+// asset.extras.drift_origin. Takes GLBs of the form write_gltf writes:
+// triangle primitives (joined), float POSITION, NORMAL and SCALAR custom
+// attributes, unsigned byte/short/int indices, buffer 0 the BIN chunk, no
+// node transforms, sparse accessors, interleaving or required extensions.
+// y up back to z up ((x, y, z) -> (x, -z, y), write_gltf's inverse, exact).
+// Every chunk length, offset, stride and count is checked against the file
+// before use; anything else is a drift::Error naming the file and the value.
+Mesh read_glb(const std::filesystem::path& path);
+
 // Binary STL: facets with their normals, z up and metres as stored (STL says
 // neither; docs/meshes.md).
 void write_stl(const Mesh& mesh, const std::filesystem::path& path);

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "terrain/derivatives.h"
+#include "terrain/height_mesh.h"
 #include "terrain/import.h"
 #include "tests/bench/peak_memory.h"
 
@@ -70,6 +71,29 @@ void BM_Pyramid(benchmark::State& state) {
   report(state, static_cast<double>(dem.size()));
 }
 BENCHMARK(BM_Pyramid)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+// drift mesh on the imported Yarigatake DEM (1151 x 959 cells): the full
+// mesh, and --decimate's RTIN at 0, 1 and 5 m (arg: centimetres; -1 = full),
+// the mesh alone without the file (docs/meshes.md quotes these).
+void BM_HeightMesh(benchmark::State& state) {
+  static const HeightField dem =
+      drift::terrain::import_dem(
+          std::filesystem::path(DRIFT_SOURCE_DIR) / "data" / "yarigatake_gsi_dem10b_jgd2000.tif",
+          {})
+          .grid;
+  const double bound = static_cast<double>(state.range(0)) / 100.0;
+  std::size_t triangles = 0;
+  for (auto _ : state) {
+    const drift::terrain::Mesh m = bound < 0
+                                       ? drift::terrain::height_field_mesh(dem, 1)
+                                       : drift::terrain::decimated_height_field_mesh(dem, bound);
+    triangles = m.triangle_count();
+    benchmark::DoNotOptimize(m.positions.data());
+  }
+  state.counters["triangles"] = static_cast<double>(triangles);
+  report(state, static_cast<double>(dem.size()));
+}
+BENCHMARK(BM_HeightMesh)->Arg(-1)->Arg(0)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -201,6 +201,24 @@ void mesh(const std::uint8_t* data, std::size_t size) {
   });
 }
 
+// drift's own GLB reader (terrain/mesh_glb.cpp: --snow-objects x.glb).
+void glb(const std::uint8_t* data, std::size_t size) {
+  const fs::path file = as_file(data, size, "mesh.glb");
+  refusals_allowed([&] {
+    const terrain::Mesh m = terrain::read_glb(file);
+    for (const auto& p : m.positions) {
+      if (!p.allFinite()) throw std::logic_error("read_glb let a non-finite vertex through");
+    }
+    for (const auto& t : m.triangles)
+      for (int v : t)
+        if (v < 0 || static_cast<std::size_t>(v) >= m.positions.size())
+          throw std::logic_error("read_glb let a face name a missing vertex");
+    for (const auto& [name, values] : m.vertex_attributes)
+      if (values.size() != m.positions.size())
+        throw std::logic_error("read_glb gave attribute '" + name + "' a wrong length");
+  });
+}
+
 // EXR and PNG tiles as merge and compare read them.
 void image(const std::uint8_t* data, std::size_t size) {
   const bool png = size >= 8 && data[1] == 'P' && data[2] == 'N' && data[3] == 'G';
@@ -218,9 +236,9 @@ void bound_work_per_input() { g_bounded = true; }
 
 const std::vector<Target>& targets() {
   static const std::vector<Target> all = {
-      {"raster", raster}, {"scene", scene},       {"objects", objects},
-      {"track", track},   {"scenario", scenario}, {"obj", obj},
-      {"ply", ply},       {"image", image},       {"mesh", mesh}};
+      {"raster", raster},     {"scene", scene}, {"objects", objects}, {"track", track},
+      {"scenario", scenario}, {"obj", obj},     {"ply", ply},         {"image", image},
+      {"mesh", mesh},         {"glb", glb}};
   return all;
 }
 

@@ -256,3 +256,112 @@ TEST(MeshFormats, HeightFieldMeshIsCounterClockwiseFromAboveAndKeepsTheCrs) {
   }
   EXPECT_EQ(m.positions[0], Eigen::Vector3f(0, 0, 100));
 }
+
+namespace {
+
+// A GLB of `json` and `bin`, each chunk padded as write_gltf pads them.
+std::string join_glb(std::string json, std::string bin) {
+  while (json.size() % 4) json += ' ';
+  while (bin.size() % 4) bin += '\0';
+  auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  return u32(0x46546C67u) + u32(2) +
+         u32(static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size())) +
+         u32(static_cast<std::uint32_t>(json.size())) + u32(0x4E4F534Au) + json +
+         u32(static_cast<std::uint32_t>(bin.size())) + u32(0x004E4942u) + bin;
+}
+
+std::string glb_refusal(const fs::path& p) {
+  try {
+    read_glb(p);
+  } catch (const drift::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// drift's own GLB reader (issue 37; Assimp drops custom attributes,
+// assimp#4830) gives back what the PLY path gives: the same positions,
+// triangles, named attributes and origin bit for bit, normals to 1e-6.
+TEST(MeshFormats, OwnGlbReadBackEqualsThePlyPath) {
+  const fs::path d = test_dir("mesh_formats");
+  Mesh m = tetra();
+  m.vertex_attributes.push_back({"object", {0.0f, 0.0f, 1.0f, 1.0f}});
+  m.normals = vertex_normals(m);
+  write_mesh(m, d / "t.glb");
+  write_mesh(m, d / "t.ply");
+  const Mesh g = read_glb(d / "t.glb"), p = read_ply(d / "t.ply");
+  ASSERT_EQ(g.positions.size(), p.positions.size());
+  for (std::size_t v = 0; v < g.positions.size(); ++v) {
+    EXPECT_EQ(g.positions[v], p.positions[v]) << "vertex " << v;
+    EXPECT_LT((g.normals.at(v) - p.normals.at(v)).norm(), 1e-6f) << "normal " << v;
+  }
+  EXPECT_EQ(g.triangles, p.triangles);
+  EXPECT_EQ(g.origin, p.origin);
+  ASSERT_EQ(g.vertex_attributes.size(), 2u);
+  EXPECT_EQ(g.vertex_attributes, p.vertex_attributes);
+  // Assimp, by contrast, loses the attribute (why read_glb exists).
+  EXPECT_EQ(read_mesh(d / "t.glb").attribute("snow_coverage"), nullptr);
+}
+
+// Malformed GLBs are refused naming the file and what is wrong, before
+// anything is sized by a declared count: cut short, chunk lengths and
+// offsets past the file, a huge count, a wrong component type, an index past
+// the vertices, JSON that does not parse.
+TEST(MeshFormats, MalformedGlbIsRefusedByTheOwnReader) {
+  const fs::path d = test_dir("mesh_formats");
+  write_mesh(tetra(), d / "whole.glb");
+  const std::string bytes = slurp(d / "whole.glb");
+  const Glb g = split_glb(bytes);
+  auto expect = [&](const std::string& name, const std::string& file, const std::string& says) {
+    put(d / name, file);
+    const std::string why = glb_refusal(d / name);
+    EXPECT_NE(why.find((d / name).string()), std::string::npos) << name << ": " << why;
+    EXPECT_NE(why.find(says), std::string::npos) << name << ": " << why;
+  };
+  auto edit = [&](std::string json, const std::string& from, const std::string& to) {
+    const auto at = json.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) json.replace(at, from.size(), to);
+    return json;
+  };
+  expect("cut.glb", bytes.substr(0, bytes.size() - 40), "truncated?");
+  expect("tiny.glb", bytes.substr(0, 10), "too short for GLB");
+  // The BIN chunk declaring more bytes than the file holds (header length fixed up).
+  std::string past = bytes;
+  const std::uint32_t huge = 0x7fffff00u;
+  std::memcpy(&past[20 + g.json.size()], &huge, 4);
+  expect("chunk_past_end.glb", past, "past the file's end");
+  // The first accessor (POSITION) declaring 2^31 vertices.
+  expect("huge_count.glb", join_glb(edit(g.json, "\"count\":4", "\"count\":2147483648"), g.bin),
+         "past its bufferView's 48 bytes");
+  expect("too_many.glb", join_glb(edit(g.json, "\"count\":4", "\"count\":99999999999"), g.bin),
+         "outside [1, 2147483648]");
+  // A bufferView past buffer 0, and one at an offset beyond it.
+  expect("view_past.glb", join_glb(edit(g.json, "\"byteLength\":48", "\"byteLength\":4800"), g.bin),
+         "outside [1, ");
+  expect("offset_past.glb",
+         join_glb(edit(g.json, "\"byteOffset\":0,\"byteLength\":48",
+                       "\"byteOffset\":200,\"byteLength\":48"),
+                  g.bin),
+         "reaches past buffer 0's");
+  // POSITION as unsigned shorts; indices as floats.
+  expect("component.glb",
+         join_glb(edit(g.json, "\"componentType\":5126", "\"componentType\":5123"), g.bin),
+         "componentType 5123, not one drift reads");
+  std::string json = g.json;
+  const auto last = json.rfind("\"componentType\":5125");
+  ASSERT_NE(last, std::string::npos);
+  json.replace(last, 20, "\"componentType\":5126");
+  expect("float_indices.glb", join_glb(json, g.bin), "componentType 5126");
+  // An index naming vertex 9 of 4.
+  std::string bin = g.bin;
+  const std::uint32_t nine = 9;
+  std::memcpy(&bin[bin.size() - 4], &nine, 4);
+  expect("index_past.glb", join_glb(g.json, bin), "names vertex 9 of 4");
+  expect("broken_json.glb", join_glb(g.json.substr(0, g.json.size() / 2), g.bin), "does not parse");
+  expect("deep_json.glb", join_glb(std::string(5000, '[') + std::string(5000, ']'), g.bin),
+         "does not parse");
+  EXPECT_NE(glb_refusal(d / "no_such.glb").find("no_such.glb"), std::string::npos);
+}
