@@ -85,21 +85,19 @@ PagedTerrain::PagedTerrain(const std::filesystem::path& dem, std::uint64_t memor
   frame_.dx = static_cast<float>(geo.cell_size_x());
   frame_.dy = static_cast<float>(geo.cell_size_y());
   // What the DEM holds in memory, counted before the scan (it was not counted
-  // at all: MemoryEstimate.RenderOutOfCoreAndMaps): the min-max tree (8 B a
-  // leaf and a third more above) and Embree's BVH over the blocks (about 128
-  // B a block, measured), GDAL's block cache (64 MiB at most), and the larger
-  // of the scan's strips (a page of rows a thread, freed after the scan) and
-  // the cache (its budget, or every page if they are fewer).
+  // at all: MemoryEstimate.RenderOutOfCoreAndMaps): what stays in memory
+  // beside the pages (held_bytes_, above), GDAL's block cache (64 MiB at
+  // most), and the larger of the scan's strips (a page of rows a thread,
+  // freed after the scan) and the cache (its share of the budget, or every
+  // page if they are fewer).
   const std::uint64_t cells = static_cast<std::uint64_t>(w - 1) * (h - 1), rows = page_cells_;
-  const std::uint64_t leaves = cells / (kLeaf * kLeaf) + 1;
-  const std::uint64_t blocks = cells / (HeightFieldBlocks::kBlock * HeightFieldBlocks::kBlock) + 1;
   const std::uint64_t pages = static_cast<std::uint64_t>(pages_x_) * pages_y_ * page_bytes();
   const std::uint64_t strips = rows * w * sizeof(float) *
                                static_cast<std::uint64_t>(tbb::this_task_arena::max_concurrency());
-  require_memory(leaves * 8 * 4 / 3 + blocks * 128 +
+  require_memory(held_bytes_ +
                      std::min<std::uint64_t>(cells * sizeof(float), std::uint64_t{64} << 20) +
-                     std::max(strips, std::min(memory_budget, pages)),
-                 name + " out of core (its tree, GDAL's cache and the --memory-budget)",
+                     std::max(strips, std::min(memory_budget - held_bytes_, pages)),
+                 name + " out of core (its blocks' bounds, GDAL's cache and the --memory-budget)",
                  "give a smaller --memory-budget, or resample the DEM");
   scan();
 }
