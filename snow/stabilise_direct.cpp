@@ -12,13 +12,12 @@
 #include <vector>
 
 #include "terrain/error.h"
+#include "terrain/neighbours.h"
 
 namespace drift::snow {
 
 namespace {
 
-constexpr std::array<int, 8> kDx{-1, 0, 1, -1, 1, -1, 0, 1};
-constexpr std::array<int, 8> kDy{-1, -1, -1, 0, 0, 1, 1, 1};
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
 // Snow on ground as flat arrays, with the repose drop k d to each neighbour.
@@ -35,8 +34,9 @@ class Field {
         diag_(std::hypot(dx, dy)),
         k_(k) {
     for (int n = 0; n < 8; ++n) {
-      drop_[n] = k * std::hypot(kDx[n] * dx, kDy[n] * dy);
-      offset_[n] = static_cast<std::ptrdiff_t>(kDy[n]) * w_ + kDx[n];
+      drop_[n] = k * std::hypot(terrain::kNeighbours8[n].dx * dx, terrain::kNeighbours8[n].dy * dy);
+      offset_[n] = static_cast<std::ptrdiff_t>(terrain::kNeighbours8[n].dy) * w_ +
+                   terrain::kNeighbours8[n].dx;
     }
   }
   std::size_t cells() const { return static_cast<std::size_t>(w_) * ht_; }
@@ -48,7 +48,7 @@ class Field {
   void neighbours(std::size_t i, const Fn& fn) const {
     const int x = static_cast<int>(i % w_), y = static_cast<int>(i / w_);
     for (int n = 0; n < 8; ++n) {
-      const int nx = x + kDx[n], ny = y + kDy[n];
+      const int nx = x + terrain::kNeighbours8[n].dx, ny = y + terrain::kNeighbours8[n].dy;
       if (nx >= 0 && ny >= 0 && nx < w_ && ny < ht_) fn(i + offset_[n], n);
     }
   }

@@ -9,13 +9,12 @@
 #include <queue>
 #include <utility>
 
+#include "terrain/neighbours.h"
+
 namespace drift::snow {
 
 namespace {
 
-// Neighbour k and neighbour 7 - k are opposite.
-constexpr std::array<int, 8> kDx{-1, 0, 1, -1, 1, -1, 0, 1};
-constexpr std::array<int, 8> kDy{-1, -1, -1, 0, 0, 1, 1, 1};
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 
 // Snow on ground as flat arrays, with the repose drop to each neighbour.
@@ -29,8 +28,10 @@ class SnowSurface {
         hgt_(snow.height()),
         geo_(geo) {
     for (int k = 0; k < 8; ++k) {
-      drop_[k] = geo.tan_repose * std::hypot(kDx[k] * geo.dx, kDy[k] * geo.dy);
-      offset_[k] = static_cast<std::ptrdiff_t>(kDy[k]) * w_ + kDx[k];
+      drop_[k] = geo.tan_repose * std::hypot(terrain::kNeighbours8[k].dx * geo.dx,
+                                             terrain::kNeighbours8[k].dy * geo.dy);
+      offset_[k] = static_cast<std::ptrdiff_t>(terrain::kNeighbours8[k].dy) * w_ +
+                   terrain::kNeighbours8[k].dx;
     }
   }
   std::size_t cells() const { return static_cast<std::size_t>(w_) * hgt_; }
@@ -38,7 +39,8 @@ class SnowSurface {
   double& snow(std::size_t i) const { return h_[i]; }
   double surface(std::size_t i) const { return static_cast<double>(g_[i]) + h_[i]; }
   bool inside(std::size_t i, int k) const {
-    const int x = static_cast<int>(i % w_) + kDx[k], y = static_cast<int>(i / w_) + kDy[k];
+    const int x = static_cast<int>(i % w_) + terrain::kNeighbours8[k].dx,
+              y = static_cast<int>(i / w_) + terrain::kNeighbours8[k].dy;
     return x >= 0 && y >= 0 && x < w_ && y < hgt_;
   }
   std::size_t neighbour(std::size_t i, int k) const { return i + offset_[k]; }
