@@ -251,7 +251,7 @@ std::vector<float> PagedTerrain::load(std::uint64_t key) const {
   const std::size_t tree = HeightFieldBlocks::page_tree_floats(page_cells_);
   std::vector<float> out(tree + z.size());
   std::copy(z.begin(), z.end(), out.begin() + static_cast<std::ptrdiff_t>(tree));
-  HeightFieldBlocks::page_tree(out.data() + tree, static_cast<std::size_t>(c1 - c0 + 1),
+  HeightFieldBlocks::page_tree(out.data() + tree, static_cast<std::size_t>(c1 - c0) + 1,
                                page_cells_, c1 - c0, r1 - r0, out.data());
   return out;
 }

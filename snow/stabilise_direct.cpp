@@ -90,7 +90,9 @@ std::vector<double> drained_surface(const Field& f) {
   // Lowered cells are relaxed only once popped, from their final label; cells
   // never lowered were checked against their neighbours above.
   while (!queue.empty()) {
-    const auto [v, i] = queue.top();
+    // Named copies, not a structured binding: the lambda below captures them.
+    const double v = queue.top().first;
+    const std::size_t i = queue.top().second;
     queue.pop();
     if (v > e[i]) continue;
     f.neighbours(i, [&](std::size_t n, int k) {
@@ -173,7 +175,8 @@ Spill heap_at(const Field& f, std::size_t p, double mass, std::vector<std::uint8
       apex = (mass + sum_t) / static_cast<double>(region.size());
       break;
     }
-    const auto [j, c] = flood.top();
+    const double j = flood.top().first;  // captured below: no structured binding
+    const std::size_t c = flood.top().second;
     const double m = static_cast<double>(region.size());
     if (!region.empty() && m * j - sum_t >= mass) {  // the apex lies before c joins
       apex = (mass + sum_t) / m;

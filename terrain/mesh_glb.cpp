@@ -295,7 +295,7 @@ class GlbReader {
       const std::string name = a.GetName();
       const bool normal = name == "NORMAL";
       if (!normal && !(name.size() > 1 && name[0] == '_')) continue;  // TEXCOORD_0, COLOR_0, ...
-      const std::string what = where + " " + name;
+      const std::string what = std::string(where).append(" ").append(name);
       std::size_t c = 0;
       std::vector<float> values =
           floats(integer_value(a, what, 0, kMaxCount), normal ? "VEC3" : "SCALAR", c, what);
@@ -330,10 +330,13 @@ class GlbReader {
     }
     if (custom.size() != mesh.vertex_attributes.size())
       throw bad(where + " has other custom attributes than the first primitive");
-    for (auto& [name, values] : mesh.vertex_attributes) {
+    for (auto& attribute : mesh.vertex_attributes) {
+      const std::string& name = attribute.first;  // captured below: no structured binding
+      std::vector<float>& values = attribute.second;
       auto it = std::find_if(custom.begin(), custom.end(),
                              [&](const auto& c) { return c.first == name; });
-      if (it == custom.end()) throw bad(where + " has no attribute '" + name + "'");
+      if (it == custom.end())
+        throw bad(std::string(where).append(" has no attribute '").append(name).append("'"));
       values.insert(values.end(), it->second.begin(), it->second.begin() + static_cast<long>(n));
     }
   }

@@ -90,7 +90,7 @@ struct MarksSimulation::Impl {
   // The seed of the erosion's roughness: the run's, so that a cell keeps its
   // own angle from step to step (terrain/slope_relax.h, SlopeRule::rough).
   std::uint64_t erosion_seed() const { return terrain::mix64(sim.options_.seed); }
-  void erode(std::vector<int> seeds) {
+  void erode(const std::vector<int>& seeds) {
     std::vector<terrain::SlopeRule> rules;
     for (const Material& m : sim.materials_.table) rules.push_back(m.slope_rule());
     terrain::SlopeCells cells{rules, sim.materials_.index.empty() ? nullptr : &sim.materials_.index,
@@ -106,7 +106,7 @@ struct MarksSimulation::Impl {
     // walls steeper than theta, MarksMemory).
     o.settle = 1e-3 * std::min(sim.frame_.dx, sim.frame_.dy);
     std::vector<int> moved;
-    terrain::relax_slopes(sim.heights_, std::move(seeds), cells, o, moved,
+    terrain::relax_slopes(sim.heights_, seeds, cells, o, moved,
                           sim.options_.track_disturbed ? &sim.disturbed_ : nullptr, &workspace);
     remember(moved);
   }
@@ -206,7 +206,7 @@ struct MarksSimulation::Impl {
     // erosion once a step, where needed).
     if (!erode_now) return bottom;
     set_ceiling(bottom, true);
-    erode(std::move(seeds));
+    erode(seeds);
     set_ceiling(bottom, false);
     return bottom;
   }
@@ -320,7 +320,7 @@ void MarksSimulation::end_step() {
   for (int c : impl_->remembered)
     if (impl_->expiry.values()[static_cast<std::size_t>(c)] >= step_) active.push_back(c);
   impl_->remembered = active;
-  if (!active.empty()) impl_->erode(std::move(active));
+  if (!active.empty()) impl_->erode(active);
   for (const BottomMap& b : impl_->last) impl_->set_ceiling(b, false);
   impl_->last.clear();
   ++step_;
