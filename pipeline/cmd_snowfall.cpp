@@ -63,6 +63,12 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
       c.occlusion == "opengl" ? snow::TerrainOcclusion::OpenGL : snow::TerrainOcclusion::Sweep;
   o.direct_stabilise = c.stabilise == "direct";
   if (c.block < 0) usage_error("--block takes a number of cells, 0 or more");
+  // Blocks tile the ground's horizon sweep only: refused, not ignored, with
+  // the objects' depth maps or OSMesa's (issue 34: no value dropped silently).
+  if (c.block > 0 && (!c.objects.empty() || c.occlusion == "opengl"))
+    usage_error(
+        "--block works on the ground alone with --occlusion sweep; drop --block, or "
+        "--objects and --occlusion opengl");
   o.block = c.block;
   if (!c.mesh_out.empty() && c.objects.empty())
     usage_error("--mesh-out needs --objects (there are no objects to write)");

@@ -137,6 +137,10 @@ TEST(SnowfallCli, BlockByBlockOcclusionGivesTheSameRasters) {
   for (float v : a.values()) shadowed += v < 0.25f;
   EXPECT_GT(shadowed, 200);
   EXPECT_EQ(run(common + (d / "x.tif").string() + " --block -3", d), 2);
+  // Where blocks do not apply, --block is refused rather than ignored.
+  EXPECT_EQ(run(common + (d / "x.tif").string() + " --block 8 --occlusion opengl", d), 2);
+  EXPECT_NE(output(d).find("--block works on the ground alone"), std::string::npos) << output(d);
+  EXPECT_FALSE(fs::exists(d / "x.tif"));
 }
 
 TEST(SnowfallCli, BadInputIsRefusedWithAMessageAndNoOutput) {
