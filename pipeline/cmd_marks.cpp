@@ -52,6 +52,13 @@ terrain::HeightField read_snow_depth(const MarksCommand& c, const terrain::Heigh
 // The --materials raster: per cell 0 sand, 1 mud, 2 snow (the presets' order).
 marks::MaterialField read_material_raster(const MarksCommand& c,
                                           const terrain::HeightField& ground) {
+  // One band of material indices: which band of several holds them is not
+  // guessed (band 1 was read without a word; issue 34, class 6).
+  const int bands = terrain::read_raster_header(c.materials).bands;
+  if (bands != 1) {
+    throw Error("material raster '" + c.materials + "' has " + std::to_string(bands) +
+                " bands; give a single-band raster of material indices (0 sand, 1 mud, 2 snow)");
+  }
   const terrain::HeightField m = terrain::read_raster(c.materials);
   if (m.width() != ground.width() || m.height() != ground.height()) {
     throw Error("material raster '" + c.materials + "' is " + std::to_string(m.width()) + " x " +

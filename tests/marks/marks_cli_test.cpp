@@ -1,6 +1,7 @@
 // drift marks: writes the marked ground, the disturbance raster and frames;
 // bad track files and keyframes exit 1 naming the file, line and value, and
 // write nothing.
+#include <gdal_priv.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -177,6 +178,15 @@ TEST(MarksCli, AMaterialRasterSetsTheGroundsMaterialPerCell) {
   fs::remove(d / "out.tif");
   EXPECT_EQ(run(args, d), 1) << output(d);
   EXPECT_NE(output(d).find("paint.tif': cell (9, 4) holds 7"), std::string::npos) << output(d);
+  EXPECT_FALSE(fs::exists(d / "out.tif"));
+  // Three bands: refused naming the count, not read as band 1.
+  GDALAllRegister();
+  GDALDataset* rgb = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(
+      (d / "paint.tif").string().c_str(), 64, 64, 3, GDT_Float32, nullptr);
+  ASSERT_NE(rgb, nullptr);
+  GDALClose(rgb);
+  EXPECT_EQ(run(args, d), 1) << output(d);
+  EXPECT_NE(output(d).find("paint.tif' has 3 bands"), std::string::npos) << output(d);
   EXPECT_FALSE(fs::exists(d / "out.tif"));
 }
 
