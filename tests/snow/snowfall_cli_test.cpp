@@ -66,6 +66,15 @@ int ground_passes(const std::string& log) {
   return at == std::string::npos ? -1 : std::atoi(log.c_str() + at + key.size());
 }
 
+// Steep 96^2 mountains at UTM coordinates in D, and the arguments of a short
+// snowfall on them up to "-o " (the two stabilisations' tests).
+std::string mountains_run(const fs::path& d) {
+  auto ground = drift::testing::snowfall_mountains(96);
+  ground.geo().geotransform[0] = 600000.0, ground.geo().geotransform[3] = 4000000.0;
+  drift::terrain::write_geotiff(ground, d / "ground.tif");
+  return (d / "ground.tif").string() + " --maps 1 --rate 0.05 --hours 10 --threads 1 -o ";
+}
+
 double total(const drift::terrain::HeightField& f) {
   double sum = 0.0;
   for (float v : f.values()) sum += v;
@@ -77,11 +86,7 @@ double total(const drift::terrain::HeightField& f) {
 // holding the same snow.
 TEST(SnowfallCli, CoarseLevelsStartTheGroundsStabilisation) {
   const fs::path d = dir();
-  auto ground = drift::testing::snowfall_mountains(96);
-  ground.geo().geotransform[0] = 600000.0, ground.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(ground, d / "ground.tif");
-  const std::string common =
-      (d / "ground.tif").string() + " --maps 1 --rate 0.05 --hours 10 --threads 1 -o ";
+  const std::string common = mountains_run(d);
   ASSERT_EQ(run(common + (d / "alone.tif").string(), d), 0) << output(d);
   const int alone = ground_passes(output(d));
   ASSERT_EQ(run(common + (d / "coarse.tif").string() + " --coarse-levels 1", d), 0) << output(d);
@@ -98,11 +103,7 @@ TEST(SnowfallCli, CoarseLevelsStartTheGroundsStabilisation) {
 // the same snow as the passes leave, a different state; an unknown solver is a usage error.
 TEST(SnowfallCli, StabiliseDirectSettlesTheSameSnowInOneStep) {
   const fs::path d = dir();
-  auto ground = drift::testing::snowfall_mountains(96);
-  ground.geo().geotransform[0] = 600000.0, ground.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(ground, d / "ground.tif");
-  const std::string common =
-      (d / "ground.tif").string() + " --maps 1 --rate 0.05 --hours 10 --threads 1 -o ";
+  const std::string common = mountains_run(d);
   ASSERT_EQ(run(common + (d / "passes.tif").string(), d), 0) << output(d);
   ASSERT_EQ(run(common + (d / "direct.tif").string() + " --stabilise direct", d), 0) << output(d);
   const auto a = drift::terrain::read_raster(d / "passes.tif");
