@@ -15,6 +15,7 @@
 #include "terrain/error.h"
 #include "terrain/height_change.h"
 #include "terrain/marks/marks.h"
+#include "terrain/marks/marks_blocks.h"
 #include "terrain/marks/marks_parameters.h"
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
@@ -30,6 +31,7 @@ struct MarksCommand {
   std::string ground, track, output, material, disturbed, frames, snow_depth, materials, posed,
       renderer = "cpu";
   double snow_min = 0.01;
+  int block = 0, halo = 64;  // --block, --halo: block by block (marks_blocks.h)
   std::optional<double> posed_at;
   bool add_snow = false;
   marks::MarksOptions options;
@@ -113,7 +115,44 @@ void warn_about_misses(const marks::MarksReport& report) {
   }
 }
 
+// --block: the ground read, marked and written a block at a time (issue 36
+// item 3), for rasters larger than memory.
+void run_marks_by_blocks(MarksCommand& c, const CLI::App& sub) {
+  if (!c.frames.empty() || !c.materials.empty() || !c.snow_depth.empty() || !c.posed.empty())
+    usage_error(
+        "--block works on one ground raster with one material: drop --frames, --materials, "
+        "--snow-depth and --posed, or drop --block");
+  c.parameters.apply(sub, c.options);
+  std::vector<fs::path> inputs = {c.ground, c.track};
+  for (const fs::path& mesh : object_mesh_paths(c.track, "track file")) inputs.push_back(mesh);
+  OutputSet outputs({c.output, c.disturbed}, inputs);
+  TrackFile track = read_track_file(c.track);
+  marks::MarksOptions o = c.options;
+  o.step = track.step;
+  o.camera = track.camera;
+  o.renderer = c.renderer == "opengl" ? marks::BottomRenderer::OpenGL : marks::BottomRenderer::Cpu;
+  if (!c.material.empty())
+    for (marks::MarkObject& obj : track.objects) obj.material.reset();  // --material overrides all
+  marks::Material base = track.material.value_or(*marks::material_preset("sand"));
+  if (!c.material.empty()) base = *marks::material_preset(c.material);
+  require_metric_crs(terrain::HeightField(1, 1, 0.0f, terrain::read_raster_header(c.ground).geo),
+                     c.ground);
+  const marks::MarksBlockReport r =
+      marks::marks_to_files({c.ground, c.output, c.disturbed, c.block, c.halo}, track.objects, base,
+                            o, terminal_progress("marks"));
+  outputs.commit();
+  std::printf("marks: wrote %s\n", c.output.c_str());
+  if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
+  warn_about_misses(r.report);
+  std::printf(
+      "marks: %d steps, %d with contact (in the busiest block); %d of %d blocks of %d cells "
+      "worked, halo %d cells (%d widened, widest %d)\n",
+      r.report.steps, r.report.contact_steps, r.simulated, r.blocks, r.block, r.halo, r.widened,
+      r.largest_halo);
+}
+
 void run_marks(MarksCommand& c, const CLI::App& sub) {
+  if (c.block > 0) return run_marks_by_blocks(c, sub);
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
   if (!c.materials.empty() && (!c.snow_depth.empty() || !c.material.empty()))
     usage_error("--materials gives every cell its material; drop --snow-depth and --material");
@@ -219,6 +258,16 @@ void add_marks_command(CLI::App& root) {
   sub->add_option("--posed-at", c->posed_at,
                   "time (s) of the --posed objects; default: the run's last keyframe")
       ->check(CLI::Range(-1e9, 1e9));
+  sub->add_option("--block", c->block,
+                  "work block by block on blocks of N cells a side (rounded up to a multiple of "
+                  "4), reading and writing the rasters a block at a time: grounds larger than "
+                  "memory (0: the whole raster at once)")
+      ->check(CLI::Range(0, 1 << 20));
+  sub->add_option("--halo", c->halo,
+                  "with --block: cells around a block that its window also works (doubled where "
+                  "marks reach the window's edge)")
+      ->check(CLI::Range(0, 1 << 20))
+      ->capture_default_str();
   c->parameters.add_to(*sub);
   sub->add_option("--seed", c->options.seed,
                   "seed of the roughness draws (sigma, paper 000, 3.5); same seed, same marks")

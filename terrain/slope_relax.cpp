@@ -220,7 +220,12 @@ class SlopeRelaxer {
   // call.
   double tan_of(std::size_t i, const SlopeRule& r) const {
     if (!r.rough) return r.tan_repose;
-    return r.tan_repose * (1.0 - r.fraction * unit_double(mix64(seed_ ^ i)));
+    std::uint64_t cell = i;
+    if (o_.index_width > 0)
+      cell = static_cast<std::uint64_t>((static_cast<std::int64_t>(i / w_) + o_.index_y0) *
+                                            o_.index_width +
+                                        static_cast<std::int64_t>(i % w_) + o_.index_x0);
+    return r.tan_repose * (1.0 - r.fraction * unit_double(mix64(seed_ ^ cell)));
   }
 
   // The per-pair rule, written once for both loops (tiles and cell lists) and
@@ -279,8 +284,8 @@ class SlopeRelaxer {
       // would trickle on for ever in amounts nobody can see).
       if (r.share == SlopeShare::HalfSteepest)
         factor = room > o_.tolerance ? std::min(room, 0.5 * largest) / sum : 0.0;
-      else
-        factor = std::min({1.0, 0.5 * largest / sum, room / sum});
+      else  // min(a / s, b / s) = min(a, b) / s: division by s > 0 is monotone, one divide
+        factor = std::min(1.0, std::min(0.5 * largest, room) / sum);
     }
     ws_.factor_[s] = factor;
     ws_.mult_[s] = r.share == SlopeShare::Fraction ? r.fraction : factor;
@@ -333,7 +338,8 @@ class SlopeRelaxer {
     }
     if (!(in > 0.0)) return 0.0;
     const double room = ceiling(i) - h_[i];
-    return std::min({1.0, 0.5 * largest / in, std::max(room, 0.0) / in});
+    // One divide: division by in > 0 is monotone (as in give).
+    return std::min(1.0, std::min(0.5 * largest, std::max(room, 0.0)) / in);
   }
   // Phase 3: the change of cell i (taken - given), applied at once: nothing
   // in this phase reads a height (the excesses and shares are the pass's), so
@@ -341,7 +347,12 @@ class SlopeRelaxer {
   double change(std::size_t i, int x, int y) {
     double out = 0.0, in = 0.0;
     bool moved = false;
+    // The disturbance is summed in a register and stored once: the same
+    // float additions in the same order as adding to the cell each time, but
+    // without a store-to-load chain through memory for every flow (the
+    // compiler cannot tell the grid does not alias the workspace's vectors).
     float* disturbed = disturbed_ ? &disturbed_->values()[i] : nullptr;
+    float dist = disturbed ? *disturbed : 0.0f;
     const int s = ws_.slot_[i];
     const double* take = ws_.take_.data();
     const double tolerance = o_.tolerance;
@@ -359,7 +370,7 @@ class SlopeRelaxer {
         const double f = mult * e[k] * post * t;
         const bool flows = e[k] > tolerance && f > 0.0;
         out += flows ? f : 0.0, moved = moved || flows;
-        if (disturbed) *disturbed += flows ? static_cast<float>(f) : 0.0f;
+        dist += flows ? static_cast<float>(f) : 0.0f;
       }
     }
     const double take_i = ws_.take_[i];
@@ -374,16 +385,17 @@ class SlopeRelaxer {
         const double f = mult[n] * e * post[n] * take_i;
         const bool flows = e > tolerance && f > 0.0;
         in += flows ? f : 0.0, moved = moved || flows;
-        if (disturbed) *disturbed += flows ? static_cast<float>(f) : 0.0f;
+        dist += flows ? static_cast<float>(f) : 0.0f;
       }
     } else if (take_i > 0.0) {
       for_offers(i, x, y, [&](std::size_t n, double e) {
         const double f = flow(n, e, take_i);
         if (!(f > 0.0)) return;
         in += f, moved = true;
-        if (disturbed) *disturbed += static_cast<float>(f);
+        dist += static_cast<float>(f);
       });
     }
+    if (disturbed) *disturbed = dist;
     h_[i] += in - out;
     ws_.touched_[i] = !moved ? 0 : o_.settle > 0.0 && in + out <= o_.settle ? kSettled : 1;
     return out;

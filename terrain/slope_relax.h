@@ -77,6 +77,13 @@ struct SlopeRelaxOptions {
   // has settled and drops out of the passes, while a bow wave still moving
   // keeps its own cells going.
   double settle = 0.0;
+  // The roughness draws' cell (SlopeRule::rough) when the grid is a window of
+  // a larger raster (marks run block by block): the window's cell (x, y)
+  // draws as the raster's cell (index_x0 + x, index_y0 + y) of a raster
+  // index_width cells wide does, so a block's window slides as the whole
+  // raster would. 0: the grid's own flat index.
+  std::int64_t index_width = 0;
+  int index_x0 = 0, index_y0 = 0;
 };
 
 // Called after each pass with the passes so far and the share of the tiles still

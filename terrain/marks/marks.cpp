@@ -105,6 +105,10 @@ struct MarksSimulation::Impl {
     // 1.2 mm of relaxing every mover; 3e-3 of a cell left a long-held print's
     // walls steeper than theta, MarksMemory).
     o.settle = 1e-3 * std::min(sim.frame_.dx, sim.frame_.dy);
+    if (sim.options_.window) {  // a block's window draws as the whole raster does
+      o.index_width = sim.options_.window->raster_width;
+      o.index_x0 = sim.options_.window->col0, o.index_y0 = sim.options_.window->row0;
+    }
     std::vector<int> moved;
     terrain::relax_slopes(sim.heights_, seeds, cells, o, moved,
                           sim.options_.track_disturbed ? &sim.disturbed_ : nullptr, &workspace);
@@ -216,6 +220,10 @@ MarksSimulation::MarksSimulation(const terrain::HeightField& ground, MaterialFie
                                  const MarksOptions& options)
     : materials_(std::move(materials)), frame_(GridFrame::of(ground.geo())), options_(options) {
   options_.validate();
+  if (options_.window) {  // a window of a larger raster: that raster's cells
+    frame_.x0 = options_.window->x0, frame_.y0 = options_.window->y0;
+    frame_.col0 = options_.window->col0, frame_.row0 = options_.window->row0;
+  }
   const std::uint64_t cells = static_cast<std::uint64_t>(ground.width()) * ground.height();
   // Heights, ceiling (double), disturbance, expiry (4 bytes), material (1), the
   // float copy written out (4), and the erosion's workspace (terrain/slope_relax:

@@ -144,6 +144,12 @@ using StepFn = std::function<bool(int step, const MarksSimulation& state)>;
 // it follows the ground.
 Pose object_pose(const MarkObject& object, const terrain::HeightField& ground, double t);
 
+// The ground's height (m) under a point of the ground's CRS, for objects that
+// follow the ground; a run on a window of a larger raster (marks_blocks.h)
+// reads it from the whole raster, as a run on the whole raster would.
+using GroundAt = std::function<double(double x, double y)>;
+Pose object_pose(const MarkObject& object, const GroundAt& ground_at, double t);
+
 // The objects' meshes at their poses at time t, in the ground's CRS measured
 // from the raster's north-west corner (the mesh's origin), merged into one (issue 32 item 7: a
 // scene shows the mark with the thing that made it, placed by the same keyframes). Objects whose
@@ -161,5 +167,12 @@ MarksResult simulate_marks(const terrain::HeightField& ground,
                            const std::vector<MarkObject>& objects, MaterialField materials,
                            const MarksOptions& options, const StepFn& on_step = {},
                            const ProgressFn& progress = no_progress);
+
+// The same with the height objects that follow the ground stand on taken from
+// `ground_at` (empty: from `ground`), for a window of a larger raster.
+MarksResult simulate_marks_on(const terrain::HeightField& ground,
+                              const std::vector<MarkObject>& objects, MaterialField materials,
+                              const MarksOptions& options, const GroundAt& ground_at,
+                              const StepFn& on_step = {}, const ProgressFn& progress = no_progress);
 
 }  // namespace drift::marks

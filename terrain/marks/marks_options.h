@@ -27,6 +27,16 @@ struct MarksOptions {
   std::uint64_t seed = 0;
   std::optional<MarksCamera> camera;
   bool track_disturbed = true;  // keep the per-cell disturbance raster
+  // The ground is a window of a larger raster (marks block by block,
+  // terrain/marks/marks_blocks.h): where it starts in that raster's cells,
+  // the raster's width and first cell centre. Objects are placed and the
+  // roughness drawn as on the whole raster.
+  struct Window {
+    int col0 = 0, row0 = 0;
+    std::int64_t raster_width = 0;
+    double x0 = 0.0, y0 = 0.0;  // the raster's first cell centre (m)
+  };
+  std::optional<Window> window;
   // Throws drift::Error naming the option.
   void validate() const;
 };

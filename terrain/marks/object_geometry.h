@@ -16,12 +16,17 @@ namespace drift::marks {
 // (x0, y0) the centre of cell (0, 0) in the ground's CRS.
 struct GridFrame {
   double x0 = 0, y0 = 0, dx = 1, dy = 1;
+  // A window of a larger raster (marks block by block): x0, y0 are the
+  // raster's first cell centre and the window starts at its cell (col0,
+  // row0). A cell coordinate is the raster's minus a whole number, which is
+  // exact, so a window sees the object where the whole raster does.
+  int col0 = 0, row0 = 0;
   static GridFrame of(const terrain::GeoReference& geo);
   Eigen::Vector3d to_cell(const Eigen::Vector3d& world) const {
-    return {(world.x() - x0) / dx, (y0 - world.y()) / dy, world.z()};
+    return {(world.x() - x0) / dx - col0, (y0 - world.y()) / dy - row0, world.z()};
   }
   Eigen::Vector3d to_world(double col, double row, double z) const {
-    return {x0 + col * dx, y0 - row * dy, z};
+    return {x0 + (col + col0) * dx, y0 - (row + row0) * dy, z};
   }
 };
 

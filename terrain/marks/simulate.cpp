@@ -43,6 +43,12 @@ Pose object_pose(const MarkObject& object, const terrain::HeightField& ground, d
   return p;
 }
 
+Pose object_pose(const MarkObject& object, const GroundAt& ground_at, double t) {
+  Pose p = object.trajectory.at(t);
+  if (object.follow_ground) p.position.z() += ground_at(p.position.x(), p.position.y());
+  return p;
+}
+
 terrain::Mesh posed_objects(const std::vector<MarkObject>& objects,
                             const terrain::HeightField& ground, double t) {
   terrain::Mesh out;
@@ -72,6 +78,13 @@ MarksResult simulate_marks(const terrain::HeightField& ground,
                            const std::vector<MarkObject>& objects, MaterialField materials,
                            const MarksOptions& options, const StepFn& on_step,
                            const ProgressFn& progress) {
+  return simulate_marks_on(ground, objects, std::move(materials), options, {}, on_step, progress);
+}
+
+MarksResult simulate_marks_on(const terrain::HeightField& ground,
+                              const std::vector<MarkObject>& objects, MaterialField materials,
+                              const MarksOptions& options, const GroundAt& ground_at,
+                              const StepFn& on_step, const ProgressFn& progress) {
   options.validate();
   validate_objects(objects);
   if (objects.empty()) throw Error("marks: no objects to move");
@@ -86,7 +99,9 @@ MarksResult simulate_marks(const terrain::HeightField& ground,
   if (span > 1e7)
     throw Error("marks: the keyframes span " + std::to_string(span) + " steps; raise 'step'");
   const int steps = static_cast<int>(std::ceil(span - 1e-9));
-  auto pose_of = [&](const MarkObject& o, double t) { return object_pose(o, ground, t); };
+  auto pose_of = [&](const MarkObject& o, double t) {
+    return ground_at ? object_pose(o, ground_at, t) : object_pose(o, ground, t);
+  };
   MarksResult result;
   for (const MarkObject& o : objects) result.report.objects.push_back({o.name});
   if (progress && !progress(0.0, "marks")) throw Cancelled();
