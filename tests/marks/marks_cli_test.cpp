@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -188,6 +189,37 @@ TEST(MarksCli, AMaterialRasterSetsTheGroundsMaterialPerCell) {
   EXPECT_EQ(run(args, d), 1) << output(d);
   EXPECT_NE(output(d).find("paint.tif' has 3 bands"), std::string::npos) << output(d);
   EXPECT_FALSE(fs::exists(d / "out.tif"));
+}
+
+}  // namespace
+
+namespace {
+
+// Issue 36 item 3: --block reads, marks and writes the ground 16 cells at a
+// time (UTM-sized coordinates: the windows place the ball in the raster's
+// cells) and writes the one-pass run's heights bit for bit; with an option it
+// cannot honour it exits 2 and writes nothing.
+TEST(MarksCli, BlocksGiveTheOnePassGroundAndRefuseWhatTheyCannotDo) {
+  const fs::path d = dir(), g = ground(d);
+  std::ofstream(d / "track.toml") << track();
+  const std::string common = g.string() + " --track " + (d / "track.toml").string();
+  ASSERT_EQ(run(common + " -o " + (d / "one.tif").string(), d), 0) << output(d);
+  ASSERT_EQ(run(common + " -o " + (d / "blocks.tif").string() + " --block 16 --halo 8", d), 0)
+      << output(d);
+  EXPECT_NE(output(d).find("blocks of 16 cells worked"), std::string::npos) << output(d);
+  const auto one = drift::terrain::read_raster(d / "one.tif");
+  const auto blocks = drift::terrain::read_raster(d / "blocks.tif");
+  ASSERT_EQ(one.values().size(), blocks.values().size());
+  EXPECT_TRUE(std::equal(one.values().begin(), one.values().end(), blocks.values().begin(),
+                         [](float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }));
+  EXPECT_LT(one(32, 32), 2000.0f - 0.02f);  // the ball pressed it
+  EXPECT_EQ(run(common + " -o " + (d / "f.tif").string() + " --block 16 --frames " +
+                    (d / "frames").string(),
+                d),
+            2)
+      << output(d);
+  EXPECT_NE(output(d).find("--block works on one ground raster"), std::string::npos) << output(d);
+  EXPECT_FALSE(fs::exists(d / "f.tif"));
 }
 
 }  // namespace
