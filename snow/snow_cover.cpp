@@ -161,12 +161,32 @@ class DiagonalSums {
 
   // The cells of the diamond at (x, row) that the one at (x - 1, row) lacks
   // (its east edge, ">") less those it has that this one lacks (the west edge
-  // of the one at x - 1, "<"): each edge is two diagonal runs.
-  FixedSum step_east(int x, int row) const {
-    const int n = n_, xl = x - 1;
-    return down_right(row - n, x, n + 1) + down_left(row + 1, x + n - 1, n) -
-           down_left(row - n, xl, n + 1) - down_right(row + 1, xl - n + 1, n);
+  // of the one at x - 1, "<"): each edge is two diagonal runs,
+  //   east:  down_right(row - n, x, n + 1) + down_left(row + 1, x + n - 1, n),
+  //   west:  down_left(row - n, x - 1, n + 1) + down_right(row + 1, x - n, n),
+  // written out on the three rows they touch (row - n - 1, row, row + n), whose
+  // places in the ring are found once a row.
+  struct EastStep {
+    const FixedSum *a_up, *a_mid, *a_down, *b_up, *b_mid, *b_down;
+    int n;
+    FixedSum operator()(int x) const {
+      return a_mid[x + n] - a_up[x - 1] + b_down[x] - b_mid[x + n] - b_mid[x - 1 - n] + b_up[x] -
+             a_down[x - 1] + a_mid[x - n - 1];
+    }
+  };
+  EastStep east_step(int row) const {
+    const auto at_row = [&](const std::vector<FixedSum>& t, int r) {
+      return &t[static_cast<std::size_t>((r - base_) % ring_) * cols_ + (n_ + 1)];
+    };
+    return {at_row(a_, row - n_ - 1),
+            at_row(a_, row),
+            at_row(a_, row + n_),
+            at_row(b_, row - n_ - 1),
+            at_row(b_, row),
+            at_row(b_, row + n_),
+            n_};
   }
+
   // The same from (x, row - 1) to (x, row): south edge "v" less north edge "^".
   FixedSum step_south(int x, int row) const {
     const int n = n_, up = row - 1;
@@ -235,8 +255,9 @@ HeightField smooth(const HeightField& dem, int region) {
             first = row == r0 ? diamond_direct(dem, 0, row, n) : first + sums.step_south(0, row);
             FixedSum d = first;
             put(0, row, d);
+            const auto step_east = sums.east_step(row);
             for (int x = 1; x < w; ++x) {
-              d += sums.step_east(x, row);
+              d += step_east(x);
               put(x, row, d);
             }
           }
