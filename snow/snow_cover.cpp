@@ -107,51 +107,160 @@ __extension__ typedef __int128 FixedSum;      // a row's sum: 2^56 a cell, room 
 constexpr double kFixedScale = 4294967296.0;  // 2^32: exact in double
 inline Fixed to_fixed(float v) { return static_cast<Fixed>(static_cast<double>(v) * kFixedScale); }
 
-// Rows of the output smoothed together: each chunk makes the prefix sums of
-// the rows its diamonds reach (chunk + 2n rows), so memory is chunk-sized, not
-// grid-sized.
+// Rows of the output smoothed together (at least 4n, so that the 2n + 2 rows
+// of sums a strip builds beyond its own cost at most half as much again).
 constexpr int kSmoothChunk = 64;
+int strip_rows(int region) { return std::max(kSmoothChunk, 4 * region); }
+
+// Prefix sums of the padded heights along both diagonals for the rows of one
+// strip, kept in a ring of 2n + 3 rows: A(r, x) = P(r, x) + A(r - 1, x - 1)
+// ("\") and B(r, x) = P(r, x) + B(r - 1, x + 1) ("/"), P the height in fixed
+// point with the nearest edge cell beyond the border. The first row of the
+// ring and the columns just outside x in [-n, w + n) hold 0, so a diagonal's
+// sum restarts there; only differences along one diagonal are used, which are
+// exact whatever the start.
+class DiagonalSums {
+ public:
+  DiagonalSums(const HeightField& dem, int region, int base_row)
+      : dem_(dem),
+        n_(region),
+        base_(base_row),
+        ring_(2 * region + 3),
+        cols_(dem.width() + 2 * region + 2),
+        a_(static_cast<std::size_t>(ring_) * cols_, 0),
+        b_(a_.size(), 0),
+        filled_(base_row) {}
+
+  // Fills the rows up to `row` (rows are added in order).
+  void fill_to(int row) {
+    const int w = dem_.width(), h = dem_.height();
+    for (int r = filled_ + 1; r <= row; ++r) {
+      FixedSum* a = line(a_, r);
+      FixedSum* b = line(b_, r);
+      const FixedSum* pa = line(a_, r - 1);
+      const FixedSum* pb = line(b_, r - 1);
+      const int cr = std::clamp(r, 0, h - 1);
+      a[0] = 0, b[cols_ - 1] = 0;
+      for (int c = 1; c + 1 < cols_; ++c) {
+        const FixedSum p = to_fixed(dem_(std::clamp(c - n_ - 1, 0, w - 1), cr));
+        a[c] = p + pa[c - 1];
+        b[c] = p + pb[c + 1];
+      }
+      a[cols_ - 1] = 0, b[0] = 0;
+    }
+    filled_ = std::max(filled_, row);
+  }
+
+  // Sums of `len` cells from (x0, r0) down and to the right / left.
+  FixedSum down_right(int r0, int x0, int len) const {
+    return at(a_, r0 + len - 1, x0 + len - 1) - at(a_, r0 - 1, x0 - 1);
+  }
+  FixedSum down_left(int r0, int x0, int len) const {
+    return at(b_, r0 + len - 1, x0 - len + 1) - at(b_, r0 - 1, x0 + 1);
+  }
+
+  // The cells of the diamond at (x, row) that the one at (x - 1, row) lacks
+  // (its east edge, ">") less those it has that this one lacks (the west edge
+  // of the one at x - 1, "<"): each edge is two diagonal runs,
+  //   east:  down_right(row - n, x, n + 1) + down_left(row + 1, x + n - 1, n),
+  //   west:  down_left(row - n, x - 1, n + 1) + down_right(row + 1, x - n, n),
+  // written out on the three rows they touch (row - n - 1, row, row + n), whose
+  // places in the ring are found once a row.
+  struct EastStep {
+    const FixedSum *a_up, *a_mid, *a_down, *b_up, *b_mid, *b_down;
+    int n;
+    FixedSum operator()(int x) const {
+      return a_mid[x + n] - a_up[x - 1] + b_down[x] - b_mid[x + n] - b_mid[x - 1 - n] + b_up[x] -
+             a_down[x - 1] + a_mid[x - n - 1];
+    }
+  };
+  EastStep east_step(int row) const {
+    const auto at_row = [&](const std::vector<FixedSum>& t, int r) {
+      return &t[static_cast<std::size_t>((r - base_) % ring_) * cols_ + (n_ + 1)];
+    };
+    return {at_row(a_, row - n_ - 1),
+            at_row(a_, row),
+            at_row(a_, row + n_),
+            at_row(b_, row - n_ - 1),
+            at_row(b_, row),
+            at_row(b_, row + n_),
+            n_};
+  }
+
+  // The same from (x, row - 1) to (x, row): south edge "v" less north edge "^".
+  FixedSum step_south(int x, int row) const {
+    const int n = n_, up = row - 1;
+    return down_right(row, x - n, n + 1) + down_left(row, x + n, n) - down_left(up - n, x, n + 1) -
+           down_right(up - n + 1, x + 1, n);
+  }
+
+ private:
+  FixedSum* line(std::vector<FixedSum>& t, int r) {
+    return &t[static_cast<std::size_t>((r - base_) % ring_) * cols_];
+  }
+  FixedSum at(const std::vector<FixedSum>& t, int r, int x) const {
+    return t[static_cast<std::size_t>((r - base_) % ring_) * cols_ + (x + n_ + 1)];
+  }
+
+  const HeightField& dem_;
+  int n_, base_, ring_, cols_;
+  std::vector<FixedSum> a_, b_;
+  int filled_;
+};
+
+// The diamond of L1 radius n at (x, row), its centre included, cell by cell
+// (the start of a strip).
+FixedSum diamond_direct(const HeightField& dem, int x, int row, int n) {
+  FixedSum sum = 0;
+  for (int dr = -n; dr <= n; ++dr) {
+    const int reach = n - std::abs(dr);
+    const int r = std::clamp(row + dr, 0, dem.height() - 1);
+    for (int dc = -reach; dc <= reach; ++dc)
+      sum += to_fixed(dem(std::clamp(x + dc, 0, dem.width() - 1), r));
+  }
+  return sum;
+}
 
 }  // namespace
 
-// The diamond sums are exact integer sums, so they do not depend on where a
-// row's prefix sums start: a window of the DEM smooths to the bits the whole
-// DEM gives (away from its edges), which the tiled descriptor
-// (snow_cover_to_files) relies on. Double prefix sums from each row's first
-// cell would round differently in a window that starts elsewhere.
+// The diamond sums are exact integer sums, so they do not depend on the order
+// they are made in: a window of the DEM smooths to the bits the whole DEM
+// gives (away from its edges), which the tiled descriptor
+// (snow_cover_to_files) relies on, and the O(1) sums below give the bits of
+// the direct ones. Each diamond comes from its west neighbour's by adding its
+// east edge and taking away the west edge of the other (two diagonal runs
+// each, four lookups of the diagonal prefix sums): O(1) a cell whatever n.
+// The first column steps south the same way; a strip's first cell is summed
+// directly (O(n^2) once a strip of at least 4n rows).
 HeightField smooth(const HeightField& dem, int region) {
-  const int w = dem.width(), h = dem.height(), n = region, pw = w + 2 * n + 1;
+  const int w = dem.width(), h = dem.height(), n = region;
   HeightField out(w, h, 0.0f, dem.geo());
   const double inv_count = 1.0 / smoothing_neighbour_count(n);
-  const int chunks = (h + kSmoothChunk - 1) / kSmoothChunk;
+  const int strip = strip_rows(n);
+  const int strips = (h + strip - 1) / strip;
+  const auto put = [&](int x, int row, FixedSum diamond) {
+    const FixedSum sum = diamond - to_fixed(dem(x, row));  // the diamond without its centre
+    const double mean = static_cast<double>(sum) / kFixedScale * inv_count;
+    out(x, row) = static_cast<float>(0.5 * (dem(x, row) + mean));
+  };
   tbb::parallel_for(
-      tbb::blocked_range<int>(0, chunks, 1),
+      tbb::blocked_range<int>(0, strips, 1),
       [&](const tbb::blocked_range<int>& range) {
-        std::vector<FixedSum> sums;
-        for (int c = range.begin(); c < range.end(); ++c) {
-          const int r0 = c * kSmoothChunk, r1 = std::min(h, r0 + kSmoothChunk);
-          // Padded rows r0 - n .. r1 - 1 + n (edge cells repeated beyond the
-          // border); line k holds sum[px] = the first px padded heights.
-          const int lines = r1 - r0 + 2 * n;
-          sums.resize(static_cast<std::size_t>(lines) * pw);
-          for (int k = 0; k < lines; ++k) {
-            const int row = std::clamp(r0 - n + k, 0, h - 1);
-            FixedSum* line = &sums[static_cast<std::size_t>(k) * pw];
-            line[0] = 0;
-            for (int px = 0; px + 1 < pw; ++px)
-              line[px + 1] = line[px] + to_fixed(dem(std::clamp(px - n, 0, w - 1), row));
-          }
-          for (int row = r0; row < r1; ++row)
-            for (int x = 0; x < w; ++x) {
-              FixedSum sum = -FixedSum{to_fixed(dem(x, row))};  // the diamond without its centre
-              for (int dr = -n; dr <= n; ++dr) {
-                const int reach = n - std::abs(dr);
-                const FixedSum* line = &sums[static_cast<std::size_t>(row - r0 + n + dr) * pw];
-                sum += line[x + n + reach + 1] - line[x + n - reach];
-              }
-              const double mean = static_cast<double>(sum) / kFixedScale * inv_count;
-              out(x, row) = static_cast<float>(0.5 * (dem(x, row) + mean));
+        for (int s = range.begin(); s < range.end(); ++s) {
+          const int r0 = s * strip, r1 = std::min(h, r0 + strip);
+          DiagonalSums sums(dem, n, r0 - n - 1);
+          FixedSum first = 0;  // the diamond at (0, row)
+          for (int row = r0; row < r1; ++row) {
+            sums.fill_to(row + n);
+            first = row == r0 ? diamond_direct(dem, 0, row, n) : first + sums.step_south(0, row);
+            FixedSum d = first;
+            put(0, row, d);
+            const auto step_east = sums.east_step(row);
+            for (int x = 1; x < w; ++x) {
+              d += step_east(x);
+              put(x, row, d);
             }
+          }
         }
       },
       tbb::simple_partitioner());
@@ -215,15 +324,15 @@ std::string nodata_message(std::size_t nodata) {
 // Bytes a cell of the grid worked on (the DEM or a window of it) at the
 // descriptor's peak, the TSA step: the DEM, the smoothed field and the TSA (4
 // each) and the normals (12); later steps hold the DEM, the smoothed field,
-// the TSA, t and t smoothed (20). The smoothing's prefix sums are chunk-sized
-// (16 bytes a cell of kSmoothChunk + 2n rows a thread), counted apart.
+// the TSA, t and t smoothed (20). The smoothing's diagonal sums are
+// strip-sized (two 16-byte sums a cell of 2n + 3 rows a thread), counted apart.
 // Measured: a 3072^2 DEM in blocks of 2048 (windows of 2204^2) peaked 148 MB
 // above a 32^2 one, where this counts 140 MB.
 constexpr std::uint64_t kCoverBytesPerCell = 24;
 
 std::uint64_t smoothing_bytes(int width, int region) {
   const std::uint64_t threads = std::max(1, tbb::this_task_arena::max_concurrency());
-  return threads * (kSmoothChunk + 2 * std::uint64_t(region)) * (width + 2 * region + 1) * 16;
+  return threads * (2 * std::uint64_t(region) + 3) * (width + 2 * std::uint64_t(region) + 2) * 32;
 }
 
 void validate(const HeightField& dem, const CoverOptions& o) {

@@ -39,7 +39,9 @@ int smoothing_neighbour_count(int region);
 
 // One smoothing pass: new height = (own + mean of the region-n diamond) / 2.
 // Beyond the border the nearest edge cell stands in. NaN must not occur.
-// Sums along rows by prefix sums (double), so a wide region costs O(n) a cell.
+// The diamond sums are exact (heights as integers of 2^-32 m, 128-bit sums)
+// and cost O(1) a cell whatever n: each diamond is its west neighbour's plus
+// and minus two edges, each edge two runs of diagonal prefix sums.
 terrain::HeightField smooth(const terrain::HeightField& dem, int region);
 
 // Tangent Sphere Accessibility (metres) of every grid point, +infinity where

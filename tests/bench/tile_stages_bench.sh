@@ -11,8 +11,8 @@
 # DRIFT=path overrides BUILD_DIR/pipeline/drift; BLOCK (default: the stages'
 # own, 2048) sets --block; COVER_ARGS (default: the paper's region and probe
 # radius in cells, "--region-cells 3 --radius-cells 5.5", halo 18) the
-# descriptor's options: the metric defaults widen the region to 150 cells on a
-# 1 m DEM (halo 753), which costs O(region) a cell and pass. The data stays in
+# descriptor's options ("" for the metric defaults, which widen the region to
+# 150 cells on a 1 m DEM: halo 753, so give BLOCK=4096). The data stays in
 # DATA_DIR for reruns (16384^2: 16 tiles, ~0.6 GB).
 set -euo pipefail
 build=${1:?usage: tile_stages_bench.sh BUILD_DIR DATA_DIR [SIZE...]}
@@ -24,7 +24,7 @@ drift=$(realpath "${DRIFT:-$build/pipeline/drift}")
 here=$(cd "$(dirname "$0")" && pwd)
 block=()
 [ -z "${BLOCK:-}" ] || block=(--block "$BLOCK")
-read -r -a cover_args <<< "${COVER_ARGS:---region-cells 3 --radius-cells 5.5}"
+read -r -a cover_args <<< "${COVER_ARGS---region-cells 3 --radius-cells 5.5}"
 mkdir -p "$data"
 cd "$data"
 # One line of figures from a /usr/bin/time -v log.
