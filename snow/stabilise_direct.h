@@ -1,8 +1,9 @@
 // Snow stabilisation in one step (issue 36, item 3): the state at rest computed
 // directly instead of by passes, at a cost near linear in the area
-// (O(N log N): one Dijkstra, one walk down per loose cell, memoised, and one
-// priority flood over each heap's cells), with the mass exact to rounding and no pair of
-// 8-neighbours steeper than the angle of repose where the higher holds snow.
+// (O(N log N) a layer: one Dijkstra, one pass down over the cells the loose
+// snow crosses, highest first, and one priority flood over each heap's cells), with the mass exact
+// to rounding and no pair of 8-neighbours steeper than the angle of repose where the higher holds
+// snow.
 //
 // The passes (snow/stabilise_grid.h) shift a slope standing at repose only as
 // fast as a diffusion (O(L^2) passes for a slope L cells long); this solver
