@@ -203,6 +203,7 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   ground_rule.tolerance = options.ground_tolerance;
   ground_rule.coarse_levels = options.coarse_levels;
   ground_rule.direct = options.direct_stabilise;
+  ground_rule.direct_layers = options.direct_layers;
   // Alive beside stabilisation: the ground, the probability and its facing
   // (4 B a cell each) and the snow (8): 20 B a cell, 54.8 measured with the
   // passes' 34 (MemoryEstimate.SnowFallOnGroundThatNeverSlides).

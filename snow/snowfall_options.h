@@ -32,6 +32,9 @@ struct SnowfallOptions {
   // The ground settled in one step (StabiliseOptions::direct) instead of by
   // the passes: `--stabilise direct`.
   bool direct_stabilise = false;
+  // With direct_stabilise: the snow settled in this many equal layers
+  // (StabiliseOptions::direct_layers): `--direct-layers`.
+  int direct_layers = 4;
   // > 0: the ground's occlusion swept on blocks of this many cells a side,
   // each with its halo (snow/occlusion_blocks.h; the same bits as one pass);
   // ground alone, by the sweep. 0: one pass.

@@ -46,6 +46,10 @@ const std::vector<SnowfallParameter>& snowfall_parameters() {
        "settle the ground snow first on this many levels of 2 x 2 blocks: faster on large "
        "rasters, the state a few cm from the default's (docs/snowfall.md)",
        DRIFT_PARAMETER_FIELD(SnowfallOptions, coarse_levels)},
+      {"direct_layers", "--direct-layers", 1, 1024, Ends::Closed, true, "",
+       "with --stabilise direct: the snow settled in this many equal layers, each on the "
+       "last's state at rest: nearer the passes' state, cost x N (docs/snowfall.md)",
+       DRIFT_PARAMETER_FIELD(SnowfallOptions, direct_layers)},
       // The library's own: no flag.
       {"occlusion.ground_samples", "", 0, 16, Ends::Closed, true, "",
        "depth-map samples K for cells near objects (0: a cell / 2 texels)",

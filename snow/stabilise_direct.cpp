@@ -125,23 +125,6 @@ std::uint32_t next_down(const Field& f, std::size_t i, const std::vector<std::ui
   return moves ? static_cast<std::uint32_t>(next) : kNone;
 }
 
-std::uint32_t resting_cell(const Field& f, std::size_t i, const std::vector<std::uint8_t>& cut,
-                           std::vector<std::uint32_t>& rest, std::vector<std::uint32_t>& path) {
-  path.clear();
-  std::size_t c = i;
-  while (rest[c] == kNone) {
-    path.push_back(static_cast<std::uint32_t>(c));
-    const std::uint32_t next = next_down(f, c, &cut);
-    if (next == kNone) {
-      rest[c] = static_cast<std::uint32_t>(c);
-      break;
-    }
-    c = next;
-  }
-  for (std::uint32_t p : path) rest[p] = rest[c];
-  return rest[c];
-}
-
 // Step 3: heaps `mass` at p as the cone of slope k over the surface, over the
 // connected cells around p where it stands above it. A cell c lies under the
 // cone of apex T where T > t(c) = H(c) + k d(p, c), and joins p's region once T
@@ -197,15 +180,24 @@ Spill heap_at(const Field& f, std::size_t p, double mass, std::vector<std::uint8
     });
   }
   for (std::size_t c : touched) seen[c] = 0;
-  double total = 0.0;
+  // Layers under 1 nm (rounding at the region's rim) are left to the apex
+  // cell, so that no film is left on a face steeper than repose. When the
+  // heap spills, the cells at the pass's level (within the pass tolerance
+  // above, their layer thinner than it) are the pass itself, whose ground
+  // may fall to the spill cell more steeply than repose: their layer spills
+  // on with the rest instead of lying there as a film.
+  const double film = spill.mass > 0.0 ? std::max(1e-9, 1e-7 * (1.0 + std::abs(apex))) : 1e-9;
+  double total = 0.0, withheld = 0.0;
   for (std::size_t c : region) {
-    // Layers under 1 nm (rounding at the region's rim) are left to the apex
-    // cell, so that no film is left on a face steeper than repose.
     double add = apex - t_of(c);
-    if (!(add > 1e-9)) add = 0.0;
+    if (!(add > film)) {
+      if (spill.mass > 0.0 && add > 0.0) withheld += add;
+      add = 0.0;
+    }
     f.snow(c) += add, total += add;
   }
-  f.snow(p) += mass - total;  // the rounding, to the apex cell
+  f.snow(p) += (mass - withheld) - total;  // the rounding, to the apex cell
+  spill.mass += withheld;
   return spill;
 }
 
@@ -219,10 +211,88 @@ std::size_t runs_to(const Field& f, std::size_t i) {
   }
 }
 
+// Step 2, as the passes share it: the loose snow runs down to every
+// neighbour the surface falls to more steeply than repose, in proportion to
+// the excess (paper 003 2.1(3), the passes' rule; over cut cells also where
+// the cut surface falls at repose), and rests where nothing is steeper.
+// Cells are taken from the highest down, so each has all its inflow when it
+// is taken (every flow goes strictly down); the last receiver gets the
+// remainder, so mass moves as the same doubles.
+void route_shared(const Field& f, const std::vector<std::uint32_t>& cut_cells,
+                  const std::vector<double>& loose, const std::vector<std::uint8_t>& cut,
+                  std::vector<double>& load, std::vector<std::uint32_t>& heaps,
+                  DirectReport& report) {
+  using Item = std::pair<double, std::uint32_t>;
+  std::priority_queue<Item> queue;                // highest surface first; ties by index
+  std::vector<double>& flow = load;               // pending inflow; becomes the load where it rests
+  std::vector<std::uint8_t> state(f.cells(), 0);  // 1 queued, 2 resting
+  for (std::size_t c = 0; c < cut_cells.size(); ++c) {
+    flow[cut_cells[c]] += loose[c], report.loose += loose[c];
+    if (!state[cut_cells[c]])
+      state[cut_cells[c]] = 1, queue.push({f.surface(cut_cells[c]), cut_cells[c]});
+  }
+  std::array<std::size_t, 8> to{};
+  std::array<double, 8> share{};
+  while (!queue.empty()) {
+    const std::uint32_t i = queue.top().second;
+    queue.pop();
+    const double hi = f.surface(i), slack = 1e-9 * (1.0 + std::abs(hi));
+    int m = 0;
+    double sum = 0.0, best = -std::numeric_limits<double>::infinity();
+    std::size_t steepest = i;
+    f.neighbours(i, [&](std::size_t n, int k) {
+      const double hn = f.surface(n), excess = hi - hn - f.drop(k);
+      if (!(hn < hi)) return;
+      if (excess > best) best = excess, steepest = n;
+      if (excess > slack) to[m] = n, share[m] = excess, sum += excess, ++m;
+    });
+    if (m == 0 && steepest != i && cut[i] && cut[steepest] && best >= -slack)
+      to[0] = steepest, share[0] = 1.0, sum = 1.0, m = 1;  // down the cut at repose
+    if (m == 0) {
+      state[i] = 2, heaps.push_back(i);
+      continue;
+    }
+    const double amount = flow[i];
+    flow[i] = 0.0;
+    double given = 0.0;
+    for (int j = 0; j < m; ++j) {
+      const double part = j + 1 == m ? amount - given : amount * (share[j] / sum);
+      given += part;
+      flow[to[j]] += part;
+      if (!state[to[j]])
+        state[to[j]] = 1, queue.push({f.surface(to[j]), static_cast<std::uint32_t>(to[j])});
+    }
+  }
+}
+
 }  // namespace
 
 DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
-                            double dx, double dy, double tan_repose) {
+                            double dx, double dy, double tan_repose, int layers) {
+  if (layers < 1) throw Error("settle_at_rest: the number of layers must be at least 1");
+  if (layers > 1) {
+    // Each layer is all / layers, the last what the others left (summed the
+    // same way per cell), so the layers add up to the snow given.
+    const terrain::Grid<double> all = snow;
+    std::fill(snow.values().begin(), snow.values().end(), 0.0);
+    DirectReport report;
+    for (int j = 1; j <= layers; ++j) {
+      for (std::size_t i = 0; i < snow.size(); ++i) {
+        const double piece = all.values()[i] / layers;
+        double layer = piece;
+        if (j == layers) {
+          double before = 0.0;
+          for (int l = 1; l < layers; ++l) before += piece;
+          layer = all.values()[i] - before;
+        }
+        snow.values()[i] += layer;
+      }
+      const DirectReport r = settle_at_rest(ground, snow, dx, dy, tan_repose, 1);
+      report.cut_cells += r.cut_cells, report.heaps += r.heaps, report.spills += r.spills;
+      report.loose += r.loose;
+    }
+    return report;
+  }
   if (ground.width() != snow.width() || ground.height() != snow.height())
     throw Error("settle_at_rest: ground and snow grids differ in size");
   if (snow.size() >= kNone)
@@ -244,13 +314,8 @@ DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<do
   }
   std::vector<double>& load = drained_then_load;
   std::fill(load.begin(), load.end(), 0.0);
-  std::vector<std::uint32_t> rest(f.cells(), kNone), path, heaps;
-  for (std::size_t c = 0; c < cut_cells.size(); ++c) {
-    const std::uint32_t r = resting_cell(f, cut_cells[c], cut, rest, path);
-    if (load[r] == 0.0) heaps.push_back(r);
-    load[r] += loose[c];
-    report.loose += loose[c];
-  }
+  std::vector<std::uint32_t> heaps;
+  route_shared(f, cut_cells, loose, cut, load, heaps, report);
   // Heaps in ascending cell order; spilled snow queued at its new resting
   // cell (a fixed order, so the same bits on any machine).
   std::set<std::size_t> queue(heaps.begin(), heaps.end());

@@ -1,8 +1,9 @@
 // Snow stabilisation in one step (issue 36, item 3): the state at rest computed
 // directly instead of by passes, at a cost near linear in the area
-// (O(N log N): one Dijkstra, one walk down per loose cell, memoised, and one
-// priority flood over each heap's cells), with the mass exact to rounding and no pair of
-// 8-neighbours steeper than the angle of repose where the higher holds snow.
+// (O(N log N) a layer: one Dijkstra, one pass down over the cells the loose
+// snow crosses, highest first, and one priority flood over each heap's cells), with the mass exact
+// to rounding and no pair of 8-neighbours steeper than the angle of repose where the higher holds
+// snow.
 //
 // The passes (snow/stabilise_grid.h) shift a slope standing at repose only as
 // fast as a diffusion (O(L^2) passes for a slope L cells long); this solver
@@ -13,11 +14,12 @@
 //     point, by Dijkstra from the lowest labels; each is final when popped).
 //     Snow on ground steeper than repose is cut down to what the snow below
 //     it holds up; snow at rest is not touched;
-//  2. the snow cut off, H - E, runs down over cut cells while the cut surface
-//     falls at repose or steeper, elsewhere only down ground or snow steeper
-//     than repose (the steepest excess, strictly down, so no loops), and stops
-//     where nothing is steeper: where the passes would stop it (a column's cut
-//     snow stays on the column);
+//  2. the snow cut off, H - E, runs down to every neighbour the surface falls
+//     to more steeply than repose, shared in proportion to the excess (the
+//     passes' rule, paper 003 2.1(3); strictly down, so no loops; over cut
+//     cells also down the cut at repose), and stops where nothing is
+//     steeper: where the passes would stop it (a column's cut snow stays on
+//     the column);
 //  3. there it is heaped as the cone of slope k (Prigozhin 1994; Prigozhin 1996: a heap
 //     fed at a point grows as the repose-limited surface over what lies below
 //     it) over the connected cells where the cone stands above the surface,
@@ -31,9 +33,9 @@
 // cone). So the state is at rest by construction, in every direction, up to
 // 1e-7 m (what a heap may step over a pass), not up to the passes' 1 mm.
 //
-// It is a different path to rest, so not the passes' state: snow runs down
-// the steepest way instead of spreading among every lower neighbour, and it
-// heaps where it first stops instead of creeping on. docs/snowfall.md gives
+// It is a different path to rest, so not the passes' state: the snow is
+// heaped where it first stops instead of creeping on while the deposits
+// grow (settling it in layers brings it closer). docs/snowfall.md gives
 // the distance to the passes' state measured on the benchmark field.
 // Everything runs in a fixed order on one thread: the same bits for any
 // thread count.
@@ -53,8 +55,14 @@ struct DirectReport {
 };
 
 // ground: heights (m); snow: depth (m), updated in place; dx, dy: cell sizes
-// (m); tan_repose = tan(angle of repose).
+// (m); tan_repose = tan(angle of repose). layers > 1: the snow settled in that
+// many equal layers, each added to the state at rest of those before it and
+// settled in turn (the snow falls over hours): the deposit a slope's snow
+// gathers into then rises under it and holds its lower snow up, as the
+// passes' deposits do, and each heap is small, so the order heaps are built
+// in matters less. Cost x layers; docs/snowfall.md gives the distance to the
+// passes' state against the number of layers.
 DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
-                            double dx, double dy, double tan_repose);
+                            double dx, double dy, double tan_repose, int layers = 1);
 
 }  // namespace drift::snow

@@ -75,6 +75,10 @@ struct StabiliseOptions {
   // and tolerance's pass criterion do not apply; tolerance still decides the
   // report's `converged` (no pair steeper than repose by more than it).
   bool direct = false;
+  // With direct: the snow settled in this many equal layers, each on the
+  // state at rest of those before (settle_at_rest); closer to the passes'
+  // state the more layers, at their cost (docs/snowfall.md).
+  int direct_layers = 4;
   // Bytes a cell the caller holds beside the workspace (snowfall: the ground,
   // probability, facing and snow grids), counted in its memory checks.
   std::uint64_t held_bytes_per_cell = 0;

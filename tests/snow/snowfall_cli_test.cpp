@@ -114,6 +114,22 @@ TEST(SnowfallCli, StabiliseDirectSettlesTheSameSnowInOneStep) {
   EXPECT_NE(output(d).find("--stabilise"), std::string::npos) << output(d);
 }
 
+// --direct-layers reaches the one-step solver: one layer and eight give
+// different states holding the same snow; 0 layers is a usage error naming it.
+TEST(SnowfallCli, DirectLayersReachTheOneStepSolver) {
+  const fs::path d = dir();
+  const std::string common = mountains_run(d);
+  const std::string direct = " --stabilise direct --direct-layers ";
+  ASSERT_EQ(run(common + (d / "one.tif").string() + direct + "1", d), 0) << output(d);
+  ASSERT_EQ(run(common + (d / "eight.tif").string() + direct + "8", d), 0) << output(d);
+  const auto a = drift::terrain::read_raster(d / "one.tif");
+  const auto c = drift::terrain::read_raster(d / "eight.tif");
+  EXPECT_NE(a.values(), c.values());
+  EXPECT_NEAR(total(c), total(a), 1e-5 * total(a));
+  EXPECT_EQ(run(common + (d / "x.tif").string() + direct + "0", d), 2);
+  EXPECT_NE(output(d).find("--direct-layers"), std::string::npos) << output(d);
+}
+
 // --block: the ground's occlusion on blocks with their halo gives the bytes of one pass.
 TEST(SnowfallCli, BlockByBlockOcclusionGivesTheSameRasters) {
   const fs::path d = dir();

@@ -238,3 +238,66 @@ TEST(StabiliseDirect, SameBitsForAnyThreadCountThroughStabiliseGrid) {
 }
 
 }  // namespace
+
+namespace {
+
+using drift::snow::settle_at_rest;
+using drift::terrain::Grid;
+
+// Snow cut from a ridge between two equal slopes splits between them as the
+// passes share it (in proportion to the excess, here equal), instead of all
+// going down whichever side comes first in the neighbour order.
+TEST(StabiliseDirect, SnowOnARidgeSplitsEvenlyBetweenItsSides) {
+  const int w = 41, h = 12, c = 20;  // ridge along column 20, 0.5 m cells
+  const double t60 = std::tan(60.0 * std::numbers::pi / 180.0);
+  Grid<float> ground(w, h, 0.0f);
+  Grid<double> snow(w, h, 0.0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      ground(x, y) = static_cast<float>(std::max(0, 10 - std::abs(x - c)) * 0.5 * t60);
+      if (std::abs(x - c) <= 2) snow(x, y) = 0.4;
+    }
+  const double before = total(snow);
+  settle_at_rest(ground, snow, 0.5, 0.5, kTan);
+  EXPECT_NEAR(total(snow), before, 1e-12 * before);
+  expect_at_rest(ground, snow, 0.5, 0.5);
+  double west = 0.0, east = 0.0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) (x < c ? west : east) += x == c ? 0.0 : snow(x, y);
+  std::printf("west %.4f m x cells, east %.4f, ridge %.4f\n", west, east, before - west - east);
+  EXPECT_NEAR(west, east, 0.02 * (west + east));
+}
+
+// Settling in layers (each on the last one's state at rest) brings the state
+// near the passes': on the mountain field the distance falls to under half
+// the one-layer state's, with the same ground covered to within a point,
+// at rest and with the mass exact.
+TEST(StabiliseDirect, LayersBringTheStateNearThePasses) {
+  const int n = 128;
+  const Grid<float> ground = drift::testing::snowfall_mountains(n);
+  const Grid<double> start(n, n, 0.5);
+  const Grid<double> passes = by_passes(ground, start, 1.0, 1.0);
+  auto cover = [](const Grid<double>& s) {
+    double c = 0.0;
+    for (double v : s.values()) c += v > 1e-3;
+    return 100.0 * c / s.size();
+  };
+  double rms_one = 0.0;
+  for (const int layers : {1, 16}) {
+    Grid<double> snow = start;
+    settle_at_rest(ground, snow, 1.0, 1.0, kTan, layers);
+    EXPECT_NEAR(total(snow), total(start), 1e-12 * total(start));
+    expect_at_rest(ground, snow, 1.0, 1.0);
+    const Distance d = distance(snow, passes, 16);
+    std::printf("%d layers: RMS %.4f m, worst block %.3f; covered %.2f %% against %.2f %%\n",
+                layers, d.rms, d.block, cover(snow), cover(passes));
+    if (layers == 1) {
+      rms_one = d.rms;
+    } else {
+      EXPECT_LT(d.rms, 0.5 * rms_one);
+      EXPECT_NEAR(cover(snow), cover(passes), 1.0);
+    }
+  }
+}
+
+}  // namespace
