@@ -67,7 +67,12 @@ void SoilSimulation::step() {
   for (const BodyMotion& m : motion) mark_box(m.box, dirty, state_.shape);
 
   apply_forces(state_, motion);
-  for (int i = 0; i < options_.propagation_iterations; ++i) mark(propagate_forces(state_));
+  detail::Ranges reach;
+  for (int i = 0; i < options_.propagation_iterations; ++i) {
+    // After the first iteration only what the last one reached can move.
+    reach = propagate_forces(state_, i == 0 ? nullptr : &reach);
+    mark(reach);
+  }
 
   mark(advect(state_, dt));
   resolve_overflow(state_, options_.overflow, options_.overflow_passes, &dirty);
