@@ -33,7 +33,10 @@ void apply_forces(SoilState& state, const std::vector<BodyMotion>& bodies);
 // not solid body (psi < 1), with u; anything refused comes back. f becomes
 // the inflow-weighted mean of the arriving forces where the voxel is still
 // collided, 0 elsewhere. Returns per column the z-range that changed.
-detail::Ranges propagate_forces(SoilState& state);
+// `scan`: if given, only its voxels can be pushed (the last iteration's
+// returned ranges: outside them nothing changed, so nothing is pushed and
+// the moving soil is already 0); the first iteration of a step scans all.
+detail::Ranges propagate_forces(SoilState& state, const detail::Ranges* scan = nullptr);
 
 }  // namespace drift::soil
 

@@ -284,22 +284,16 @@ terrain::Mesh SurfaceExtractor::extract(const SoilState& s) {
         kept[z] = column[z];
       }
   });
-  // A leaf reads its block and one voxel around it: flag every leaf within
-  // one voxel of a changed value, so each kept leaf's values and active
-  // voxels are what a fresh build gives (the mesh alone would not show a
-  // stale active flag next to a leaf border: volumeToMesh finds an edge from
-  // either end, and the leaf across is rebuilt).
+  // Flag the leaf of every changed value: IsoMesher rebuilds the blocks
+  // that read it.
   constexpr int L = IsoMesher::kLeaf;
   const int bx = (f.nx + L - 1) / L, by = (f.ny + L - 1) / L, bz = (f.nz + L - 1) / L;
   std::vector<unsigned char> dirty(static_cast<std::size_t>(bx) * by * bz, 0);
   for (std::size_t i = 0; i < recompute.size(); ++i) {
     if (changed[i].second < 0) continue;
     const int x = recompute[i] % g.nx, y = recompute[i] / g.nx;
-    const int z0 = std::max(0, changed[i].first - 1) / L,
-              z1 = std::min(f.nz - 1, changed[i].second + 1) / L;
-    for (int v = std::max(0, y - 1) / L; v <= std::min(f.ny - 1, y + 1) / L; ++v)
-      for (int u = std::max(0, x - 1) / L; u <= std::min(f.nx - 1, x + 1) / L; ++u)
-        for (int w = z0; w <= z1; ++w) dirty[(static_cast<std::size_t>(w) * by + v) * bx + u] = 1;
+    for (int w = changed[i].first / L; w <= changed[i].second / L; ++w)
+      dirty[(static_cast<std::size_t>(w) * by + y / L) * bx + x / L] = 1;
   }
   m.work = {recompute.size(), m.mesher.update(f, m.field, &dirty)};
   return finish_mesh(s, o, m.mesher.mesh());

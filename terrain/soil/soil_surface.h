@@ -50,16 +50,21 @@ std::vector<float> surface_density(const SoilState& state, const SurfaceOptions&
 // The iso-0.5 surface of `field` (a grid of `state.shape`) in metres,
 // outward-facing, closed where the field meets the grid's sides. Empty if the
 // field is empty.
-// `kind`: Band (the default) activates only the voxels beside the iso-value,
-// Full every non-zero voxel (as before issue 33's item 8, kept to test that
-// both give the same mesh).
+// `kind`: Band (the default) meshes the field block by block (IsoMesher);
+// Full runs OpenVDB's volumeToMesh over a grid of the whole field (kept as
+// the reference the blocks must match: the same vertices and triangles, in
+// another order).
 enum class IsoGrid { Band, Full };
 terrain::Mesh iso_surface(const terrain::Grid3Shape& shape, const std::vector<float>& field,
                           IsoGrid kind = IsoGrid::Band);
 
-// The band grid of iso_surface kept leaf by leaf (8^3 voxel blocks) between
-// frames, so a frame rebuilds only the leaves whose field changed (issue 33,
-// item 1). A leaf reads its block's field and one voxel around it.
+// OpenVDB's volumeToMesh at adaptivity 0 (dual marching cubes with its edge
+// groups and ambiguous-face correction, from its own tables and
+// computeCellPoints) done on the dense field in blocks of 8^3 cells, each
+// keeping its points and quads between frames, so that a frame redoes only
+// the blocks whose field changed (issue 33, item 1). A quad names its four
+// cells and resolves them to vertex numbers only when the blocks are joined,
+// so the seams match.
 class IsoMesher {
  public:
   static constexpr int kLeaf = 8;
@@ -67,12 +72,13 @@ class IsoMesher {
   ~IsoMesher();
   IsoMesher(IsoMesher&&) noexcept;
   IsoMesher& operator=(IsoMesher&&) noexcept;
-  // Rebuilds the leaves flagged in `dirty` (one flag per leaf, x fastest,
-  // then y, then z; every leaf if null or if the shape changed) from
-  // `field`; returns how many were rebuilt.
+  // Rebuilds the blocks that read a voxel of a leaf flagged in `dirty`
+  // (8^3 voxel leaves, one flag each, x fastest, then y, then z; the caller
+  // flags the leaf of every voxel whose value changed; every block if null
+  // or if the shape changed) from `field`; returns how many were rebuilt.
   std::size_t update(const terrain::Grid3Shape& shape, const std::vector<float>& field,
                      const std::vector<unsigned char>* dirty);
-  // The iso-0.5 surface of the kept leaves: iso_surface(shape, field) of the
+  // The iso-0.5 surface of the kept blocks: iso_surface(shape, field) of the
   // field they were built from, bit for bit.
   terrain::Mesh mesh() const;
 

@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include "terrain/soil/soil_surface.h"
+#include "terrain/soil/solid_mesh.h"
 #include "tests/bench/peak_memory.h"
 #include "tests/soil/soil_fixtures.h"
 
@@ -115,6 +116,54 @@ BENCHMARK(BM_SoilSurface)
     ->Args({64, 0})
     ->Args({64, 1})
     ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The collision field a step rebuilds for one moving body (psi = the static
+// field, plus the body's coverage; SoilSimulation::rebuild_collision_field)
+// at 64^3, for the push's blade: 0 axis-aligned (the exact cuboid share), 1
+// turned 20 degrees about z, 2 a closed box mesh of the same size turned
+// the same (both by refined_share, issue 33's exact coverage), 3 a turned
+// cylinder (refined, with an error bound).
+void BM_SoilBodyCoverage(benchmark::State& state) {
+  const SoilScenario sc = fixtures::push_scenario(64, thesis_options(4));
+  const drift::terrain::Grid3Shape& g = sc.shape;
+  RigidObject body = sc.bodies.front();
+  const Eigen::Vector3d h = body.primitives.front().size;
+  const int kind = static_cast<int>(state.range(0));
+  if (kind > 0)
+    for (Keyframe& k : body.path)
+      k.orientation =
+          Eigen::Quaterniond(Eigen::AngleAxisd(20.0 * M_PI / 180, Eigen::Vector3d::UnitZ()));
+  if (kind == 2) {
+    drift::terrain::Mesh m;
+    for (int c = 0; c < 8; ++c)
+      m.positions.emplace_back(c & 1 ? h.x() : -h.x(), c & 2 ? h.y() : -h.y(),
+                               c & 4 ? h.z() : -h.z());
+    // Outward, counter-clockwise: two triangles a face.
+    m.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                   {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    body.mesh = std::make_shared<SolidMesh>(m, 0.5 * g.voxel_size, "box");
+    body.primitives.clear();
+  }
+  if (kind == 3) body.primitives.front().kind = PrimitiveKind::Cylinder;
+  const std::vector<float> psi_static(g.count(), 0.0f);
+  std::vector<float> psi;
+  double t = 0;
+  for (auto _ : state) {
+    psi = psi_static;
+    add_coverage(placed(body, t), g, psi);
+    t += 1.0 / 60;  // a step of the push
+    benchmark::DoNotOptimize(psi.data());
+  }
+}
+BENCHMARK(BM_SoilBodyCoverage)
+    ->ArgName("kind")
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
     ->UseRealTime();
 
 void BM_SoilPushIterations(benchmark::State& state) {
