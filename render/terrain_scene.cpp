@@ -475,8 +475,7 @@ Eigen::Vector3f TerrainScene::smooth_normal(float px, float py) const {
   // so the same bits (the heights hold no NaN: fill_heights).
   const terrain::BilinearCell<float> c =
       terrain::clamped_cell((px - heights_.x0) / dx_, (heights_.y0 - py) / dy_, width_, height_);
-  if (paged_ || (blocks_ && blocks_->lod_on()) || c.x0 < 1 || c.y0 < 1 || c.x1 + 1 >= width_ ||
-      c.y1 + 1 >= height_) {
+  if (paged_ || (blocks_ && blocks_->lod_on()) || c.x0 < 1 || c.y0 < 1 || c.x1 + 1 >= width_ || c.y1 + 1 >= height_) {
     auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
     return terrain::bilinear_blend(vn(c.x0, c.y0), vn(c.x1, c.y0), vn(c.x0, c.y1), vn(c.x1, c.y1),
                                    c.tx, c.ty)
