@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "render/sampling.h"
 #include "terrain/angles.h"
@@ -214,31 +215,93 @@ PathTracer::Path PathTracer::camera_path(int px, int py, SampleStream& rng) cons
 PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& rays) const {
   PixelSample out;
   Path path = camera_path(px, py, rng);
+  Hit hit;
+  ++rays;
+  const bool found = scene_.intersect(path.origin, path.dir, hit, path.cone);
+  follow(path, hit, found, rng, out, rays, 0);
+  return out;
+}
+
+void PathTracer::trace_coherent(int px, int py, SampleStream* rngs, int n, PixelSample* out,
+                                std::uint64_t& rays) const {
+  if (n < 1 || n > kCoherentSamples) throw Error("trace_coherent takes 1 to 8 samples");
+  // The camera rays of a pixel's samples leave one point in nearly one
+  // direction: traced as one packet (TerrainScene::intersect_coherent), then
+  // each path goes on alone. Each sample draws from its own stream in the
+  // order trace() does, so the result is trace()'s, sample by sample.
+  std::array<Path, kCoherentSamples> paths;
+  std::array<Vector3f, kCoherentSamples> origins, dirs;
+  std::array<RayCone, kCoherentSamples> cones;
+  std::array<Hit, kCoherentSamples> hits;
+  std::array<bool, kCoherentSamples> found{};
+  for (int i = 0; i < n; ++i) {
+    paths[i] = camera_path(px, py, rngs[i]);
+    origins[i] = paths[i].origin, dirs[i] = paths[i].dir, cones[i] = paths[i].cone;
+  }
+  rays += static_cast<std::uint64_t>(n);
+  scene_.intersect_coherent(n, origins.data(), dirs.data(), cones.data(), hits.data(),
+                            found.data());
+  // The first vertex of every sample up to its sun's shadow ray; those rays
+  // (one direction, nearby points) are traced as one packet too.
+  std::array<std::optional<GroundBsdf>, kCoherentSamples> bsdfs;
+  std::array<Vector3f, kCoherentSamples> points, sun_dirs, shadow_origins, shadow_dirs;
+  std::array<int, kCoherentSamples> shadow{};  // sample i's shadow ray (-1: none)
+  int shadows = 0;
+  for (int i = 0; i < n; ++i) {
+    out[i] = PixelSample{};
+    if (!found[i]) {
+      escape_to_sky(paths[i], 0, out[i], rays);
+      continue;
+    }
+    if (!arrive(paths[i], hits[i], 0, out[i], rays)) continue;
+    points[i] = hits[i].position + hits[i].normal * ray_epsilon(hits[i].position);
+    bsdfs[i].emplace(hits[i].normal, -paths[i].dir, hits[i].material);
+    shadow[i] = -1;
+    if (sun_up_) {
+      const auto [u1, u2] = rngs[i].next2d();
+      if (sun_ray(hits[i], u1, u2, sun_dirs[i])) {
+        shadow_origins[shadows] = points[i], shadow_dirs[shadows] = sun_dirs[i];
+        shadow[i] = shadows++;
+      }
+    } else {
+      rngs[i].skip();
+    }
+  }
+  rays += static_cast<std::uint64_t>(shadows);
+  std::array<bool, kCoherentSamples> blocked{};
+  if (shadows > 0)
+    scene_.occluded_coherent(shadows, shadow_origins.data(), shadow_dirs.data(), 1e30f,
+                             blocked.data());
+  for (int i = 0; i < n; ++i) {
+    if (!bsdfs[i]) continue;
+    if (shadow[i] >= 0 && !blocked[shadow[i]])
+      add_sun(paths[i], hits[i], points[i], *bsdfs[i], sun_dirs[i], out[i]);
+    if (!leave(paths[i], hits[i], points[i], *bsdfs[i], 0, rngs[i], out[i], rays)) continue;
+    Hit next;
+    ++rays;
+    const bool met = scene_.intersect(paths[i].origin, paths[i].dir, next, paths[i].cone);
+    follow(paths[i], next, met, rngs[i], out[i], rays, 1);
+  }
+}
+
+void PathTracer::follow(Path& path, Hit& hit, bool found, SampleStream& rng, PixelSample& out,
+                        std::uint64_t& rays, int first) const {
   // Vertices 0 .. max_depth - 1 are shaded; the ray leaving the last one is
   // traced too, only to see whether it escapes to the sky, so that both
   // strategies of the last vertex's sky light are there (PBRT's loop).
-  for (int depth = 0;; ++depth) {
-    Hit hit;
-    ++rays;
-    if (!scene_.intersect(path.origin, path.dir, hit, path.cone)) {
+  for (int depth = first;; ++depth) {
+    if (depth > first) {
+      hit = Hit{};
+      ++rays;
+      found = scene_.intersect(path.origin, path.dir, hit, path.cone);
+    }
+    if (!found) {
       escape_to_sky(path, depth, out, rays);
       break;
     }
-    if (clouds_) cross_clouds(path, hit.distance, depth, out, rays);
-    if (air_) cross_air(path, hit, depth, out, rays);
-    if (depth == settings_.max_depth) break;
-    if (depth == 0) {
-      out.hit = true;
-      out.depth = camera_.view_depth(hit.position);
-      out.position = hit.position;
-      out.object = 1 + objects_.object_at(path.origin, path.dir, hit.distance);
-      out.normal = hit.normal;
-      out.albedo = hit.material.albedo;
-      out.coverage = hit.coverage;
-    }
-    const Vector3f wo = -path.dir;
+    if (!arrive(path, hit, depth, out, rays)) break;
     const Vector3f p = hit.position + hit.normal * ray_epsilon(hit.position);
-    const GroundBsdf bsdf(hit.normal, wo, hit.material);
+    const GroundBsdf bsdf(hit.normal, -path.dir, hit.material);
     // Every vertex passes the same sets in the same order, each used or
     // skipped, so that a set stands for the same integral in all of a
     // pixel's samples and keeps its stratification (render/random.h).
@@ -248,16 +311,37 @@ PixelSample PathTracer::trace(int px, int py, SampleStream& rng, std::uint64_t& 
     } else {
       rng.skip();
     }
-    // The sky's own samples at the first vertex only.
-    if (depth < kSkySampledVertices) {
-      const auto [s1, s2] = rng.next2d();
-      sample_sky(path, hit, p, bsdf, s1, s2, out, rays);
-    } else {
-      rng.skip();
-    }
-    if (!bounce(path, hit, p, bsdf, depth, rng)) break;
+    if (!leave(path, hit, p, bsdf, depth, rng, out, rays)) break;
   }
-  return out;
+}
+
+bool PathTracer::arrive(Path& path, const Hit& hit, int depth, PixelSample& out,
+                        std::uint64_t& rays) const {
+  if (clouds_) cross_clouds(path, hit.distance, depth, out, rays);
+  if (air_) cross_air(path, hit, depth, out, rays);
+  if (depth == settings_.max_depth) return false;
+  if (depth == 0) {
+    out.hit = true;
+    out.depth = camera_.view_depth(hit.position);
+    out.position = hit.position;
+    out.object = 1 + objects_.object_at(path.origin, path.dir, hit.distance);
+    out.normal = hit.normal;
+    out.albedo = hit.material.albedo;
+    out.coverage = hit.coverage;
+  }
+  return true;
+}
+
+bool PathTracer::leave(Path& path, const Hit& hit, const Vector3f& p, const GroundBsdf& bsdf,
+                       int depth, SampleStream& rng, PixelSample& out, std::uint64_t& rays) const {
+  // The sky's own samples at the first vertex only.
+  if (depth < kSkySampledVertices) {
+    const auto [s1, s2] = rng.next2d();
+    sample_sky(path, hit, p, bsdf, s1, s2, out, rays);
+  } else {
+    rng.skip();
+  }
+  return bounce(path, hit, p, bsdf, depth, rng);
 }
 
 void PathTracer::escape_to_sky(const Path& path, int depth, PixelSample& out,
@@ -303,19 +387,28 @@ void PathTracer::cross_air(Path& path, const Hit& hit, int depth, PixelSample& o
 void PathTracer::sample_sun(const Path& path, const Hit& hit, const Vector3f& p,
                             const GroundBsdf& bsdf, float u1, float u2, PixelSample& out,
                             std::uint64_t& rays) const {
+  Vector3f l;
+  if (sun_ray(hit, u1, u2, l) && (++rays, !scene_.occluded(p, l, 1e30f)))
+    add_sun(path, hit, p, bsdf, l, out);
+}
+
+bool PathTracer::sun_ray(const Hit& hit, float u1, float u2, Vector3f& l) const {
   // Uniform in the sun's cone: pdf 1/solid angle, radiance E/solid angle, so
   // the estimate is E * cos * f.
-  const Vector3f l = cone_sample(sun_dir_, sun_cos_max_, u1, u2);
+  l = cone_sample(sun_dir_, sun_cos_max_, u1, u2);
+  return hit.normal.dot(l) > 0.0f && l.z() > -0.2f;
+}
+
+void PathTracer::add_sun(const Path& path, const Hit& hit, const Vector3f& p,
+                         const GroundBsdf& bsdf, const Vector3f& l, PixelSample& out) const {
   const float cos_l = hit.normal.dot(l);
-  if (cos_l > 0.0f && l.z() > -0.2f && (++rays, !scene_.occluded(p, l, 1e30f))) {
-    Vector3f e = air_ ? air_->sun_irradiance(base_altitude_ + hit.position.z()) : sun_irradiance_;
-    // Cloud shadow, blurred as the sun's disc blurs it (its penumbra).
-    if (clouds_) {
-      const float width = path.cone.width_at(hit.distance);
-      e *= clouds_->transmittance(p, l, width, sun_penumbra_);
-    }
-    out.radiance += path.throughput.cwiseProduct(bsdf.eval(l)).cwiseProduct(e) * cos_l;
+  Vector3f e = air_ ? air_->sun_irradiance(base_altitude_ + hit.position.z()) : sun_irradiance_;
+  // Cloud shadow, blurred as the sun's disc blurs it (its penumbra).
+  if (clouds_) {
+    const float width = path.cone.width_at(hit.distance);
+    e *= clouds_->transmittance(p, l, width, sun_penumbra_);
   }
+  out.radiance += path.throughput.cwiseProduct(bsdf.eval(l)).cwiseProduct(e) * cos_l;
 }
 
 void PathTracer::sample_sky(const Path& path, const Hit& hit, const Vector3f& p,

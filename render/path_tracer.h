@@ -55,6 +55,12 @@ class PathTracer {
   // One sample of pixel (px, py), drawing from `rng`; adds the rays it
   // traced to `rays`.
   PixelSample trace(int px, int py, SampleStream& rng, std::uint64_t& rays) const;
+  // n (1 to kCoherentSamples) samples of pixel (px, py) at once, sample i
+  // drawing from rngs[i] into out[i]: the same as n calls of trace() but
+  // for the camera rays, traced together (TerrainScene::intersect_coherent).
+  static constexpr int kCoherentSamples = TerrainScene::kCoherentRays;
+  void trace_coherent(int px, int py, SampleStream* rngs, int n, PixelSample* out,
+                      std::uint64_t& rays) const;
 
  private:
   // A path under way: the ray leaving its last vertex and what it carries.
@@ -67,6 +73,21 @@ class PathTracer {
   };
 
   Path camera_path(int px, int py, SampleStream& rng) const;
+  // The rest of trace() from vertex `first` on, its hit known (found: the
+  // ray met something): the path's light added to `out`.
+  void follow(Path& path, Hit& hit, bool found, SampleStream& rng, PixelSample& out,
+              std::uint64_t& rays, int first) const;
+  // A vertex's steps: the air (and clouds) the path crossed to reach it and
+  // the first hit's AOVs (false: the path ends here, at max_depth); then,
+  // after the sun, the sky's sample and the bounce (false: the path ends).
+  bool arrive(Path& path, const Hit& hit, int depth, PixelSample& out, std::uint64_t& rays) const;
+  bool leave(Path& path, const Hit& hit, const Eigen::Vector3f& p, const GroundBsdf& bsdf,
+             int depth, SampleStream& rng, PixelSample& out, std::uint64_t& rays) const;
+  // The sun's sample direction `l` from (u1, u2), true if it needs a shadow
+  // ray (above the surface); and its light once that ray found nothing.
+  bool sun_ray(const Hit& hit, float u1, float u2, Eigen::Vector3f& l) const;
+  void add_sun(const Path& path, const Hit& hit, const Eigen::Vector3f& p, const GroundBsdf& bsdf,
+               const Eigen::Vector3f& l, PixelSample& out) const;
   Eigen::Vector3f sky_light(const Eigen::Vector3f& dir) const;
   Eigen::Vector3f shaft_loss(const Path& path, float distance, std::uint64_t& rays) const;
   // The cloud layer (render/clouds.h): what a ray from `origin` sees of the

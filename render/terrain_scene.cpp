@@ -548,7 +548,73 @@ float TerrainScene::hit_distance(const Eigen::Vector3f& o, const Eigen::Vector3f
 bool TerrainScene::intersect(const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
                              const RayCone& cone) const {
   if (recorder_) recorder_->traced(o, d, std::numeric_limits<float>::infinity(), false);
-  const RTCRayHit rh = nearest_hit(embree_->scene, blocks_ != nullptr, o, d);
+  return shade_hit(nearest_hit(embree_->scene, blocks_ != nullptr, o, d), o, d, hit, cone);
+}
+
+void TerrainScene::intersect_coherent(int n, const Eigen::Vector3f* o, const Eigen::Vector3f* d,
+                                      const RayCone* cones, Hit* hits, bool* found) const {
+  // The height field's user geometry prepares each ray once per call in the
+  // single-ray path (HeightContext); in a packet it would prepare it once
+  // per block, so it keeps single rays (as does a batch too large).
+  if (blocks_ || n > kCoherentRays) {
+    for (int i = 0; i < n; ++i) found[i] = intersect(o[i], d[i], hits[i], cones[i]);
+    return;
+  }
+  alignas(32) RTCRayHit8 packet{};
+  alignas(32) int valid[8] = {};
+  for (int i = 0; i < n; ++i) {
+    if (recorder_) recorder_->traced(o[i], d[i], std::numeric_limits<float>::infinity(), false);
+    valid[i] = -1;
+    packet.ray.org_x[i] = o[i].x(), packet.ray.org_y[i] = o[i].y(), packet.ray.org_z[i] = o[i].z();
+    packet.ray.dir_x[i] = d[i].x(), packet.ray.dir_y[i] = d[i].y(), packet.ray.dir_z[i] = d[i].z();
+    packet.ray.tnear[i] = 0.0f;
+    packet.ray.tfar[i] = std::numeric_limits<float>::infinity();
+    packet.ray.mask[i] = 0xffffffffu;
+    packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  // One traversal for the packet: its rays leave one point in nearly one
+  // direction (a pixel's camera rays), so they share most of the BVH's nodes.
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect8(valid, embree_->scene, &context, &packet);
+  for (int i = 0; i < n; ++i) {
+    RTCRayHit rh = nearest_ray_hit(o[i], d[i]);
+    rh.ray.tfar = packet.ray.tfar[i];
+    rh.hit.Ng_x = packet.hit.Ng_x[i], rh.hit.Ng_y = packet.hit.Ng_y[i];
+    rh.hit.Ng_z = packet.hit.Ng_z[i];
+    rh.hit.u = packet.hit.u[i], rh.hit.v = packet.hit.v[i];
+    rh.hit.primID = packet.hit.primID[i], rh.hit.geomID = packet.hit.geomID[i];
+    found[i] = shade_hit(rh, o[i], d[i], hits[i], cones[i]);
+  }
+}
+
+void TerrainScene::occluded_coherent(int n, const Eigen::Vector3f* o, const Eigen::Vector3f* d,
+                                     float max_distance, bool* blocked) const {
+  if (blocks_ || n > kCoherentRays) {
+    for (int i = 0; i < n; ++i) blocked[i] = occluded(o[i], d[i], max_distance);
+    return;
+  }
+  alignas(32) RTCRay8 packet{};
+  alignas(32) int valid[8] = {};
+  for (int i = 0; i < n; ++i) {
+    if (recorder_) recorder_->traced(o[i], d[i], max_distance, true);
+    valid[i] = -1;
+    packet.org_x[i] = o[i].x(), packet.org_y[i] = o[i].y(), packet.org_z[i] = o[i].z();
+    packet.dir_x[i] = d[i].x(), packet.dir_y[i] = d[i].y(), packet.dir_z[i] = d[i].z();
+    packet.tnear[i] = 0.0f;
+    packet.tfar[i] = max_distance;
+    packet.mask[i] = 0xffffffffu;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcOccluded8(valid, embree_->scene, &context, &packet);
+  for (int i = 0; i < n; ++i) blocked[i] = packet.tfar[i] < 0.0f;  // -inf on a hit
+}
+
+bool TerrainScene::shade_hit(const RTCRayHit& rh, const Eigen::Vector3f& o,
+                             const Eigen::Vector3f& d, Hit& hit, const RayCone& cone) const {
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.distance = rh.ray.tfar;
   hit.position = o + d * rh.ray.tfar;

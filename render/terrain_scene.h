@@ -16,6 +16,8 @@
 #include "render/height_field.h"
 #include "render/render_settings.h"
 
+struct RTCRayHit;  // Embree's (embree3/rtcore_ray.h)
+
 namespace drift::render {
 
 class PagedTerrain;
@@ -84,6 +86,18 @@ class TerrainScene {
   // footprint given by `cone`.
   bool intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, Hit& hit,
                  const RayCone& cone = {}) const;
+  // The nearest hits of n <= kCoherentRays rays that leave about one point
+  // in about one direction (a pixel's camera rays), as intersect() gives
+  // each (found[i]: ray i met something), traced as one Embree packet on the
+  // grid geometry; the height field traces them one by one.
+  static constexpr int kCoherentRays = 8;
+  void intersect_coherent(int n, const Eigen::Vector3f* origins, const Eigen::Vector3f* dirs,
+                          const RayCone* cones, Hit* hits, bool* found) const;
+  // occluded() of n <= kCoherentRays rays of about one direction from
+  // nearby points (the sun's shadow rays of a pixel's samples) into
+  // blocked[i], as one Embree packet on the grid geometry.
+  void occluded_coherent(int n, const Eigen::Vector3f* origins, const Eigen::Vector3f* dirs,
+                         float max_distance, bool* blocked) const;
   // True if anything lies on the ray within (0, max_distance).
   bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
                 float max_distance) const;
@@ -149,6 +163,9 @@ class TerrainScene {
   // `cone`) or on mesh `geometry`'s `triangle` at barycentrics (u, v) with
   // geometric normal `ng` (seen by a footprint `footprint` metres wide);
   // each returns the shading normal, not yet facing the ray.
+  // intersect()'s answer from Embree's record `rh` of the ray (o, d).
+  bool shade_hit(const RTCRayHit& rh, const Eigen::Vector3f& o, const Eigen::Vector3f& d, Hit& hit,
+                 const RayCone& cone) const;
   Eigen::Vector3f shade_terrain_hit(Hit& hit, const RayCone& cone,
                                     const std::optional<Eigen::Vector3f>& facet = {}) const;
   Eigen::Vector3f shade_mesh_hit(unsigned geometry, unsigned triangle, float u, float v,
