@@ -8,7 +8,9 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <regex>
 
+#include "terrain/error.h"
 #include "terrain/parameter.h"
 
 namespace drift::pipeline {
@@ -136,6 +138,25 @@ CLI::Option* whole_in_range(CLI::Option* option, long long lo, long long hi) {
 }
 
 void usage_error(const std::string& message) { throw CLI::ValidationError(message); }
+
+void refuse_files_among_frames(const std::string& flag, const std::string& dir,
+                               const std::string& prefix, const std::string& ext,
+                               const std::vector<std::filesystem::path>& named) {
+  if (dir.empty()) return;
+  std::error_code ec;
+  const std::filesystem::path frames = std::filesystem::weakly_canonical(dir, ec);
+  // The step's number has 5 digits or more (%05d); prefix and ext are ours.
+  const std::regex frame_name(prefix + "[0-9]{5,}\\" + ext);
+  for (const std::filesystem::path& p : named) {
+    if (p.empty()) continue;
+    const std::filesystem::path file = std::filesystem::weakly_canonical(p, ec);
+    if (file.parent_path() == frames && std::regex_match(file.filename().string(), frame_name))
+      throw Error("'" + p.string() + "' is named like the frames " + flag + " '" + dir +
+                  "' writes (" + prefix + "NNNNN" + ext +
+                  ", one a frame), so one would overwrite the other; give it another name or "
+                  "folder");
+  }
+}
 
 std::vector<CommandRegistration>& command_registry() {
   static std::vector<CommandRegistration> registry;
