@@ -147,15 +147,16 @@ void refuse_files_among_frames(const std::string& flag, const std::string& dir,
   const std::filesystem::path frames = std::filesystem::weakly_canonical(dir, ec);
   // The step's number has 5 digits or more (%05d); prefix and ext are ours.
   const std::regex frame_name(prefix + "[0-9]{5,}\\" + ext);
-  for (const std::filesystem::path& p : named) {
-    if (p.empty()) continue;
+  const auto among = std::find_if(named.begin(), named.end(), [&](const auto& p) {
+    if (p.empty()) return false;
     const std::filesystem::path file = std::filesystem::weakly_canonical(p, ec);
-    if (file.parent_path() == frames && std::regex_match(file.filename().string(), frame_name))
-      throw Error("'" + p.string() + "' is named like the frames " + flag + " '" + dir +
-                  "' writes (" + prefix + "NNNNN" + ext +
-                  ", one a frame), so one would overwrite the other; give it another name or "
-                  "folder");
-  }
+    return file.parent_path() == frames && std::regex_match(file.filename().string(), frame_name);
+  });
+  if (among != named.end())
+    throw Error("'" + among->string() + "' is named like the frames " + flag + " '" + dir +
+                "' writes (" + prefix + "NNNNN" + ext +
+                ", one a frame), so one would overwrite the other; give it another name or "
+                "folder");
 }
 
 std::vector<CommandRegistration>& command_registry() {

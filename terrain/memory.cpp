@@ -166,7 +166,7 @@ void require_memory(std::uint64_t asked, const std::string& asked_what, const st
       bytes = asked > kMost - g_held ? kMost : asked + g_held;
       what += " beside";
       for (std::size_t i = 0; i < g_held_what.size(); ++i)
-        what += (i == 0 ? " " : " and ") + g_held_what[i];
+        what.append(i == 0 ? " " : " and ").append(g_held_what[i]);
     }
     if (bytes > g_estimate.load()) {
       g_estimate.store(bytes);
