@@ -152,11 +152,12 @@ void refuse_files_among_frames(const std::string& flag, const std::string& dir,
     const std::filesystem::path file = std::filesystem::weakly_canonical(p, ec);
     return file.parent_path() == frames && std::regex_match(file.filename().string(), frame_name);
   });
-  if (among != named.end())
-    throw Error("'" + among->string() + "' is named like the frames " + flag + " '" + dir +
-                "' writes (" + prefix + "NNNNN" + ext +
-                ", one a frame), so one would overwrite the other; give it another name or "
-                "folder");
+  if (among == named.end()) return;
+  std::string message = "'";
+  message.append(among->string()).append("' is named like the frames ").append(flag);
+  message.append(" '").append(dir).append("' writes (").append(prefix).append("NNNNN");
+  message.append(ext).append(", one a frame), so one would overwrite the other; give it ");
+  throw Error(message.append("another name or folder"));
 }
 
 std::vector<CommandRegistration>& command_registry() {
