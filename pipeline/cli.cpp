@@ -8,7 +8,9 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <regex>
 
+#include "terrain/error.h"
 #include "terrain/parameter.h"
 
 namespace drift::pipeline {
@@ -136,6 +138,27 @@ CLI::Option* whole_in_range(CLI::Option* option, long long lo, long long hi) {
 }
 
 void usage_error(const std::string& message) { throw CLI::ValidationError(message); }
+
+void refuse_files_among_frames(const std::string& flag, const std::string& dir,
+                               const std::string& prefix, const std::string& ext,
+                               const std::vector<std::filesystem::path>& named) {
+  if (dir.empty()) return;
+  std::error_code ec;
+  const std::filesystem::path frames = std::filesystem::weakly_canonical(dir, ec);
+  // The step's number has 5 digits or more (%05d); prefix and ext are ours.
+  const std::regex frame_name(prefix + "[0-9]{5,}\\" + ext);
+  const auto among = std::find_if(named.begin(), named.end(), [&](const auto& p) {
+    if (p.empty()) return false;
+    const std::filesystem::path file = std::filesystem::weakly_canonical(p, ec);
+    return file.parent_path() == frames && std::regex_match(file.filename().string(), frame_name);
+  });
+  if (among == named.end()) return;
+  std::string message = "'";
+  message.append(among->string()).append("' is named like the frames ").append(flag);
+  message.append(" '").append(dir).append("' writes (").append(prefix).append("NNNNN");
+  message.append(ext).append(", one a frame), so one would overwrite the other; give it ");
+  throw Error(message.append("another name or folder"));
+}
 
 std::vector<CommandRegistration>& command_registry() {
   static std::vector<CommandRegistration> registry;

@@ -8,6 +8,7 @@
 // drift::Error (exit 1); CLI11 parse errors and usage_error() exit 2.
 #pragma once
 
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <utility>
@@ -56,6 +57,14 @@ CLI::Option* whole_in_range(CLI::Option* option, long long lo, long long hi);
 
 // Throws a usage error (exit 2) with `message`, e.g. for incompatible options.
 [[noreturn]] void usage_error(const std::string& message);
+
+// A sequence written one file a step into `dir` (the option `flag`, e.g.
+// --frames) as PREFIX + digits + EXT: throws drift::Error (exit 1) if one of
+// `named` (the run's inputs and other outputs) is such a file there, which a
+// frame would write over or be written over by (both exited 0, one file lost).
+void refuse_files_among_frames(const std::string& flag, const std::string& dir,
+                               const std::string& prefix, const std::string& ext,
+                               const std::vector<std::filesystem::path>& named);
 
 // --- registry --------------------------------------------------------------
 using CommandAdder = void (*)(CLI::App& root);

@@ -61,7 +61,11 @@ marks::MaterialField read_material_raster(const MarksCommand& c,
     throw Error("material raster '" + c.materials + "' has " + std::to_string(bands) +
                 " bands; give a single-band raster of material indices (0 sand, 1 mud, 2 snow)");
   }
-  const terrain::HeightField m = terrain::read_raster(c.materials);
+  // Indices, not heights: 1e30 or inf is refused below as no material (it was
+  // refused as "a height beyond any ground").
+  terrain::ReadOptions indices;
+  indices.heights = false;
+  const terrain::HeightField m = terrain::read_raster(c.materials, indices);
   if (m.width() != ground.width() || m.height() != ground.height()) {
     throw Error("material raster '" + c.materials + "' is " + std::to_string(m.width()) + " x " +
                 std::to_string(m.height()) + " cells but the ground is " +
@@ -162,6 +166,10 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
   std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth, c.materials};
   for (const fs::path& mesh : object_mesh_paths(c.track, "track file")) inputs.push_back(mesh);
   OutputSet outputs({c.output, c.disturbed, c.posed}, inputs);
+  std::vector<fs::path> named = inputs;
+  named.insert(named.end(), {c.output, c.disturbed, c.posed});
+  // (--disturbed fr/frame_00001.tif beside --frames fr kept one of the two.)
+  refuse_files_among_frames("--frames", c.frames, "frame_", ".tif", named);
   TrackFile track = read_track_file(c.track);
   marks::MarksOptions o = c.options;
   o.step = track.step;

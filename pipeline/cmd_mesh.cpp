@@ -83,24 +83,47 @@ void run_mesh(const MeshCommand& c) {
   const std::uint64_t w = read.window ? read.window->width : header.width,
                       h = read.window ? read.window->height : header.height;
   const std::uint64_t cols = (w + c.step - 2) / c.step + 1, rows = (h + c.step - 2) / c.step + 1;
+  // The rasters (4 bytes a cell each), and the vertex index over their grid
+  // (4 more) while the mesh is built.
+  const std::uint64_t rasters = w * h * 4 * (1 + named.size()), index = w * h * 4;
+  const std::string fix =
+      "crop it (--crop), keep fewer cells (--step N), or write .ply or .obj, which stream";
+  if (!c.decimate) {
+    require_memory(rasters + index +
+                       terrain::mesh_and_write_bytes(c.output, cols * rows,
+                                                     2 * (cols - 1) * (rows - 1), named.size()),
+                   "a mesh of " + std::to_string(cols) + " x " + std::to_string(rows) +
+                       " vertices written as '" + c.output + "'",
+                   fix);
+  }
   // --decimate: RTIN's error grid (a float a point of the (2^k + 1)^2 square
-  // holding the raster) and its triangle list (24 B a triangle), beside a mesh
-  // that at worst keeps them all: counted at worst (uncounted, the peak at
-  // --decimate 0 on 2000^2 was 1.8 times the estimate; MemoryEstimate.MeshDecimated).
+  // holding the raster) is counted up front; the triangle list (24 B a
+  // triangle) and the mesh once the bound has decided how many it keeps,
+  // each beside what is alive with it: the error grid is freed before the
+  // mesh is built, the list and the index before it is written. Counted at
+  // worst, every triangle kept, the estimate was 7.7 times the peak at 0.5 m
+  // on 3000^2 (MemoryEstimate.MeshDecimated).
   std::uint64_t rtin = 0;
   if (c.decimate) {
     std::uint64_t side = 2;
     while (side + 1 < std::max(w, h)) side *= 2;
-    rtin = (side + 1) * (side + 1) * sizeof(float) + 2 * (w - 1) * (h - 1) * 24;
+    rtin = (side + 1) * (side + 1) * sizeof(float);
+    require_memory(rasters + rtin,
+                   "RTIN's error grid of " + std::to_string(side + 1) + " x " +
+                       std::to_string(side + 1) + " points over '" + c.raster + "'",
+                   fix);
   }
-  // The rasters and the vertex index over their grid (4 bytes a cell each).
-  require_memory(w * h * 4 * (2 + named.size()) + rtin +
-                     terrain::mesh_and_write_bytes(c.output, cols * rows,
-                                                   2 * (cols - 1) * (rows - 1), named.size()),
-                 "a mesh of " + std::to_string(cols) + " x " + std::to_string(rows) +
-                     " vertices written as '" + c.output + "'",
-                 "crop it (--crop), keep fewer cells (--step N), or write .ply or .obj, which "
-                 "stream");
+  const auto decimated_size = [&](std::uint64_t vertices, std::uint64_t triangles) {
+    const std::uint64_t list = triangles * 24;
+    const std::uint64_t mesh = vertices * (24 + 4 * named.size()) + triangles * 12;  // no writer
+    const std::uint64_t write =
+        terrain::mesh_and_write_bytes(c.output, vertices, triangles, named.size());
+    require_memory(rasters + std::max({rtin + list, list + index + mesh, write}),
+                   "a mesh decimated to " + std::to_string(triangles) + " triangles written as '" +
+                       c.output + "'",
+                   "give a larger --decimate, crop it (--crop), or write .ply or .obj, which "
+                   "stream");
+  };
   const terrain::HeightField heights = terrain::read_raster(c.raster, read);
   require_metric_crs(heights, c.raster);
   std::vector<std::pair<std::string, terrain::HeightField>> attributes;
@@ -108,9 +131,10 @@ void run_mesh(const MeshCommand& c) {
   for (const auto& [name, path] : named)
     attributes.emplace_back(name, terrain::read_raster(path, read));
   double error = 0.0;
-  const terrain::Mesh mesh =
-      c.decimate ? terrain::decimated_height_field_mesh(heights, *c.decimate, attributes, &error)
-                 : terrain::height_field_mesh(heights, c.step, attributes);
+  const terrain::Mesh mesh = c.decimate
+                                 ? terrain::decimated_height_field_mesh(
+                                       heights, *c.decimate, attributes, &error, decimated_size)
+                                 : terrain::height_field_mesh(heights, c.step, attributes);
   terrain::write_mesh(mesh, c.output);
   outputs.commit();
   if (c.decimate) {

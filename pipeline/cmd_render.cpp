@@ -395,6 +395,11 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     scene.input.terrain.geo() = dem_geo;
   }
   const render::TerrainScene& embree_scene = *scene_holder;
+  // The terrain (in memory, or its pages, cache and tree out of core) stays
+  // while the image is made and written: the image's check adds the largest
+  // check so far, the terrain's (they were separate, so a large image with a
+  // large --memory-budget counted only the larger; docs/outputs.md).
+  const HeldMemory terrain_held(memory_estimate_bytes(), "the terrain");
   const double setup_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const render::Camera camera =

@@ -116,6 +116,10 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
   // The scenario's DEM is an input too, unless --terrain replaces it.
   const fs::path dem = c.terrain.empty() ? soil_scenario_dem(c.scenario) : fs::path(c.terrain);
   OutputSet outputs({c.output, c.collision, c.vdb, c.surface, c.ground}, {c.scenario, dem});
+  const std::vector<fs::path> named = {c.output, c.collision, c.vdb, c.surface,
+                                       c.ground, c.scenario,  dem};
+  refuse_files_among_frames("--frames", c.frames, "frame_", ".ply", named);
+  refuse_files_among_frames("--vdb-frames", c.vdb_frames, "soil_", ".vdb", named);
   soil::SoilSimulation sim = soil::make_simulation(sc);  // checks sizes and memory first
   const soil::SurfaceOptions surface{
       c.no_ridge_fix ? soil::RidgeFix::Off : soil::RidgeFix::StraightSlopes, 3, 0.0};

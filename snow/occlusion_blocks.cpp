@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "terrain/error.h"
 
@@ -33,13 +34,17 @@ SnowProbability ground_probability_in_blocks(const SnowScene& scene,
   if (block < 1) throw Error("the snow probability's block must be 1 cell or more");
   const int W = scene.ground.width(), H = scene.ground.height();
   const int halo = occlusion_halo_cells(scene, dirs);
+  // A block past the grid is the grid (the same bits): near INT_MAX, bx +
+  // block + halo overflowed and a negative size aborted (--block 2147483647).
+  block = std::min(block, std::max(W, H));
   SnowProbability out;
   out.ground = terrain::Grid<float>(W, H, 0.0f);
   out.ground_facing = terrain::Grid<float>(W, H, 0.0f);
   for (int by = 0; by < H; by += block)
     for (int bx = 0; bx < W; bx += block) {
       const int c0 = std::max(0, bx - halo), r0 = std::max(0, by - halo);
-      const int c1 = std::min(W, bx + block + halo), r1 = std::min(H, by + block + halo);
+      const int c1 = static_cast<int>(std::min<std::int64_t>(W, std::int64_t{bx} + block + halo));
+      const int r1 = static_cast<int>(std::min<std::int64_t>(H, std::int64_t{by} + block + halo));
       SnowScene part;
       part.ground = terrain::Grid<float>(c1 - c0, r1 - r0);
       for (int r = r0; r < r1; ++r)

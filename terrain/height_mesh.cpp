@@ -138,11 +138,15 @@ Mesh height_field_mesh(const HeightField& h, int step,
 
 Mesh decimated_height_field_mesh(const HeightField& h, double max_error,
                                  const std::vector<std::pair<std::string, HeightField>>& attributes,
-                                 double* measured_error) {
+                                 double* measured_error, const RtinSizeCheck& before_list) {
   require_same_grid(h, attributes);
-  const RtinMesh rtin = rtin_triangles(h, max_error);
+  const RtinMesh rtin = rtin_triangles(h, max_error, before_list);
   Mesh mesh;
+  // Sized once: grown by doubling, the lists held up to twice the mesh.
+  mesh.positions.reserve(rtin.vertices);
+  mesh.triangles.reserve(rtin.triangles.size());
   GridVertices vertex(mesh, h, attributes);
+  for (auto& named : mesh.vertex_attributes) named.second.reserve(rtin.vertices);
   const bool flip = south_up(h);
   for (const GridTriangle& t : rtin.triangles) {
     // Counter-clockwise from above is clockwise in (column, row) when rows

@@ -9,6 +9,7 @@
 
 #include "terrain/grid.h"
 #include "terrain/mesh.h"
+#include "terrain/mesh_rtin.h"
 #include "terrain/raster_io.h"
 
 namespace drift::terrain {
@@ -33,10 +34,12 @@ Mesh height_field_mesh(const HeightField& heights, int step,
 // The same mesh simplified to at most `max_error` metres of vertical error at
 // every cell centre (terrain/mesh_rtin.h: a right-triangulated irregular
 // network, crack-free). Halves of cells with a nodata corner are left out.
-// `measured_error`, if given, receives the largest error the mesh has.
+// `measured_error`, if given, receives the largest error the mesh has;
+// `before_list` is rtin_triangles' (terrain/mesh_rtin.h): the mesh's size
+// once known, before it is allocated.
 Mesh decimated_height_field_mesh(
     const HeightField& heights, double max_error,
     const std::vector<std::pair<std::string, HeightField>>& attributes = {},
-    double* measured_error = nullptr);
+    double* measured_error = nullptr, const RtinSizeCheck& before_list = {});
 
 }  // namespace drift::terrain

@@ -11,6 +11,8 @@
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "terrain/error.h"
 
@@ -132,9 +134,40 @@ std::string memory_estimate_what() {
   return g_estimate_what;
 }
 
-void require_memory(std::uint64_t bytes, const std::string& what, const std::string& fix) {
+namespace {
+// What HeldMemory objects keep (guarded by g_estimate_mutex).
+std::uint64_t g_held = 0;
+std::vector<std::string> g_held_what;
+}  // namespace
+
+HeldMemory::HeldMemory(std::uint64_t bytes, std::string what)
+    : bytes_(bytes), what_(std::move(what)) {
+  const std::lock_guard<std::mutex> lock(g_estimate_mutex);
+  g_held += bytes_;
+  g_held_what.push_back(what_ + " (" + human_bytes(bytes_) + ")");
+}
+
+HeldMemory::~HeldMemory() {
+  const std::lock_guard<std::mutex> lock(g_estimate_mutex);
+  g_held -= bytes_;
+  const std::string entry = what_ + " (" + human_bytes(bytes_) + ")";
+  const auto it = std::find(g_held_what.begin(), g_held_what.end(), entry);
+  if (it != g_held_what.end()) g_held_what.erase(it);
+}
+
+void require_memory(std::uint64_t asked, const std::string& asked_what, const std::string& fix) {
+  std::uint64_t bytes = asked;
+  std::string what = asked_what;
   {
     const std::lock_guard<std::mutex> lock(g_estimate_mutex);
+    if (g_held > 0) {
+      // Saturating: a hostile size near 2^64 must not wrap to a small one.
+      constexpr std::uint64_t kMost = std::numeric_limits<std::uint64_t>::max();
+      bytes = asked > kMost - g_held ? kMost : asked + g_held;
+      what += " beside";
+      for (std::size_t i = 0; i < g_held_what.size(); ++i)
+        what.append(i == 0 ? " " : " and ").append(g_held_what[i]);
+    }
     if (bytes > g_estimate.load()) {
       g_estimate.store(bytes);
       g_estimate_what = what;

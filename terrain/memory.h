@@ -19,6 +19,24 @@ void require_memory(std::uint64_t bytes, const std::string& what, const std::str
 
 std::string human_bytes(std::uint64_t bytes);
 
+// Memory a run keeps while later, separate checks are made (render's terrain
+// while its image is allocated): while one is alive, every require_memory
+// call asks for its own bytes plus every held amount, and names what is held,
+// so that the run's estimate adds them (render's terrain and image checks were
+// separate, and the larger alone was the estimate: MemoryEstimate.
+// RenderLargeImageWithLargeBudget). Not copyable; held amounts add up.
+class HeldMemory {
+ public:
+  HeldMemory(std::uint64_t bytes, std::string what);
+  ~HeldMemory();
+  HeldMemory(const HeldMemory&) = delete;
+  HeldMemory& operator=(const HeldMemory&) = delete;
+
+ private:
+  std::uint64_t bytes_;
+  std::string what_;
+};
+
 // The run's memory estimate: the largest amount any require_memory call of this
 // process asked for, and what it named. Each subcommand's largest check counts
 // every buffer its inputs size that is alive at its peak (docs/outputs.md), so

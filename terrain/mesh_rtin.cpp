@@ -104,7 +104,7 @@ bool is_vertex(const HeightField& h, int x, int y) {
 
 }  // namespace
 
-RtinMesh rtin_triangles(const HeightField& h, double max_error) {
+RtinMesh rtin_triangles(const HeightField& h, double max_error, const RtinSizeCheck& before_list) {
   if (!(max_error >= 0.0))
     throw Error("--decimate " + std::to_string(max_error) + " must be 0 or more metres");
   if (h.width() < 2 || h.height() < 2)
@@ -144,21 +144,43 @@ RtinMesh rtin_triangles(const HeightField& h, double max_error) {
 
   RtinMesh out;
   // Splits while the midpoint's error is above the bound and the legs are
-  // longer than a cell; keeps the leaves whose corners are all data.
-  auto visit = [&](auto&& self, int ax, int ay, int bx, int by, int cx, int cy) -> void {
-    const int mx = (ax + bx) >> 1, my = (ay + by) >> 1;
-    if (std::abs(ax - cx) + std::abs(ay - cy) > 1 && errors[at(mx, my)] > max_error) {
-      self(self, cx, cy, ax, ay, mx, my);
-      self(self, bx, by, cx, cy, mx, my);
-      return;
-    }
-    if (!is_vertex(h, ax, ay) || !is_vertex(h, bx, by) || !is_vertex(h, cx, cy)) return;
+  // longer than a cell; calls keep(a, b, c) on the leaves whose corners are all data.
+  auto for_each_kept = [&](auto&& keep) {
+    auto visit = [&](auto&& self, int ax, int ay, int bx, int by, int cx, int cy) -> void {
+      const int mx = (ax + bx) >> 1, my = (ay + by) >> 1;
+      if (std::abs(ax - cx) + std::abs(ay - cy) > 1 && errors[at(mx, my)] > max_error) {
+        self(self, cx, cy, ax, ay, mx, my);
+        self(self, bx, by, cx, cy, mx, my);
+        return;
+      }
+      if (!is_vertex(h, ax, ay) || !is_vertex(h, bx, by) || !is_vertex(h, cx, cy)) return;
+      keep(ax, ay, bx, by, cx, cy);
+    };
+    visit(visit, 0, 0, tile, tile, tile, 0);
+    visit(visit, tile, tile, 0, 0, 0, tile);
+  };
+  {
+    // The mesh's size before its list: a walk of the decided tree, far
+    // cheaper than deciding it, and a bit a grid point for the vertices.
+    std::uint64_t triangles = 0, vertices = 0;
+    std::vector<bool> used(static_cast<std::size_t>(h.width()) * h.height(), false);
+    const auto mark = [&](int x, int y) {
+      const std::size_t i = static_cast<std::size_t>(y) * h.width() + x;
+      if (!used[i]) used[i] = true, ++vertices;
+    };
+    for_each_kept([&](int ax, int ay, int bx, int by, int cx, int cy) {
+      ++triangles;
+      mark(ax, ay), mark(bx, by), mark(cx, cy);
+    });
+    if (before_list) before_list(vertices, triangles);
+    out.vertices = vertices;
+    out.triangles.reserve(triangles);
+  }
+  for_each_kept([&](int ax, int ay, int bx, int by, int cx, int cy) {
     out.triangles.push_back({{{ax, ay}, {bx, by}, {cx, cy}}});
     out.max_error =
         std::max(out.max_error, static_cast<double>(triangle_error(h, ax, ay, bx, by, cx, cy)));
-  };
-  visit(visit, 0, 0, tile, tile, tile, 0);
-  visit(visit, tile, tile, 0, 0, 0, tile);
+  });
   if (out.triangles.empty()) throw Error("the raster has no 2 x 2 cells with data to mesh");
   return out;
 }

@@ -9,6 +9,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "terrain/grid.h"
@@ -23,6 +25,8 @@ struct RtinMesh {
   // The largest |height - the triangle's plane| over every grid cell centre
   // the kept triangles cover (0 when every cell is a vertex): <= max_error.
   double max_error = 0.0;
+  // The distinct grid points the triangles use.
+  std::uint64_t vertices = 0;
 };
 
 // The fewest-levels RTIN whose triangles all lie within `max_error` metres
@@ -34,6 +38,12 @@ struct RtinMesh {
 // halves of a cell with a nodata or outside corner are left out (the full
 // mesh leaves out the whole cell). Throws drift::Error for a negative
 // max_error or a grid smaller than 2 x 2.
-RtinMesh rtin_triangles(const HeightField& heights, double max_error);
+// `before_list`, if given, is called once the tree is decided and before the
+// triangle list is allocated, with the number of distinct vertices and of
+// triangles the mesh will have (so that a memory check counts the mesh the
+// bound keeps, not every triangle at worst); it may throw to stop.
+using RtinSizeCheck = std::function<void(std::uint64_t vertices, std::uint64_t triangles)>;
+RtinMesh rtin_triangles(const HeightField& heights, double max_error,
+                        const RtinSizeCheck& before_list = {});
 
 }  // namespace drift::terrain

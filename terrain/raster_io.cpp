@@ -251,7 +251,7 @@ HeightField read_dataset(GDALDataset& dataset, const fs::path& path, const ReadO
                 (g_last_gdal_message.empty() ? std::string("read failed") : g_last_gdal_message) +
                 " (the file may be truncated or corrupt)");
   }
-  require_finite_cells(grid, path);
+  if (options.heights) require_finite_cells(grid, path);
   // Invalid cells become NaN in memory, whatever the file called them.
   if (geo.nodata) {
     const float nd = static_cast<float>(*geo.nodata);

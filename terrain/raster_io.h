@@ -30,6 +30,10 @@ struct RasterWindow {
 struct ReadOptions {
   int band = 1;                        // 1-based, as in GDAL
   std::optional<RasterWindow> window;  // read a part only (crop at read time)
+  // Heights (and quantities like them) are refused beyond |1e7| or infinite,
+  // in a message about heights; false for a raster of other values (material
+  // indices), which its caller checks and names itself.
+  bool heights = true;
 };
 
 // Header facts, read without loading the cells.

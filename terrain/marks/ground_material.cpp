@@ -1,6 +1,7 @@
 #include "terrain/marks/ground_material.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "terrain/angles.h"
 #include "terrain/error.h"
@@ -82,10 +83,12 @@ MaterialField materials_from_raster(const terrain::Grid<float>& indices,
     if (!(v >= 0.0f && v < static_cast<float>(table.size()) && v == std::floor(v))) {
       const int col = static_cast<int>(i % static_cast<std::size_t>(indices.width()));
       const int row = static_cast<int>(i / static_cast<std::size_t>(indices.width()));
-      throw Error(
-          what + ": cell (" + std::to_string(col) + ", " + std::to_string(row) + ") holds " +
-          std::to_string(v) + "; each cell must hold a whole number from 0 to " +
-          std::to_string(table.size() - 1) + " (" + material_preset_names() + ", in that order)");
+      char value[32];  // %g: 1e+30 and inf as such, not 31 digits
+      std::snprintf(value, sizeof value, "%g", static_cast<double>(v));
+      throw Error(what + ": cell (" + std::to_string(col) + ", " + std::to_string(row) +
+                  ") holds " + value + "; each cell must hold a whole number from 0 to " +
+                  std::to_string(table.size() - 1) + " (" + material_preset_names() +
+                  ", in that order)");
     }
     f.index.values()[i] = static_cast<std::uint8_t>(v);
   }

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "terrain/mesh_io.h"
 #include "terrain/raster_io.h"
@@ -180,6 +181,21 @@ TEST(MarksCli, AMaterialRasterSetsTheGroundsMaterialPerCell) {
   EXPECT_EQ(run(args, d), 1) << output(d);
   EXPECT_NE(output(d).find("paint.tif': cell (9, 4) holds 7"), std::string::npos) << output(d);
   EXPECT_FALSE(fs::exists(d / "out.tif"));
+  // 1e30 and inf are no material: named as such, with the value as given and
+  // the fix (they were refused as "a height beyond any ground").
+  for (const float bad : {1e30f, std::numeric_limits<float>::infinity()}) {
+    painted(9, 4) = bad;
+    drift::terrain::write_geotiff(painted, d / "paint.tif");
+    EXPECT_EQ(run(args, d), 1) << output(d);
+    const std::string said = bad > 1e31f ? "holds inf;" : "holds 1e+30;";
+    EXPECT_NE(output(d).find(std::string("material raster '") + (d / "paint.tif").string() +
+                             "': cell (9, 4) " + said +
+                             " each cell must hold a whole number from 0 to 2"),
+              std::string::npos)
+        << output(d);
+    EXPECT_EQ(output(d).find("height"), std::string::npos) << output(d);
+    EXPECT_FALSE(fs::exists(d / "out.tif"));
+  }
   // Three bands: refused naming the count, not read as band 1.
   GDALAllRegister();
   GDALDataset* rgb = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(
@@ -189,6 +205,40 @@ TEST(MarksCli, AMaterialRasterSetsTheGroundsMaterialPerCell) {
   EXPECT_EQ(run(args, d), 1) << output(d);
   EXPECT_NE(output(d).find("paint.tif' has 3 bands"), std::string::npos) << output(d);
   EXPECT_FALSE(fs::exists(d / "out.tif"));
+}
+
+TEST(MarksCli, FramesDoNotOverwriteTheRunsOtherFiles) {
+  // --frames DIR writes DIR/frame_NNNNN.tif a step: another output or an
+  // input named so there was written over by a frame (or wrote over it), exit 0.
+  const fs::path d = dir(), g = ground(d);
+  std::ofstream(d / "track.toml") << track();
+  fs::create_directories(d / "fr");
+  const std::string base =
+      g.string() + " --track " + (d / "track.toml").string() + " --frames " + (d / "fr").string();
+  for (const std::string& extra :
+       {std::string(" -o ") + (d / "out.tif").string() + " --disturbed " +
+            (d / "fr" / "frame_00001.tif").string(),
+        std::string(" -o ") + (d / "fr" / ".." / "fr" / "frame_00000.tif").string()}) {
+    SCOPED_TRACE(extra);
+    EXPECT_EQ(run(base + extra, d), 1) << output(d);
+    EXPECT_NE(output(d).find("is named like the frames --frames"), std::string::npos) << output(d);
+    EXPECT_TRUE(fs::is_empty(d / "fr")) << "nothing written";
+    EXPECT_FALSE(fs::exists(d / "out.tif"));
+  }
+  // An input there: the frames would write over the ground they mark.
+  fs::copy_file(g, d / "fr" / "frame_00002.tif");
+  EXPECT_EQ(
+      run((d / "fr" / "frame_00002.tif").string() + " --track " + (d / "track.toml").string() +
+              " --frames " + (d / "fr").string() + " -o " + (d / "out.tif").string(),
+          d),
+      1)
+      << output(d);
+  EXPECT_NE(output(d).find("frame_00002.tif' is named like the frames"), std::string::npos)
+      << output(d);
+  // Elsewhere, or named otherwise, the frames and the outputs stand side by side.
+  EXPECT_EQ(run(base + " -o " + (d / "fr" / "marked.tif").string(), d), 0) << output(d);
+  EXPECT_TRUE(fs::exists(d / "fr" / "frame_00001.tif"));
+  EXPECT_TRUE(fs::exists(d / "fr" / "marked.tif"));
 }
 
 }  // namespace

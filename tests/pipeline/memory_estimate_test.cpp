@@ -299,6 +299,16 @@ TEST(MemoryEstimate, RenderOutOfCoreAndMaps) {
   const std::string paged = " --spp 1 --size 160x120 --memory-budget 32M --full-resolution -o ";
   expect_estimate_within_a_quarter(run_measured("render small.toml" + paged + "p0.png", d),
                                    run_measured("render big.toml" + paged + "p1.png", d));
+  // A large image beside a large budget: the terrain's check and the image's
+  // were separate, and the estimate was the larger alone (0.64 of the peak
+  // here); the image's check now adds the terrain held beside it (1.04).
+  {
+    SCOPED_TRACE("large image, large budget");
+    const std::string both = " --spp 1 --memory-budget 128M --full-resolution --size ";
+    expect_estimate_within_a_quarter(
+        run_measured("render small.toml" + both + "16x8 -o q0.exr", d),
+        run_measured("render big.toml" + both + "1000x750 -o q1.exr", d));
+  }
   for (const char* ext : {".png", ".tif"}) {
     SCOPED_TRACE(ext);
     const std::string map = "render map.toml --spp 1 --map --cell ";
@@ -317,6 +327,12 @@ TEST(MemoryEstimate, MeshDecimated) {
   write_dem(d / "rtin.tif", 1500, 10.0);
   expect_estimate_within_a_quarter(run_measured("mesh dem.tif --decimate 0 -o small.ply", d),
                                    run_measured("mesh rtin.tif --decimate 0 -o big.ply", d));
+  // Where the bound drops most triangles (0.5 m on 2 m cells keeps 4 % of
+  // them), the mesh is counted as kept, not at worst: every triangle counted,
+  // the estimate was 7.7 times the peak (3000^2 at 2 m, 0.5 m).
+  write_dem(d / "smooth.tif", 2600, 2.0);
+  expect_estimate_within_a_quarter(run_measured("mesh dem.tif --decimate 0.5 -o s0.ply", d),
+                                   run_measured("mesh smooth.tif --decimate 0.5 -o s1.ply", d));
 }
 
 }  // namespace

@@ -154,6 +154,10 @@ TEST(SnowfallCli, BlockByBlockOcclusionGivesTheSameRasters) {
   for (float v : a.values()) shadowed += v < 0.25f;
   EXPECT_GT(shadowed, 200);
   EXPECT_EQ(run(common + (d / "x.tif").string() + " --block -3", d), 2);
+  // A block past the grid is the grid: near INT_MAX its bounds overflowed and
+  // an assertion aborted the run (exit 134).
+  ASSERT_EQ(run(common + (d / "huge.tif").string() + " --block 2147483647", d), 0) << output(d);
+  EXPECT_TRUE(a.values() == drift::terrain::read_raster(d / "huge.tif").values());
   // Where blocks do not apply, --block is refused rather than ignored.
   EXPECT_EQ(run(common + (d / "x.tif").string() + " --block 8 --occlusion opengl", d), 2);
   EXPECT_NE(output(d).find("--block works on the ground alone"), std::string::npos) << output(d);

@@ -105,6 +105,38 @@ TEST(SoilCli, VdbFramesAreASequenceAndRunsRepeatByteForByte) {
   EXPECT_FALSE(first[0] == first[2]);  // the frames do change
 }
 
+// --frames and --vdb-frames write frame_NNNNN.ply and soil_NNNNN.vdb a frame:
+// an output named so in their folder (or the scenario) was written over by a
+// frame, or over one, both exiting 0. Refused before any work; elsewhere fine.
+TEST(SoilCli, FramesDoNotOverwriteTheRunsOtherFiles) {
+  const fs::path d = dir();
+  std::ofstream(d / "s.toml") << kScenario;
+  fs::create_directories(d / "fr");
+  const std::string scenario = (d / "s.toml").string(), fr = (d / "fr").string();
+  for (const std::string& args : {std::string(" -o ") + fr + "/frame_00020.ply --frames " + fr,
+                                  std::string(" -o ") + (d / "soil.ply").string() + " --frames " +
+                                      fr + " --collision " + fr + "/../fr/frame_00040.ply",
+                                  std::string(" -o ") + (d / "soil.ply").string() +
+                                      " --vdb-frames " + fr + " --vdb " + fr + "/soil_00020.vdb"}) {
+    SCOPED_TRACE(args);
+    EXPECT_EQ(run(scenario + args + " --frame-every 20", d), 1) << output(d);
+    EXPECT_NE(output(d).find("is named like the frames --"), std::string::npos) << output(d);
+    EXPECT_TRUE(fs::is_empty(d / "fr")) << "nothing written";
+    EXPECT_FALSE(fs::exists(d / "soil.ply"));
+  }
+  fs::copy_file(d / "s.toml", d / "fr" / "frame_00020.ply");  // the scenario, named so
+  EXPECT_EQ(run((d / "fr" / "frame_00020.ply").string() + " -o " + (d / "soil.ply").string() +
+                    " --frames " + fr + " --frame-every 20",
+                d),
+            1)
+      << output(d);
+  fs::remove(d / "fr" / "frame_00020.ply");
+  EXPECT_EQ(run(scenario + " -o " + fr + "/soil.ply --frames " + fr + " --frame-every 20", d), 0)
+      << output(d);
+  EXPECT_TRUE(fs::exists(d / "fr" / "frame_00060.ply"));
+  EXPECT_TRUE(fs::exists(d / "fr" / "soil.ply"));
+}
+
 TEST(SoilCli, DemGroundFollowsTheDemUpToTheWindowsEdges) {
   // A tilted plane of 10 m cells; a 6 x 4 window inside it split 4 x 4. The
   // ground under the grid is the DEM's bilinear surface, the plane itself, up
