@@ -1,5 +1,6 @@
-// The sand model's parameters in one table (Mitsuba's parameter tables are
-// the model): each row names the SandOptions field, the `drift dunes` flag,
+// The sand model's parameters in one table, kept as data in
+// sand_parameters.toml beside this header and compiled by scripts/parameter_table.cmake (Mitsuba's
+// parameter tables are the model): each row names the SandOptions field, the `drift dunes` flag,
 // the unit, the valid range and what it means, as every stage's table does. validate(), the command
 // line's flags and help, and docs/dunes.md's table all come from it: the defaults are
 // default_options(model)'s, and tests/dunes/sand_parameters_test.cpp fails

@@ -50,6 +50,11 @@ void require_nonempty_values(const CLI::App& sub) {
 
 }  // namespace
 
+CLI::Option* add_choice(CLI::App& sub, const std::string& name, std::string& value,
+                        const std::vector<std::string>& choices, const std::string& help) {
+  return sub.add_option(name, value, help)->check(CLI::IsMember(choices))->capture_default_str();
+}
+
 CLI::App* add_subcommand(CLI::App& parent, const std::string& name, const std::string& description,
                          std::function<void()> run) {
   CLI::App* sub = parent.add_subcommand(name, description);

@@ -2,7 +2,7 @@
 // after a successful parse, and the options every subcommand takes (--threads).
 //
 // Each subcommand lives in its own file, pipeline/cmd_<name>.cpp, which defines
-// `void add_<name>_command(CLI::App&)` and registers it with DRIFT_COMMAND; the
+// its flags and action and registers them as one row with DRIFT_COMMAND; the
 // build picks up every cmd_*.cpp, so adding a subcommand touches no other file.
 // The action only calls library code and reports. Library errors are
 // drift::Error (exit 1); CLI11 parse errors and usage_error() exit 2.
@@ -10,7 +10,9 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -55,6 +57,11 @@ std::string whole_number(const std::string& text);
 // number", not "not in range"), then within [lo, hi]. Returns `option`.
 CLI::Option* whole_in_range(CLI::Option* option, long long lo, long long hi);
 
+// Adds option `name` taking one of `choices` into `value`, its help listing
+// them and the default. Returns the option.
+CLI::Option* add_choice(CLI::App& sub, const std::string& name, std::string& value,
+                        const std::vector<std::string>& choices, const std::string& help);
+
 // Throws a usage error (exit 2) with `message`, e.g. for incompatible options.
 [[noreturn]] void usage_error(const std::string& message);
 
@@ -67,6 +74,43 @@ void refuse_files_among_frames(const std::string& flag, const std::string& dir,
                                const std::vector<std::filesystem::path>& named);
 
 // --- registry --------------------------------------------------------------
+// A subcommand as one row: its name and help, the function declaring its flags
+// on its options struct, and its action, run once they are parsed with the
+// struct (and, where it takes it, the subcommand, e.g. to ask whether a flag
+// was given); under a group such as `drift snow`, the group's name and help
+// (the first row of a group gives its help).
+template <class Options>
+struct Command {
+  template <class Run>
+  Command(const char* name, const char* help, void (*flags)(CLI::App* sub, Options* options),
+          Run run, const char* group = "", const char* group_help = "")
+      : name(name), help(help), flags(flags), group(group), group_help(group_help) {
+    if constexpr (std::is_invocable_v<Run, Options&, const CLI::App&>)
+      this->run = run;
+    else
+      this->run = [run](Options& o, const CLI::App&) { run(o); };
+  }
+
+  const char* name;
+  const char* help;
+  void (*flags)(CLI::App* sub, Options* options);
+  std::function<void(Options&, const CLI::App&)> run;
+  const char* group;
+  const char* group_help;
+};
+
+// Adds `row`'s subcommand (with --threads, add_subcommand) under `root` or its
+// group, its options struct living as long as the subcommand.
+template <class Options>
+void add_command(CLI::App& root, const Command<Options>& row) {
+  CLI::App& parent = *row.group ? command_group(root, row.group, row.group_help) : root;
+  auto options = std::make_shared<Options>();
+  CLI::App* sub =
+      add_subcommand(parent, row.name, row.help,
+                     [options, run = row.run](const CLI::App& self) { run(*options, self); });
+  row.flags(sub, options.get());
+}
+
 using CommandAdder = void (*)(CLI::App& root);
 
 struct CommandRegistration {
@@ -82,8 +126,14 @@ struct RegisterCommand {
 
 }  // namespace drift::pipeline
 
-// Registers a subcommand adder at static-initialisation time. `order` sorts the
-// help listing: 10 import, 20 info, 30 dunes, 40 snow, 50 marks, 60 soil,
-// 70 render, 80 merge, 90 compare, 100 sheet.
-#define DRIFT_COMMAND(order, adder) \
-  static const ::drift::pipeline::RegisterCommand drift_register_##adder { order, adder }
+// Registers the subcommand of a pipeline/cmd_<name>.cpp at static-initialisation
+// time: DRIFT_COMMAND(order, name, help, flags, run[, group, group help]), the
+// arguments of a Command row. `order` sorts the help listing: 10 import,
+// 20 info, 30 dunes, 40 snow, 50 marks, 60 soil, 65 mesh, 70 render, 80 merge,
+// 90 compare, 100 sheet.
+#define DRIFT_COMMAND(order, ...)                                                    \
+  static const ::drift::pipeline::RegisterCommand drift_register_command {           \
+    order, [](CLI::App& root) {                                                      \
+      ::drift::pipeline::add_command(root, ::drift::pipeline::Command{__VA_ARGS__}); \
+    }                                                                                \
+  }

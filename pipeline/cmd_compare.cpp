@@ -76,11 +76,7 @@ void run_compare(const CompareCommandOptions& o) {
 
 }  // namespace
 
-void add_compare_command(CLI::App& root) {
-  auto o = std::make_shared<CompareCommandOptions>();
-  CLI::App* sub =
-      add_subcommand(root, "compare", "compare an image with a reference (exit 0 pass, 1 fail)",
-                     [o] { run_compare(*o); });
+void compare_flags(CLI::App* sub, CompareCommandOptions* o) {
   sub->add_option("image", o->a, "image to test (EXR or PNG)")->required();
   sub->add_option("reference", o->b, "reference image (EXR or PNG), same size")->required();
   sub->add_option("--metric", o->metric, "rmse | relmse | ssim (error of ssim is 1 - SSIM)")
@@ -105,6 +101,7 @@ void add_compare_command(CLI::App& root) {
       ->delimiter(',');
 }
 
-DRIFT_COMMAND(90, add_compare_command);
+DRIFT_COMMAND(90, "compare", "compare an image with a reference (exit 0 pass, 1 fail)",
+              compare_flags, run_compare);
 
 }  // namespace drift::pipeline

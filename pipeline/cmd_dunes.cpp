@@ -87,20 +87,14 @@ void run_dunes(const DunesCommand& c, const CLI::App& sub) {
 
 }  // namespace
 
-void add_dunes_command(CLI::App& root) {
-  auto c = std::make_shared<DunesCommand>();
-  CLI::App* sub = add_subcommand(
-      root, "dunes", "wind ripples or dunes by saltation, creep and avalanching (Nishimori-Ouchi)",
-      [c](const CLI::App& self) { run_dunes(*c, self); });
+void dunes_flags(CLI::App* sub, DunesCommand* c) {
   sub->footer(
       "Ripples: L = L0 + b H (cells, H in height units); dunes: L = L0 - b tanh(dH/dx),\n"
       "q = q0 + b' tanh(dH/dx). Ripples form at about L0 + 1 cells. Any wind azimuth; off\n"
       "the axes it is rounded to a direction of whole columns and rows so that the field\n"
       "always tiles (within 2 degrees on a 256-cell grid, 1 on 1024; the run prints it).\n"
       "See docs/dunes.md.");
-  sub->add_option("--model", c->model, "ripples or dunes")
-      ->check(CLI::IsMember({"ripples", "dunes"}))
-      ->capture_default_str();
+  add_choice(*sub, "--model", c->model, {"ripples", "dunes"}, "ripples or dunes");
   sub->add_option("-o,--output", c->output, "output GeoTIFF (heights in metres)")->required();
   c->parameters.add_to(*sub);
   whole_in_range(sub->add_option("--snapshot-every", c->snapshot_every,
@@ -109,6 +103,8 @@ void add_dunes_command(CLI::App& root) {
   add_seed_option(*sub, c->seed);
 }
 
-DRIFT_COMMAND(30, add_dunes_command);
+DRIFT_COMMAND(30, "dunes",
+              "wind ripples or dunes by saltation, creep and avalanching (Nishimori-Ouchi)",
+              dunes_flags, run_dunes);
 
 }  // namespace drift::pipeline

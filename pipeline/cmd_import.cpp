@@ -48,11 +48,7 @@ void run_import(const ImportCommand& c) {
 
 }  // namespace
 
-void add_import_command(CLI::App& root) {
-  auto c = std::make_shared<ImportCommand>();
-  CLI::App* sub = add_subcommand(
-      root, "import", "any DEM GDAL reads -> float32 GeoTIFF in metres (UTM), nodata filled",
-      [c] { run_import(*c); });
+void import_flags(CLI::App* sub, ImportCommand* c) {
   sub->add_option("dem", c->input, "input raster (GeoTIFF, .hgt, DTED, ASCII grid, USGS DEM, ...)")
       ->required();
   sub->add_option("-o,--output", c->output, "output GeoTIFF")->required();
@@ -70,6 +66,7 @@ void add_import_command(CLI::App& root) {
                   "cells a side of the blocks worked in (default: DRIFT_BLOCK_CELLS, else 2048)");
 }
 
-DRIFT_COMMAND(10, add_import_command);
+DRIFT_COMMAND(10, "import", "any DEM GDAL reads -> float32 GeoTIFF in metres (UTM), nodata filled",
+              import_flags, run_import);
 
 }  // namespace drift::pipeline

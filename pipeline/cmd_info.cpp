@@ -48,13 +48,11 @@ void run_info(const InfoOptions& o) {
 
 }  // namespace
 
-void add_info_command(CLI::App& root) {
-  auto o = std::make_shared<InfoOptions>();
-  CLI::App* sub = add_subcommand(root, "info", "print a raster's size, CRS, cell size and heights",
-                                 [o] { run_info(*o); });
+void info_flags(CLI::App* sub, InfoOptions* o) {
   sub->add_option("raster", o->raster, "any raster GDAL reads")->required();
 }
 
-DRIFT_COMMAND(20, add_info_command);
+DRIFT_COMMAND(20, "info", "print a raster's size, CRS, cell size and heights", info_flags,
+              run_info);
 
 }  // namespace drift::pipeline

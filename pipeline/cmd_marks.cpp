@@ -225,13 +225,7 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
 
 }  // namespace
 
-void add_marks_command(CLI::App& root) {
-  auto c = std::make_shared<MarksCommand>();
-  CLI::App* sub = add_subcommand(
-      root, "marks",
-      "marks of objects in soft ground: footprints, tyre tracks, dragged objects in sand, mud "
-      "and snow (paper 000)",
-      [c](const CLI::App& self) { run_marks(*c, self); });
+void marks_flags(CLI::App* sub, MarksCommand* c) {
   sub->add_option("ground", c->ground,
                   "ground heights, a metric GeoTIFF (DEM, dunes, snow surface)")
       ->required();
@@ -280,13 +274,15 @@ void add_marks_command(CLI::App& root) {
   sub->add_option("--seed", c->options.seed,
                   "seed of the roughness draws (sigma, paper 000, 3.5); same seed, same marks")
       ->capture_default_str();
-  sub->add_option("--renderer", c->renderer,
-                  "how the object's bottom is rendered: cpu (z-buffer, faster at these sizes) or "
-                  "opengl (OSMesa)")
-      ->check(CLI::IsMember({"cpu", "opengl"}))
-      ->capture_default_str();
+  add_choice(*sub, "--renderer", c->renderer, {"cpu", "opengl"},
+             "how the object's bottom is rendered: cpu (z-buffer, faster at these sizes) or "
+             "opengl (OSMesa)");
 }
 
-DRIFT_COMMAND(50, add_marks_command);
+DRIFT_COMMAND(
+    50, "marks",
+    "marks of objects in soft ground: footprints, tyre tracks, dragged objects in sand, mud "
+    "and snow (paper 000)",
+    marks_flags, run_marks);
 
 }  // namespace drift::pipeline

@@ -84,17 +84,14 @@ void run_merge(const MergeOptions& o, const CLI::App& sub) {
 
 }  // namespace
 
-void add_merge_command(CLI::App& root) {
-  auto o = std::make_shared<MergeOptions>();
-  CLI::App* sub =
-      add_subcommand(root, "merge", "join tiles of drift render --tile i/n into the whole frame",
-                     [o](const CLI::App& self) { run_merge(*o, self); });
+void merge_flags(CLI::App* sub, MergeOptions* o) {
   sub->add_option("tiles", o->tiles, "tile EXR files, in any order")->required();
   sub->add_option("-o,--output", o->outputs, "output file(s), .exr and/or .png")->required();
   sub->add_option("--exposure", o->exposure, "PNG exposure in EV (default: the render's)")
       ->check(CLI::Range(-20.0, 20.0));
 }
 
-DRIFT_COMMAND(80, add_merge_command);
+DRIFT_COMMAND(80, "merge", "join tiles of drift render --tile i/n into the whole frame",
+              merge_flags, run_merge);
 
 }  // namespace drift::pipeline

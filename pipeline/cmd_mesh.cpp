@@ -152,13 +152,7 @@ void run_mesh(const MeshCommand& c) {
 
 }  // namespace
 
-void add_mesh_command(CLI::App& root) {
-  auto c = std::make_shared<MeshCommand>();
-  CLI::App* sub = add_subcommand(
-      root, "mesh",
-      "a DEM or product raster as a triangle mesh: glTF/GLB, FBX, STL, OBJ or PLY (metres; "
-      "glTF and FBX y up, the others z up)",
-      [c] { run_mesh(*c); });
+void mesh_flags(CLI::App* sub, MeshCommand* c) {
   sub->add_option("raster", c->raster, "heights: a metric DEM or product raster (GeoTIFF, ...)")
       ->required();
   sub->add_option("-o,--output", c->output,
@@ -182,6 +176,9 @@ void add_mesh_command(CLI::App& root) {
       ->allow_extra_args(false);  // one NAME=RASTER a flag: a raster after it stays the raster
 }
 
-DRIFT_COMMAND(65, add_mesh_command);
+DRIFT_COMMAND(65, "mesh",
+              "a DEM or product raster as a triangle mesh: glTF/GLB, FBX, STL, OBJ or PLY (metres; "
+              "glTF and FBX y up, the others z up)",
+              mesh_flags, run_mesh);
 
 }  // namespace drift::pipeline

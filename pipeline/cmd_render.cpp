@@ -449,10 +449,7 @@ void add_product_flags(CLI::App& sub, RenderOptions& o) {
 
 }  // namespace
 
-void add_render_command(CLI::App& root) {
-  auto o = std::make_shared<RenderOptions>();
-  CLI::App* sub = add_subcommand(root, "render", "path-trace a scene file (TOML) to EXR and/or PNG",
-                                 [o](const CLI::App& self) { run_render(*o, self); });
+void render_flags(CLI::App* sub, RenderOptions* o) {
   sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
   sub->add_option("--set", o->variables,
                   "NAME=VALUE: ${NAME} in the scene file's strings becomes VALUE (overrides its "
@@ -517,6 +514,7 @@ void add_render_command(CLI::App& root) {
   add_seed_option(*sub, o->seed);
 }
 
-DRIFT_COMMAND(70, add_render_command);
+DRIFT_COMMAND(70, "render", "path-trace a scene file (TOML) to EXR and/or PNG", render_flags,
+              run_render);
 
 }  // namespace drift::pipeline

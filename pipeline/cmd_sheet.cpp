@@ -55,10 +55,7 @@ void run_sheet(const SheetCommandOptions& o) {
 
 }  // namespace
 
-void add_sheet_command(CLI::App& root) {
-  auto o = std::make_shared<SheetCommandOptions>();
-  CLI::App* sub = add_subcommand(root, "sheet", "lay images out in a labelled grid (contact sheet)",
-                                 [o] { run_sheet(*o); });
+void sheet_flags(CLI::App* sub, SheetCommandOptions* o) {
   sub->add_option("images", o->images, "images (EXR or PNG)")->required();
   sub->add_option("-o,--output", o->output, "output sheet (.png or .exr)")->required();
   sub->add_option("--labels", o->labels, "one label per image, separated by '|'");
@@ -71,14 +68,14 @@ void add_sheet_command(CLI::App& root) {
   whole_in_range(sub->add_option("--padding", o->padding, "pixels between cells, 0..256"), 0, 256)
       ->capture_default_str();
   sub->add_option("--font", o->font, "TrueType font file (default DejaVu Sans)");
-  sub->add_option("--tone", o->tone, "tone curve for linear EXR inputs: clamp | filmic")
-      ->check(CLI::IsMember({"clamp", "filmic"}))
-      ->capture_default_str();
+  add_choice(*sub, "--tone", o->tone, {"clamp", "filmic"},
+             "tone curve for linear EXR inputs: clamp | filmic");
   sub->add_option("--exposure", o->exposure, "exposure in EV applied to every image")
       ->check(CLI::Range(-64.0, 64.0))
       ->capture_default_str();
 }
 
-DRIFT_COMMAND(100, add_sheet_command);
+DRIFT_COMMAND(100, "sheet", "lay images out in a labelled grid (contact sheet)", sheet_flags,
+              run_sheet);
 
 }  // namespace drift::pipeline

@@ -69,27 +69,17 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
 
 }  // namespace
 
-void add_snow_cover_command(CLI::App& root) {
-  CLI::App& group = command_group(root, "snow", "snow stages: cover (descriptor), fall");
-  auto c = std::make_shared<CoverCommand>();
-  CLI::App* sub = add_subcommand(group, "cover",
-                                 "snow-cover descriptor of a DEM (tangent sphere accessibility, "
-                                 "altitude, sun aspect; paper 001)",
-                                 [c](const CLI::App& self) { run_cover(*c, self); });
+void snow_cover_flags(CLI::App* sub, CoverCommand* c) {
   sub->add_option("dem", c->dem, "DEM GeoTIFF in metres (drift import)")->required();
   sub->add_option("-o,--output", c->output, "snow cover GeoTIFF, 1 - t in [0, 1]")->required();
   c->parameters.add_to(*sub);
-  sub->add_option("--sun-step", c->sun_step,
-                  "per-triangle (the paper: t = t phi + 1 - phi for each facing triangle) or mean "
-                  "(phi averaged over the 12 triangles, applied once)")
-      ->check(CLI::IsMember({"per-triangle", "mean"}))
-      ->capture_default_str();
+  add_choice(*sub, "--sun-step", c->sun_step, {"per-triangle", "mean"},
+             "per-triangle (the paper: t = t phi + 1 - phi for each facing triangle) or mean "
+             "(phi averaged over the 12 triangles, applied once)");
   sub->add_option("--snow-line", c->snow_line,
                   "snow line in metres: no snow below, full above (default: (z/zmax)^2)");
-  sub->add_option("--hemisphere", c->hemisphere,
-                  "where the sun stands: auto (from the DEM's CRS), north or south")
-      ->check(CLI::IsMember({"auto", "north", "south"}))
-      ->capture_default_str();
+  add_choice(*sub, "--hemisphere", c->hemisphere, {"auto", "north", "south"},
+             "where the sun stands: auto (from the DEM's CRS), north or south");
   sub->add_option("--descriptor", c->descriptor, "also write t (0 snow, 1 rock)");
   sub->add_option("--accessibility", c->accessibility, "also write the TSA in metres");
   sub->add_option("--block", c->block,
@@ -97,6 +87,9 @@ void add_snow_cover_command(CLI::App& root) {
       ->check(CLI::Range(16, 1048576));
 }
 
-DRIFT_COMMAND(40, add_snow_cover_command);
+DRIFT_COMMAND(40, "cover",
+              "snow-cover descriptor of a DEM (tangent sphere accessibility, "
+              "altitude, sun aspect; paper 001)",
+              snow_cover_flags, run_cover, "snow", "snow stages: cover (descriptor), fall");
 
 }  // namespace drift::pipeline

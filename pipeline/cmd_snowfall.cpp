@@ -118,14 +118,7 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
 
 }  // namespace
 
-void add_snowfall_command(CLI::App& root) {
-  CLI::App& group = command_group(root, "snow", "snow: snowfall (fall) and snow cover (cover)");
-  auto c = std::make_shared<SnowfallCommand>();
-  CLI::App* sub =
-      add_subcommand(group, "fall",
-                     "snowfall on a DEM and objects: occlusion by depth maps, jittered directions, "
-                     "stabilisation (paper 003)",
-                     [c](const CLI::App& self) { run_snowfall(*c, self); });
+void snowfall_flags(CLI::App* sub, SnowfallCommand* c) {
   sub->add_option("ground", c->ground, "ground heights, a metric GeoTIFF (see drift import)")
       ->required();
   sub->add_option("--objects", c->objects, "TOML file of [[objects]] (mesh, position, ...)");
@@ -138,15 +131,11 @@ void add_snowfall_command(CLI::App& root) {
       ->expected(2)
       ->delimiter(',')
       ->capture_default_str();
-  sub->add_option("--occlusion", c->occlusion,
-                  "how the ground occludes: sweep (horizon sweep) or opengl (OSMesa depth map)")
-      ->check(CLI::IsMember({"sweep", "opengl"}))
-      ->capture_default_str();
-  sub->add_option("--stabilise", c->stabilise,
-                  "how the ground's snow comes to rest: passes (paper 003's rule, many passes) "
-                  "or direct (in one step, near-linear cost; docs/snowfall.md)")
-      ->check(CLI::IsMember({"passes", "direct"}))
-      ->capture_default_str();
+  add_choice(*sub, "--occlusion", c->occlusion, {"sweep", "opengl"},
+             "how the ground occludes: sweep (horizon sweep) or opengl (OSMesa depth map)");
+  add_choice(*sub, "--stabilise", c->stabilise, {"passes", "direct"},
+             "how the ground's snow comes to rest: passes (paper 003's rule, many passes) "
+             "or direct (in one step, near-linear cost; docs/snowfall.md)");
   sub->add_option("--block", c->block,
                   "sweep the ground's occlusion on blocks of N cells a side with their halo "
                   "(the same result; ground without objects, --occlusion sweep); 0: one pass")
@@ -155,6 +144,9 @@ void add_snowfall_command(CLI::App& root) {
   add_seed_option(*sub, c->seed);
 }
 
-DRIFT_COMMAND(41, add_snowfall_command);
+DRIFT_COMMAND(41, "fall",
+              "snowfall on a DEM and objects: occlusion by depth maps, jittered directions, "
+              "stabilisation (paper 003)",
+              snowfall_flags, run_snowfall, "snow", "snow: snowfall (fall) and snow cover (cover)");
 
 }  // namespace drift::pipeline

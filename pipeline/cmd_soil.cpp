@@ -157,12 +157,7 @@ void run_soil(SoilCommand& c, const CLI::App& sub) {
 
 }  // namespace
 
-void add_soil_command(CLI::App& root) {
-  auto c = std::make_shared<SoilCommand>();
-  CLI::App* sub = add_subcommand(root, "soil",
-                                 "voxel soil that pours, slides, piles and is pushed, dug and "
-                                 "lifted; writes its surface (paper 004; docs/soil.md)",
-                                 [c](const CLI::App& self) { run_soil(*c, self); });
+void soil_flags(CLI::App* sub, SoilCommand* c) {
   sub->add_option("scenario", c->scenario, "scenario TOML (see data/soil/, docs/soil.md)")
       ->required();
   sub->add_option("-o,--output", c->output, "soil surface mesh, .ply or .obj (metres)")->required();
@@ -196,6 +191,9 @@ void add_soil_command(CLI::App& root) {
                 "extract the raw density (shows the thesis's vertical ridges)");
 }
 
-DRIFT_COMMAND(60, add_soil_command);
+DRIFT_COMMAND(60, "soil",
+              "voxel soil that pours, slides, piles and is pushed, dug and "
+              "lifted; writes its surface (paper 004; docs/soil.md)",
+              soil_flags, run_soil);
 
 }  // namespace drift::pipeline

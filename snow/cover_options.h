@@ -15,7 +15,7 @@ enum class SunStep {
 };
 
 // The ranges, units and meanings of the numeric fields are in
-// snow/cover_parameters.cpp's table (docs/snow.md's options table).
+// snow/cover_parameters.toml's table (docs/snow.md's options table).
 struct CoverOptions {
   double region = 3.0;          // smoothing region n in the paper's 50 m cells
   int region_cells = 0;         // > 0: region n in this DEM's cells instead

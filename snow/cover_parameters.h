@@ -1,5 +1,6 @@
-// The snow-cover descriptor's parameters in one table (terrain/parameter.h):
-// each row names the CoverOptions field, the `drift snow cover` flag, the
+// The snow-cover descriptor's parameters in one table, kept as data in
+// cover_parameters.toml beside this header and compiled by scripts/parameter_table.cmake
+// (terrain/parameter.h): each row names the CoverOptions field, the `drift snow cover` flag, the
 // range, the unit and what it means. CoverOptions::validate(), the command
 // line's flags and help, and docs/snow.md's options table come from it; the
 // defaults are CoverOptions{}'s, and tests/snow/cover_parameters_test.cpp

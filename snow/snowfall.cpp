@@ -153,7 +153,7 @@ void write_snowy_objects(const SnowScene& scene, const std::vector<ObjectSnow>& 
 
 }  // namespace
 
-// The ranges live in one table (snow/snowfall_parameters.cpp).
+// The ranges live in one table (snow/snowfall_parameters.toml).
 void SnowfallOptions::validate() const {
   for (const SnowfallParameter& p : snowfall_parameters()) p.require(*this);
 }

@@ -8,25 +8,6 @@
 
 namespace drift::marks {
 
-const std::vector<terrain::Parameter<Material>>& material_parameters() {
-  using terrain::Ends;
-  static const std::vector<terrain::Parameter<Material>> table = {
-      {"theta_deg", "", 0.0, 90.0, Ends::OpenLow, false, "degrees",
-       "angle of the slope after slipping (90: never slips)",
-       DRIFT_PARAMETER_FIELD(Material, theta_deg), "theta"},
-      {"alpha", "", 0.0, 1.0, Ends::Closed, false, "",
-       "displaced share of the material an object pushes out (the rest is compressed)",
-       DRIFT_PARAMETER_FIELD(Material, alpha), "alpha"},
-      {"sigma", "", 0.0, 0.5, Ends::OpenLow, false, "",
-       "roughness: share of a slope's excess moved per pass",
-       DRIFT_PARAMETER_FIELD(Material, sigma), "roughness"},
-      {"heave", "", 0.0, 4.0, Ends::Closed, false, "",
-       "width of the heave beside a press, in footing widths (0: the paper's rim on the ring)",
-       DRIFT_PARAMETER_FIELD(Material, heave), "heave"},
-  };
-  return table;
-}
-
 void Material::validate(const std::string& what) const {
   for (const terrain::Parameter<Material>& p : material_parameters()) {
     if (!p.admits(p.get(*this)))

@@ -42,7 +42,8 @@ struct Material {
 
 // The ranges of a material's numbers, one row each, as a track file names
 // them (key "theta", "alpha", "roughness"): the one check of Material::validate
-// and of track files' material tables.
+// and of track files' material tables (data: material_parameters.toml beside
+// this header, compiled by scripts/parameter_table.cmake).
 const std::vector<terrain::Parameter<Material>>& material_parameters();
 
 // The paper's preset by name (sand, mud, snow), or nothing.

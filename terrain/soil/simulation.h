@@ -8,7 +8,7 @@
 //
 // Options: the numeric ones (dt, gravity, propagation_iterations, overflow_passes
 // and the soil's phi, c, gamma, moisture) with their defaults, units and ranges
-// are in one table, terrain/soil/soil_parameters.cpp; besides them, overflow
+// are in one table, terrain/soil/soil_parameters.toml; besides them, overflow
 // (fig. 30's heuristic), settle (carry leftover overflow up, so that eq. 17
 // holds) and slippage (Li & Moshell slippage on).
 #pragma once

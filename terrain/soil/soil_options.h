@@ -18,7 +18,7 @@ struct SoilOptions {
   SoilType soil;
 
   // Throws terrain::ParameterError naming the field, its value and the range
-  // (terrain/soil/soil_parameters.cpp).
+  // (terrain/soil/soil_parameters.toml).
   void validate() const;
 };
 

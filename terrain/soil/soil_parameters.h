@@ -1,5 +1,6 @@
-// The soil simulation's numeric parameters in one table (terrain/parameter.h):
-// each row names the SoilOptions field, the `drift soil` flag and the
+// The soil simulation's numeric parameters in one table, kept as data in
+// soil_parameters.toml beside this header and compiled by scripts/parameter_table.cmake
+// (terrain/parameter.h): each row names the SoilOptions field, the `drift soil` flag and the
 // scenario file's key where there are any, the range, the unit and what it
 // means. validate(SoilOptions), the scenario reader, the flags with their
 // help, and docs/soil.md's options table come from it; the defaults are

@@ -28,7 +28,7 @@ namespace drift::soil {
 
 struct SoilType {
   std::string name = "dry_sand";
-  // Ranges: terrain/soil/soil_parameters.cpp.
+  // Ranges: terrain/soil/soil_parameters.toml.
   double phi_deg = 30.0;  // angle of internal friction, degrees
   double cohesion = 0.0;  // c, t/m
   double gamma = 1.95;    // specific weight, t/m^2

@@ -1,5 +1,5 @@
 // One source for the sand model's defaults and ranges: the table in
-// dunes/sand_parameters.cpp. docs/dunes.md's parameter table must agree with
+// dunes/sand_parameters.toml. docs/dunes.md's parameter table must agree with
 // it row by row (flag, both defaults, range, unit, meaning), and validate()
 // must hold every range at both of its ends.
 #include "dunes/sand_parameters.h"

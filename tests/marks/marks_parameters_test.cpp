@@ -1,5 +1,5 @@
 // One source for marks' defaults and ranges: the table in
-// terrain/marks/marks_parameters.cpp. docs/marks.md's options table must agree
+// terrain/marks/marks_parameters.toml. docs/marks.md's options table must agree
 // with it row by row, and validate() must hold every range at both of its ends.
 #include "terrain/marks/marks_parameters.h"
 

@@ -1,5 +1,5 @@
 // One source for the snow-cover descriptor's defaults and ranges: the table in
-// snow/cover_parameters.cpp. docs/snow.md's options table must agree with it
+// snow/cover_parameters.toml. docs/snow.md's options table must agree with it
 // row by row, and validate() must hold every range at both of its ends.
 #include "snow/cover_parameters.h"
 

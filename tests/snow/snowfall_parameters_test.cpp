@@ -1,5 +1,5 @@
 // One source for snowfall's defaults and ranges: the table in
-// snow/snowfall_parameters.cpp. docs/snowfall.md's options table must agree
+// snow/snowfall_parameters.toml. docs/snowfall.md's options table must agree
 // with it row by row, and validate() must hold every range at both ends.
 #include "snow/snowfall_parameters.h"
 

@@ -192,19 +192,8 @@ void expect_refusals(const fs::path& d, const std::string& base,
   }
 }
 
-TEST(SoilCli, BadScenariosAreErrorsNamingTheValueAndWriteNothing) {
+TEST(SoilCli, BadFlagsAreUsageErrorsAndWriteNothing) {
   const fs::path d = dir();
-  expect_refusals(
-      d, kScenario,
-      {
-          {"radius = 0.5", "radius = -0.5", "radius"},
-          {"radius = 0.5", "radius = nan", "radius"},
-          {"steps = 60", "steps = 60\nbogus = 1", "unknown key"},
-          {"size = [24, 24, 24]", "size = [4000, 4000, 4000]", "soil grid 4000 x 4000 x 4000"},
-          {"shape = \"cylinder\"", "shape = \"torus\"", "torus"},
-          {"[simulation]", "[soil]\ndrainage = 2\n[simulation]", "drainage"},
-      },
-      d / "soil.ply");
   std::ofstream(d / "s.toml") << kScenario;
   EXPECT_EQ(run((d / "s.toml").string() + " -o " + (d / "soil.ply").string() + " --soil clay", d),
             2);
@@ -314,7 +303,8 @@ std::string box_obj(double hx, double hy, double hz) {
   return o.str();
 }
 
-// Two soil bodies, one with its own moisture, and a mesh body that turns.
+// Two soil bodies, one with its own moisture (its primitive in TOML's inline
+// form of an array of tables, read alike), and a mesh body that turns.
 const char* kTurningScenario = R"([grid]
 size = [24, 24, 16]
 voxel = 0.1
@@ -331,10 +321,7 @@ half_extents = [0.6, 1.2, 0.25]
 [[soil_body]]
 name = "wet"
 moisture = 0.7
-[[soil_body.primitive]]
-shape = "cuboid"
-center = [1.8, 1.2, 0.25]
-half_extents = [0.6, 1.2, 0.25]
+primitive = [{shape = "cuboid", center = [1.8, 1.2, 0.25], half_extents = [0.6, 1.2, 0.25]}]
 [[body]]
 name = "bucket"
 mesh = "box.obj"
@@ -364,18 +351,35 @@ TEST(SoilCli, SoilBodyMoistureAndATurningMeshBody) {
   const auto [lo, hi] = std::minmax_element(wet->begin(), wet->end());
   EXPECT_NEAR(*lo, 0.1f, 0.02f);
   EXPECT_NEAR(*hi, 0.7f, 0.02f);
+}
+
+// Every edit of a good scenario that must be refused (exit 1, the message
+// naming the value, nothing written), in one table: the plain scenario's
+// keys, then the soil bodies' and the turning mesh body's.
+TEST(SoilCli, BadScenariosAreErrorsNamingTheValueAndWriteNothing) {
+  const fs::path d = dir();
+  std::ofstream(d / "box.obj") << box_obj(0.3, 0.5, 0.2);
   std::string open = box_obj(0.3, 0.5, 0.2);
   open.erase(open.find("f 1 3 2"), std::string("f 1 3 2\nf 2 3 4\n").size());  // no bottom
   std::ofstream(d / "open.obj") << open;
-  expect_refusals(d, kTurningScenario,
-                  {
-                      {"moisture = 0.7", "moisture = 1.5", "moisture"},
-                      {"mesh = \"box.obj\"", "mesh = \"open.obj\"", "closed"},
-                      {"mesh = \"box.obj\"", "mesh = \"none.obj\"", "none.obj"},
-                      {"spin = [0, 0, 30]", "spin = [0, nan, 30]", "spin"},
-                      {"spin = [0, 0, 30]", "rotation = [0, 0, 30]", "rotation"},
-                  },
-                  d / "bad.ply");
+  const struct {
+    const char* scenario;
+    Refusal refusal;
+  } cases[] = {
+      {kScenario, {"radius = 0.5", "radius = -0.5", "radius"}},
+      {kScenario, {"radius = 0.5", "radius = nan", "radius"}},
+      {kScenario, {"steps = 60", "steps = 60\nbogus = 1", "unknown key"}},
+      {kScenario,
+       {"size = [24, 24, 24]", "size = [4000, 4000, 4000]", "soil grid 4000 x 4000 x 4000"}},
+      {kScenario, {"shape = \"cylinder\"", "shape = \"torus\"", "torus"}},
+      {kScenario, {"[simulation]", "[soil]\ndrainage = 2\n[simulation]", "drainage"}},
+      {kTurningScenario, {"moisture = 0.7", "moisture = 1.5", "moisture"}},
+      {kTurningScenario, {"mesh = \"box.obj\"", "mesh = \"open.obj\"", "closed"}},
+      {kTurningScenario, {"mesh = \"box.obj\"", "mesh = \"none.obj\"", "none.obj"}},
+      {kTurningScenario, {"spin = [0, 0, 30]", "spin = [0, nan, 30]", "spin"}},
+      {kTurningScenario, {"spin = [0, 0, 30]", "rotation = [0, 0, 30]", "rotation"}},
+  };
+  for (const auto& c : cases) expect_refusals(d, c.scenario, {c.refusal}, d / "bad.ply");
 }
 
 // A mesh body given as glTF is read as glTF (before, every body mesh went

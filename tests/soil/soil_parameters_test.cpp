@@ -1,5 +1,5 @@
 // One source for the soil simulation's defaults and ranges: the table in
-// terrain/soil/soil_parameters.cpp. docs/soil.md's options table must agree
+// terrain/soil/soil_parameters.toml. docs/soil.md's options table must agree
 // with it row by row, and validate() must hold every range at both ends.
 #include "terrain/soil/soil_parameters.h"
 

@@ -23,16 +23,13 @@ void run_example(const ExampleCommand& c) {
   outputs.commit();
 }
 
-void add_example_command(CLI::App& root) {
-  auto c = std::make_shared<ExampleCommand>();
-  CLI::App* sub = add_subcommand(root, "example", "a ridge (the example stage)",
-                                 [c] { run_example(*c); });
+void example_flags(CLI::App* sub, ExampleCommand* c) {
   sub->add_option("-o,--output", c->output, "output GeoTIFF")->required();
   whole_in_range(sub->add_option("--size", c->size, "cells per side"), 3, 4096);
 }
 
 }  // namespace
 
-DRIFT_COMMAND(65, add_example_command);
+DRIFT_COMMAND(65, "example", "a ridge (the example stage)", example_flags, run_example);
 
 }  // namespace drift::pipeline
