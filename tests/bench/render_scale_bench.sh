@@ -33,7 +33,7 @@ for n in "${sizes[@]}"; do
     if [ -n "${FAST:-}" ]; then  # seamless, ~5x less CPU a tile (8 s of CPU a 4096^2 tile)
       /usr/bin/python3 "$here/make_fractal_dem.py" "$n" "$data" --tile $((n < 4096 ? n : 4096)) \
         --fast --jobs 2 >&2
-    elif [ "$n" -gt 16384 ]; then  # made tile by tile, 32768^2 takes ~45 min and 65536^2 ~3 h:
+    elif [ "$n" -gt 16384 ]; then  # made tile by tile, 32768^2 takes ~7 min of CPU, 65536^2 ~30 min:
       [ -f "$data/fractal_16384.vrt" ] ||  # repeat the 16384^2 tiles instead
         /usr/bin/python3 "$here/make_fractal_dem.py" 16384 "$data" --tile 4096 >&2
       /usr/bin/python3 "$here/make_mosaic_vrt.py" "$n" "$data" --from 16384 >&2
