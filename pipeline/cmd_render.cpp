@@ -60,6 +60,7 @@ struct RenderOptions {
   double cell = 0.0;
   std::string memory_budget;     // --memory-budget BYTES: the terrain out of core
   bool full_resolution = false;  // --full-resolution: no level of detail out of core
+  int height_bits = 32;          // --height-bits 16: heights quantised over each block in core
 };
 
 // X,Y,Z (CRS metres) of --from or --to.
@@ -373,6 +374,10 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     // camera, the sun) sees it at most 1024 cells a side; the scene reads
     // the full raster in pages.
     scene.coarse_terrain_side = 1024;
+    if (o.height_bits == 16)
+      usage_error(
+          "--height-bits 16 quantises the heights held in core; with --memory-budget "
+          "the pages hold float heights: give one of the two");
   }
   OutputSet outputs(written, inputs);
   load_scene_terrain(scene);
@@ -390,8 +395,10 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     scene_holder = std::make_unique<render::TerrainScene>(scene.input, *paged);
   } else {
     const terrain::GeoReference dem_geo = scene.input.terrain.geo();
-    scene_holder =
-        std::make_unique<render::TerrainScene>(scene.input, std::move(scene.input.terrain));
+    scene_holder = std::make_unique<render::TerrainScene>(
+        scene.input, std::move(scene.input.terrain),
+        o.height_bits == 16 ? render::TerrainGeometry::HeightField16
+                            : render::TerrainGeometry::Auto);
     scene.input.terrain.geo() = dem_geo;
   }
   const render::TerrainScene& embree_scene = *scene_holder;
@@ -511,6 +518,11 @@ void render_flags(CLI::App* sub, RenderOptions* o) {
                   "coarser levels by the pixel's footprint");
   sub->add_flag("--full-resolution", o->full_resolution,
                 "with --memory-budget: trace every cell at full resolution (no level of detail)");
+  sub->add_option("--height-bits", o->height_bits,
+                  "16: hold the DEM in core as 16-bit heights quantised over each 16x16 block's "
+                  "range (2 B a cell instead of 4; error at most range/65535/2 a block, "
+                  "docs/rendering.md); 32 (default): float")
+      ->check(CLI::IsMember({16, 32}));
   add_seed_option(*sub, o->seed);
 }
 

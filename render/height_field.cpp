@@ -82,8 +82,60 @@ void HeightFieldBlocks::size_levels() {
   }
 }
 
+static_assert(QuantisedHeights::kBlock == HeightFieldBlocks::kBlock,
+              "16-bit heights are quantised over the height field's blocks");
+
+QuantisedHeights::QuantisedHeights(const HeightGrid& grid)
+    : width_(grid.width),
+      height_(grid.height),
+      blocks_x_(std::max(1, (grid.width - 1 + kBlock - 1) / kBlock)),
+      blocks_y_(std::max(1, (grid.height - 1 + kBlock - 1) / kBlock)),
+      q_(static_cast<std::size_t>(grid.width) * grid.height),
+      ranges_(static_cast<std::size_t>(blocks_x_) * blocks_y_) {
+  // Block row by block row: the range of the vertices each block owns, then
+  // each vertex's nearest step, rounded in double from the float step the
+  // decode uses (so |lo + step q - z| <= step / 2 exactly, before the
+  // decode's one rounding to float).
+  tbb::parallel_for(0, blocks_y_, [&](int by) {
+    const int r0 = by * kBlock, r1 = by == blocks_y_ - 1 ? height_ : r0 + kBlock;
+    for (int bx = 0; bx < blocks_x_; ++bx) {
+      const int c0 = bx * kBlock, c1 = bx == blocks_x_ - 1 ? width_ : c0 + kBlock;
+      float lo = kInf, hi = -kInf;
+      for (int r = r0; r < r1; ++r)
+        for (int c = c0; c < c1; ++c)
+          lo = std::min(lo, grid.at(c, r)), hi = std::max(hi, grid.at(c, r));
+      Range& range = ranges_[static_cast<std::size_t>(by) * blocks_x_ + bx];
+      range.lo = lo;
+      range.step = static_cast<float>((static_cast<double>(hi) - lo) / kSteps);
+      for (int r = r0; r < r1; ++r)
+        for (int c = c0; c < c1; ++c) {
+          const double steps =
+              range.step > 0.0f ? (static_cast<double>(grid.at(c, r)) - lo) / range.step : 0.0;
+          q_[static_cast<std::size_t>(r) * width_ + c] =
+              static_cast<std::uint16_t>(std::clamp(std::nearbyint(steps), 0.0, kSteps));
+        }
+    }
+  });
+}
+
 HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
   size_levels();
+  build_leaves();
+  build_upper_levels();
+  build_coarse_from_grid();
+}
+
+HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid, QuantisedHeights heights)
+    : grid_(&grid), quantised_(std::move(heights)) {
+  if (quantised_.width() != grid.width || quantised_.height() != grid.height)
+    throw std::invalid_argument("HeightFieldBlocks: 16-bit heights of another size");
+  size_levels();
+  build_leaves();
+  build_upper_levels();
+  build_coarse_from_grid();
+}
+
+void HeightFieldBlocks::build_leaves() {
   // Leaves from the heights (every vertex of their cells, edges included),
   // each level above from the one below.
   Level& leaves = levels_[0];
@@ -93,12 +145,10 @@ HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {
       const int r0 = iy * kLeaf, r1 = std::min(r0 + kLeaf, cells_y_);
       MinMax m{kInf, -kInf};
       for (int r = r0; r <= r1; ++r)
-        for (int c = c0; c <= c1; ++c) widen(m, grid.at(c, r));
+        for (int c = c0; c <= c1; ++c) widen(m, vertex_z(c, r));
       leaves.nodes[static_cast<std::size_t>(iy) * leaves.nx + ix] = m;
     }
   });
-  build_upper_levels();
-  build_coarse_from_grid();
 }
 
 HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid, const HeightSource& source,
@@ -119,7 +169,7 @@ void HeightFieldBlocks::build_coarse_from_grid() {
   for (int j = 0; j < coarse_ny_; ++j)
     for (int i = 0; i < coarse_nx_; ++i)
       coarse_[static_cast<std::size_t>(j) * coarse_nx_ + i] =
-          grid_->at(coarse_vertex(i, grid_->width), coarse_vertex(j, grid_->height));
+          vertex_z(coarse_vertex(i, grid_->width), coarse_vertex(j, grid_->height));
 }
 
 void HeightFieldBlocks::build_upper_levels() {
@@ -166,7 +216,7 @@ void HeightFieldBlocks::page_tree(const float* z, std::size_t stride, int page_c
 }
 
 std::size_t HeightFieldBlocks::bytes() const {
-  std::size_t n = coarse_.size() * sizeof(float);
+  std::size_t n = coarse_.size() * sizeof(float) + quantised_.bytes();
   for (const Level& l : levels_) n += l.nodes.size() * sizeof(MinMax);
   return n;
 }
@@ -232,7 +282,7 @@ float HeightFieldBlocks::coarse_height(int c, int r, int spacing) const {
 // morphs (Strugar 2010), so a vertex's height moves continuously with the
 // camera.
 float HeightFieldBlocks::lod_height(int c, int r, const HeightPage* page) const {
-  const auto full = [&] { return page ? page->at(c, r) : grid_->at(c, r); };
+  const auto full = [&] { return page ? page->at(c, r) : vertex_z(c, r); };
   if (!lod_on()) return full();
   const float h4 = coarse_height(c, r, kBlock);
   const float l = lod_level(c, r, h4);
@@ -309,6 +359,7 @@ void HeightFieldBlocks::view_block(int bx, int by, BlockView& view) const {
   if (!lod_on() || hi < kFullBelow) {  // full resolution: every vertex's height is its own
     if (!source_) {
       view.page = {0, 0, static_cast<std::size_t>(grid_->width), grid_->z.data()};
+      if (quantised()) view.page = {0, 0, 0, nullptr, nullptr, 0, &quantised_};
       for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 4; ++i) {
           const int lx = bx * 4 + i, ly = by * 4 + j;

@@ -245,14 +245,17 @@ void TerrainScene::build(const SceneInput& input, terrain::HeightField* adopt,
   embree_->open();
   if (geometry == TerrainGeometry::Auto)
     geometry = cells < kHeightFieldMinCells ? TerrainGeometry::Grid : TerrainGeometry::HeightField;
-  if (geometry == TerrainGeometry::Grid) {
+  if (geometry == TerrainGeometry::HeightField16) {
+    attach_quantised_height_field(input.surround);
+  } else if (geometry == TerrainGeometry::Grid) {
     // The float3 vertex a cell and Embree's BVH over the grids.
     require_memory(cells * 32, "the terrain's grid geometry", "crop or resample the DEM");
     attach_terrain_grids();
+    attach_surround(input.surround);
   } else {
     attach_height_field();
+    attach_surround(input.surround);
   }
-  attach_surround(input.surround);
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
   std::tie(bottom_, top_) = embree_->commit();
 }
@@ -332,6 +335,23 @@ void TerrainScene::attach_height_field() {
   attach_blocks();
 }
 
+void TerrainScene::attach_quantised_height_field(const SurroundOptions& surround) {
+  // 2 B a cell beside the 4 B of floats (the peak), then the floats are
+  // decoded in place so the ring beyond the edge meets the heights the rays
+  // meet, the ring is built, and the floats freed before the tree is built.
+  QuantisedHeights quantised(heights_);
+  tbb::parallel_for(0, height_, [&](int row) {
+    for (int x = 0; x < width_; ++x)
+      heights_.z[static_cast<std::size_t>(row) * width_ + x] = quantised.at(x, row);
+  });
+  SurroundGrids ring = build_surround(
+      DemVertices{&heights_, width_, height_, dx_, dy_, origin_, exaggeration_}, surround);
+  std::vector<float>().swap(heights_.z);
+  blocks_ = std::make_unique<HeightFieldBlocks>(heights_, std::move(quantised));
+  attach_blocks();
+  attach_ring(std::move(ring));
+}
+
 void TerrainScene::attach_blocks() {
   RTCGeometry g = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(g, blocks_->block_count());
@@ -382,7 +402,10 @@ void TerrainScene::attach_terrain_grids() {
 
 void TerrainScene::attach_surround(const SurroundOptions& options) {
   DemVertices dem{&heights_, width_, height_, dx_, dy_, origin_, exaggeration_};
-  SurroundGrids ring = build_surround(dem, options);
+  attach_ring(build_surround(dem, options));
+}
+
+void TerrainScene::attach_ring(SurroundGrids ring) {
   if (ring.grids.empty()) return;
   surround_vertices_ = std::move(ring.vertices);
   surround_normals_ = std::move(ring.normals);
@@ -449,7 +472,8 @@ TerrainScene::~TerrainScene() = default;
 float TerrainScene::z_at(int c, int r) const {
   // The level of detail's heights where it is on (the geometry's, so the
   // shading reads no page the rays did not need), else the DEM's.
-  if (paged_ || (blocks_ && blocks_->lod_on())) return blocks_->height(c, r);
+  if (paged_ || (blocks_ && (blocks_->lod_on() || blocks_->quantised())))
+    return blocks_->height(c, r);
   return heights_.at(c, r);
 }
 
@@ -475,17 +499,23 @@ Eigen::Vector3f TerrainScene::smooth_normal(float px, float py) const {
   // so the same bits (the heights hold no NaN: fill_heights).
   const terrain::BilinearCell<float> c =
       terrain::clamped_cell((px - heights_.x0) / dx_, (heights_.y0 - py) / dy_, width_, height_);
-  if (paged_ || (blocks_ && blocks_->lod_on()) || c.x0 < 1 || c.y0 < 1 || c.x1 + 1 >= width_ || c.y1 + 1 >= height_) {
+  if (paged_ || (blocks_ && blocks_->lod_on()) || c.x0 < 1 || c.y0 < 1 || c.x1 + 1 >= width_ ||
+      c.y1 + 1 >= height_) {
     auto vn = [&](int xx, int rr) { return vertex_normal(xx, rr); };
     return terrain::bilinear_blend(vn(c.x0, c.y0), vn(c.x1, c.y0), vn(c.x0, c.y1), vn(c.x1, c.y1),
                                    c.tx, c.ty)
         .normalized();
   }
-  float z[4][4];  // z[r][k]: row y0 - 1 + r, column x0 - 1 + k
-  for (int r = 0; r < 4; ++r) {
-    const float* row =
-        heights_.z.data() + static_cast<std::size_t>(c.y0 - 1 + r) * width_ + c.x0 - 1;
-    for (int k = 0; k < 4; ++k) z[r][k] = row[k];
+  float z[4][4];                          // z[r][k]: row y0 - 1 + r, column x0 - 1 + k
+  if (blocks_ && blocks_->quantised()) {  // 16-bit: no float rows to read
+    for (int r = 0; r < 4; ++r)
+      for (int k = 0; k < 4; ++k) z[r][k] = blocks_->height(c.x0 - 1 + k, c.y0 - 1 + r);
+  } else {
+    for (int r = 0; r < 4; ++r) {
+      const float* row =
+          heights_.z.data() + static_cast<std::size_t>(c.y0 - 1 + r) * width_ + c.x0 - 1;
+      for (int k = 0; k < 4; ++k) z[r][k] = row[k];
+    }
   }
   // The normal of the vertex at stencil (k, r), 1 <= k, r <= 2.
   auto vn = [&](int k, int r) {

@@ -60,7 +60,9 @@ class RayRecorder {
 // thread). Both trace the same triangles. Auto, the default, takes the grid
 // below kHeightFieldMinCells cells (4096^2; the grid's peak there is about
 // 600 MB) and the height field from there on, where memory is what limits.
-enum class TerrainGeometry { Auto, HeightField, Grid };
+// HeightField16: the height field over 16-bit heights (render/height_field.h,
+// QuantisedHeights; `drift render --height-bits 16`), about 3 B a cell held.
+enum class TerrainGeometry { Auto, HeightField, Grid, HeightField16 };
 inline constexpr std::size_t kHeightFieldMinCells = std::size_t{4096} * 4096;
 
 class TerrainScene {
@@ -203,6 +205,10 @@ class TerrainScene {
   // The ground beyond the DEM's edge (render/surround.h): its vertex buffer,
   // grids and Embree geometry id (none: -1).
   void attach_surround(const SurroundOptions& options);
+  void attach_ring(SurroundGrids ring);
+  // The height field over 16-bit heights; the float heights are freed
+  // (the ring beyond the edge is built from the decoded ones first).
+  void attach_quantised_height_field(const SurroundOptions& surround);
   std::vector<Eigen::Vector3f> surround_vertices_;
   std::vector<Eigen::Vector3f> surround_normals_;  // smooth shading (render/surround.h)
   // The smooth normal at (u, v) of surround grid `grid` (Embree's grid-local
