@@ -10,12 +10,15 @@
 #include "pipeline/parameter_flags.h"
 #include "pipeline/progress_bar.h"
 #include "snow/snowfall.h"
+#include "snow/snowfall_blocks.h"
 #include "snow/snowfall_parameters.h"
 #include "terrain/error.h"
+#include "terrain/geodesy.h"
 #include "terrain/height_change.h"
 #include "terrain/mesh_io.h"
 #include "terrain/output_set.h"
 #include "terrain/products.h"
+#include "terrain/raster_blocks.h"
 #include "terrain/raster_io.h"
 
 namespace drift::pipeline {
@@ -29,6 +32,7 @@ struct SnowfallCommand {
   std::string occlusion = "sweep";
   std::string stabilise = "passes";
   int block = 0;
+  int halo = snow::SnowfallBlockFiles{}.halo;
   unsigned long long seed = snow::SnowfallOptions{}.seed;
   // The table's flags (snow/snowfall_parameters.h); only those given override
   // SnowfallOptions{}'s defaults.
@@ -52,6 +56,39 @@ std::string direction_help() {
   return help;
 }
 
+// --block with --stabilise direct: the ground read, settled and written block
+// by block through GDAL (snow/snowfall_blocks.h), the rasters of one pass.
+void run_snowfall_in_blocks(const SnowfallCommand& c, const snow::SnowfallOptions& o,
+                            OutputSet& outputs) {
+  {
+    const terrain::RasterBlockReader reader(c.ground);
+    if (terrain::is_geographic(reader.geo().crs_wkt))
+      throw Error("raster '" + c.ground +
+                  "' is in degrees (geographic CRS); convert it to metres first: drift import " +
+                  c.ground + " -o DEM_metric.tif");
+  }
+  snow::SnowfallBlockReport r;
+  try {
+    r = snow::snowfall_to_files({c.ground, c.output, c.cover, c.surface, o.block, c.halo}, o,
+                                terminal_progress("snow fall"));
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const Error& e) {
+    throw Error(c.ground + ": " + e.what());
+  }
+  outputs.commit();
+  std::printf("snow fall: wrote %s\n", c.output.c_str());
+  if (!c.cover.empty()) std::printf("snow fall: wrote %s\n", c.cover.c_str());
+  if (!c.surface.empty()) std::printf("snow fall: wrote %s\n", c.surface.c_str());
+  std::printf("snow fall: %.6g m3 fell on the ground, %.6g on it after settling\n", r.fallen_volume,
+              r.ground_volume);
+  std::printf(
+      "snow fall: %d blocks of %d cells, occlusion halo %d cells, stabilisation halo up to %d "
+      "cells (%d windows worked again wider)%s\n",
+      r.blocks, r.block, r.occlusion_halo, r.largest_halo, r.widened,
+      r.converged ? "" : " (NOT at rest within the tolerance)");
+}
+
 void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   if (c.direction.size() != 2) usage_error("--direction takes AZ,EL (degrees)");
   snow::SnowfallOptions o;
@@ -70,6 +107,8 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
         "--block works on the ground alone with --occlusion sweep; drop --block, or "
         "--objects and --occlusion opengl");
   o.block = c.block;
+  if (sub.count("--halo") && !(c.block > 0 && o.direct_stabilise))
+    usage_error("--halo works with --block and --stabilise direct; drop --halo or add them");
   if (!c.mesh_out.empty() && c.objects.empty())
     usage_error("--mesh-out needs --objects (there are no objects to write)");
   // Before reading anything large; the ranges live in SnowfallOptions::validate().
@@ -80,6 +119,10 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
     for (const auto& mesh : object_mesh_paths(c.objects, "objects file")) inputs.push_back(mesh);
   }
   OutputSet outputs({c.output, c.cover, c.surface, c.mesh_out}, inputs);
+  if (o.block > 0 && o.direct_stabilise) {
+    run_snowfall_in_blocks(c, o, outputs);
+    return;
+  }
   const terrain::HeightField ground = terrain::read_raster(c.ground);
   require_metric_crs(ground, c.ground);
   const std::vector<terrain::PlacedMesh> objects =
@@ -138,7 +181,14 @@ void snowfall_flags(CLI::App* sub, SnowfallCommand* c) {
              "or direct (in one step, near-linear cost; docs/snowfall.md)");
   sub->add_option("--block", c->block,
                   "sweep the ground's occlusion on blocks of N cells a side with their halo "
-                  "(the same result; ground without objects, --occlusion sweep); 0: one pass")
+                  "(the same result; ground without objects, --occlusion sweep); with "
+                  "--stabilise direct the snow is also settled, read and written block by "
+                  "block (rasters larger than memory); 0: one pass")
+      ->capture_default_str();
+  sub->add_option("--halo", c->halo,
+                  "with --block and --stabilise direct: cells around a block that its window "
+                  "also settles (doubled where snow moves near the window's edge)")
+      ->check(CLI::Range(0, 1 << 20))
       ->capture_default_str();
   c->parameters.add_to(*sub);
   add_seed_option(*sub, c->seed);

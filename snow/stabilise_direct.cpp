@@ -144,7 +144,7 @@ struct Spill {
 };
 
 Spill heap_at(const Field& f, std::size_t p, double mass, std::vector<std::uint8_t>& seen,
-              std::vector<std::size_t>& region) {
+              std::vector<std::size_t>& region, std::uint8_t* marks) {
   using Item = std::pair<double, std::size_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> flood;
   std::vector<std::size_t> touched;
@@ -189,6 +189,7 @@ Spill heap_at(const Field& f, std::size_t p, double mass, std::vector<std::uint8
   const double film = spill.mass > 0.0 ? std::max(1e-9, 1e-7 * (1.0 + std::abs(apex))) : 1e-9;
   double total = 0.0, withheld = 0.0;
   for (std::size_t c : region) {
+    if (marks) marks[c] = 1;
     double add = apex - t_of(c);
     if (!(add > film)) {
       if (spill.mass > 0.0 && add > 0.0) withheld += add;
@@ -221,7 +222,7 @@ std::size_t runs_to(const Field& f, std::size_t i) {
 void route_shared(const Field& f, const std::vector<std::uint32_t>& cut_cells,
                   const std::vector<double>& loose, const std::vector<std::uint8_t>& cut,
                   std::vector<double>& load, std::vector<std::uint32_t>& heaps,
-                  DirectReport& report) {
+                  DirectReport& report, std::uint8_t* touched) {
   using Item = std::pair<double, std::uint32_t>;
   std::priority_queue<Item> queue;                // highest surface first; ties by index
   std::vector<double>& flow = load;               // pending inflow; becomes the load where it rests
@@ -236,6 +237,7 @@ void route_shared(const Field& f, const std::vector<std::uint32_t>& cut_cells,
   while (!queue.empty()) {
     const std::uint32_t i = queue.top().second;
     queue.pop();
+    if (touched) touched[i] = 1;  // snow passed or rests here
     const double hi = f.surface(i), slack = 1e-9 * (1.0 + std::abs(hi));
     int m = 0;
     double sum = 0.0, best = -std::numeric_limits<double>::infinity();
@@ -268,7 +270,9 @@ void route_shared(const Field& f, const std::vector<std::uint32_t>& cut_cells,
 }  // namespace
 
 DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
-                            double dx, double dy, double tan_repose, int layers) {
+                            double dx, double dy, double tan_repose, int layers,
+                            std::vector<std::uint8_t>* touched) {
+  if (touched && touched->size() != snow.size()) touched->assign(snow.size(), 0);
   if (layers < 1) throw Error("settle_at_rest: the number of layers must be at least 1");
   if (layers > 1) {
     // Each layer is all / layers, the last what the others left (summed the
@@ -287,7 +291,7 @@ DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<do
         }
         snow.values()[i] += layer;
       }
-      const DirectReport r = settle_at_rest(ground, snow, dx, dy, tan_repose, 1);
+      const DirectReport r = settle_at_rest(ground, snow, dx, dy, tan_repose, 1, touched);
       report.cut_cells += r.cut_cells, report.heaps += r.heaps, report.spills += r.spills;
       report.loose += r.loose;
     }
@@ -310,12 +314,14 @@ DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<do
     f.snow(i) = std::max(drained_then_load[i] - f.ground(i), 0.0);
     loose.push_back(before - f.snow(i));
     cut[i] = 1;
+    if (touched) (*touched)[i] = 1;
     cut_cells.push_back(static_cast<std::uint32_t>(i));
   }
   std::vector<double>& load = drained_then_load;
   std::fill(load.begin(), load.end(), 0.0);
   std::vector<std::uint32_t> heaps;
-  route_shared(f, cut_cells, loose, cut, load, heaps, report);
+  std::uint8_t* const marks = touched ? touched->data() : nullptr;
+  route_shared(f, cut_cells, loose, cut, load, heaps, report, marks);
   // Heaps in ascending cell order; spilled snow queued at its new resting
   // cell (a fixed order, so the same bits on any machine).
   std::set<std::size_t> queue(heaps.begin(), heaps.end());
@@ -328,7 +334,7 @@ DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<do
     const double mass = load[p];
     load[p] = 0.0;
     if (!(mass > 0.0)) continue;
-    const Spill spill = heap_at(f, p, mass, seen, region);
+    const Spill spill = heap_at(f, p, mass, seen, region, marks);
     if (spill.mass > 0.0) {
       ++report.spills;
       std::size_t r = runs_to(f, spill.from);

@@ -42,6 +42,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "terrain/grid.h"
 
@@ -62,7 +64,14 @@ struct DirectReport {
 // passes' deposits do, and each heap is small, so the order heaps are built
 // in matters less. Cost x layers; docs/snowfall.md gives the distance to the
 // passes' state against the number of layers.
+//
+// touched (optional): set to 1 at every cell the run cut, routed snow
+// through or heaped onto (the cells whose snow it may have changed, and those
+// snow passed over on its way); sized to the grid if it is not. The block by
+// block run (snow/snowfall_blocks.h) reads it to know how far a window's
+// snow moved.
 DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
-                            double dx, double dy, double tan_repose, int layers = 1);
+                            double dx, double dy, double tan_repose, int layers = 1,
+                            std::vector<std::uint8_t>* touched = nullptr);
 
 }  // namespace drift::snow

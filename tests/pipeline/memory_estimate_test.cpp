@@ -237,6 +237,26 @@ TEST(MemoryEstimate, SnowFallOnGroundThatNeverSlides) {
                                    run_measured("snow fall gentle_big.tif --maps 2 -o g1.tif", d));
 }
 
+TEST(MemoryEstimate, SnowFallBlockByBlock) {
+  DRIFT_SKIP_UNDER_SANITIZER();
+  // --block with --stabilise direct holds one window (the block, the
+  // stabilisation's halo and the occlusion's) and a bit a cell of the raster,
+  // not the raster: the estimate counts the window (snow/snowfall_blocks.h).
+  // Slopes up to about 37 degrees: the windows keep their first halo.
+  const fs::path d = dir();
+  auto hills = [](int n) {
+    return drift::testing::dem_from(n, 1.0, 0.5, [](double x, double y) {
+      return 1000 + 6 * std::sin(x / 17.0) + 5 * std::cos(y / 13.0);
+    });
+  };
+  drift::terrain::write_geotiff(hills(64), d / "blocks_small.tif", {"height", "m"});
+  drift::terrain::write_geotiff(hills(3000), d / "blocks_big.tif", {"height", "m"});
+  const std::string args = " --maps 1 --spread 0 --stabilise direct -o ";
+  expect_estimate_within_a_quarter(
+      run_measured("snow fall blocks_small.tif --block 32" + args + "b0.tif", d),
+      run_measured("snow fall blocks_big.tif --block 1024" + args + "b1.tif", d));
+}
+
 TEST(MemoryEstimate, MergeInfoAndMesh) {
   DRIFT_SKIP_UNDER_SANITIZER();
   // merge counted its merged frame and held the tiles beside it (0.51); info
