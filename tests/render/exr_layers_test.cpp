@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 #include <ogr_spatialref.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <numeric>
 #include <regex>
 
 #include "render/cryptomatte.h"
@@ -153,6 +155,39 @@ TEST(Cryptomatte, HashesAndIdsFollowTheSpecification) {
   for (int i = 0; i < 20000; ++i) {
     const float id = cryptomatte_id("name" + std::to_string(i));
     ASSERT_TRUE(std::isnormal(id)) << i;
+  }
+}
+
+// A pixel's (ID, coverage) pairs: heaviest first, ties in name order (the
+// empty ID last among equals), as a stable sort by coverage gives them;
+// for few names (rank_coverage's insertion sort) and for many (its
+// std::stable_sort), with many ties.
+TEST(Cryptomatte, RanksByCoverageTiesInNameOrder) {
+  for (const std::size_t n : {std::size_t{7}, std::size_t{45}}) {
+    CryptomatteLayer layer;
+    layer.type = "CryptoMaterial";
+    std::vector<float> ids, weights;
+    for (std::size_t i = 0; i < n; ++i) {
+      layer.names.push_back("m" + std::to_string(i));
+      ids.push_back(cryptomatte_id(layer.names.back()));
+      weights.push_back(static_cast<float>((i * 7) % 4) * 0.05f);  // four values, many ties
+    }
+    const float empty = 0.05f;  // ties with names too
+    layer.ranks = ranks_for(n);
+    std::vector<float> out(2 * static_cast<std::size_t>(layer.ranks), -1.0f);
+    rank_coverage(layer, ids, weights.data(), empty, out.data());
+    std::vector<std::size_t> expected(n + 1);
+    std::iota(expected.begin(), expected.end(), std::size_t{0});
+    const auto w = [&](std::size_t i) { return i == n ? empty : weights[i]; };
+    std::stable_sort(expected.begin(), expected.end(),
+                     [&](std::size_t a, std::size_t b) { return w(a) > w(b); });
+    for (int r = 0; r < layer.ranks; ++r) {
+      const std::size_t k = static_cast<std::size_t>(r);
+      const bool shown = k < expected.size() && w(expected[k]) > 0.0f;
+      const float id = !shown || expected[k] == n ? 0.0f : ids[expected[k]];
+      EXPECT_EQ(out[2 * k], id) << n << " names, rank " << r;
+      EXPECT_EQ(out[2 * k + 1], shown ? w(expected[k]) : 0.0f) << n << " names, rank " << r;
+    }
   }
 }
 
