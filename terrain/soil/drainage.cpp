@@ -30,7 +30,8 @@ void drain_moisture(SoilState& s, const SoilType& soil, double dt) {
       float* rho = s.rho.data() + c;
       float* wet = s.wet.data() + c;
       bool any = false;
-      for (int z = 0; z < g.nz && !any; ++z) any = rho[z] > kMinSoil && wet[z] > 0;
+      // Moisture first: a dry column is then read in one field, not two.
+      for (int z = 0; z < g.nz && !any; ++z) any = wet[z] > 0 && rho[z] > kMinSoil;
       if (!any) continue;
       // down[z]: water from voxel z into voxel z - 1, from the old state.
       std::fill(down.begin(), down.end(), 0.0f);

@@ -68,6 +68,20 @@ bool Primitive::misses_ball(const Vector3d& p, double r) const {
   return false;
 }
 
+bool Primitive::holds_ball(const Vector3d& p, double r) const {
+  const Vector3d q = p - center;
+  switch (kind) {
+    case PrimitiveKind::Sphere:
+      return q.norm() + r <= size.x();
+    case PrimitiveKind::Cuboid:
+      return (q.cwiseAbs().array() + r <= size.array()).all();
+    case PrimitiveKind::Cylinder:
+      return std::abs(q.z()) + r <= size.z() && std::hypot(q.x(), q.y()) + r <= size.x();
+    default:
+      return false;
+  }
+}
+
 Vector3d Primitive::lower() const {
   switch (kind) {
     case PrimitiveKind::Sphere:
@@ -252,6 +266,14 @@ using Polygon = std::vector<Vector3d>;
 // bound and closes the cut with a cap face (outward, counter-clockwise seen
 // from outside). Faces are counter-clockwise seen from outside.
 void clip_polyhedron(std::vector<Polygon>& faces, int axis, double side, double bound) {
+  // Wholly inside the plane (every corner strictly): the loop below would
+  // keep every face as it is and find no cap, so nothing to do. Most of a
+  // boundary voxel's six planes do not cut it, and building the copies was
+  // most of a turned blade's coverage (issue 33's follow-up).
+  bool cuts = false;
+  for (const Polygon& f : faces)
+    for (const Vector3d& a : f) cuts = cuts || side * a[axis] - bound >= 0;
+  if (!cuts) return;
   std::vector<Polygon> kept;
   Polygon cut;  // the points on the plane: the cap's corners
   for (const Polygon& f : faces) {
@@ -280,10 +302,19 @@ void clip_polyhedron(std::vector<Polygon>& faces, int axis, double side, double 
     Vector3d mid = Vector3d::Zero();
     for (const Vector3d& p : cut) mid += p;
     mid /= static_cast<double>(cut.size());
-    std::sort(cut.begin(), cut.end(), [&](const Vector3d& a, const Vector3d& b) {
-      return std::atan2(a[v] - mid[v], a[u] - mid[u]) < std::atan2(b[v] - mid[v], b[u] - mid[u]);
-    });
-    kept.push_back(std::move(cut));
+    // Each corner's angle once (the sort's comparisons called atan2 twice
+    // each: a third of a turned blade's coverage); sorting their indices by
+    // the same keys makes the same comparisons, so the same order.
+    std::vector<double> angle(cut.size());
+    std::vector<int> order(cut.size());
+    for (std::size_t k = 0; k < cut.size(); ++k) {
+      angle[k] = std::atan2(cut[k][v] - mid[v], cut[k][u] - mid[u]);
+      order[k] = static_cast<int>(k);
+    }
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return angle[a] < angle[b]; });
+    Polygon cap(cut.size());
+    for (std::size_t k = 0; k < cut.size(); ++k) cap[k] = cut[order[k]];
+    kept.push_back(std::move(cap));
   }
   faces = std::move(kept);
 }
@@ -507,6 +538,32 @@ double coverage(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi
   return refined_share(solid, lo, hi, kRefineDepth);
 }
 
+namespace {
+// refined_share's answer for a voxel, decided first by its bounding ball
+// alone where that suffices (issue 33's follow-up: most voxels of a turned
+// body's box lie wholly inside or outside it, and classify turned all eight
+// corners into the body's frame and tested each). A ball that one convex
+// primitive holds, with a margin far above the rounding of the corners'
+// transform, means that primitive holds all eight corners: refined_share
+// gives 1. Without a mesh, a ball every primitive misses (the very centre,
+// radius and test classify uses) means it gives 0. Else refined_share
+// itself: the shares are its, bit for bit
+// (`SoilPrimitives.BallShortcutGivesRefinedShareBitForBit`).
+double voxel_share(const PlacedSolid& solid, const Vector3d& lo, const Vector3d& hi) {
+  const Vector3d centre = solid.pose.to_body(0.5 * (lo + hi));
+  const double radius = 0.5 * (hi - lo).norm();
+  const double margin =
+      1e-9 * (radius + centre.norm() + solid.pose.position.norm() + (0.5 * (lo + hi)).norm());
+  bool missed = !solid.mesh;
+  for (const Primitive& p : *solid.primitives) {
+    if (p.holds_ball(centre, radius + margin)) return 1.0;
+    missed = missed && p.misses_ball(centre, radius);
+  }
+  if (missed) return 0.0;
+  return refined_share(solid, lo, hi, kRefineDepth);
+}
+}  // namespace
+
 void for_each_covered_voxel(const PlacedSolid& solid, const terrain::Grid3Shape& shape,
                             const std::function<void(std::size_t, float)>& fill) {
   if (plain(solid))
@@ -514,7 +571,7 @@ void for_each_covered_voxel(const PlacedSolid& solid, const terrain::Grid3Shape&
   const VoxelBox box = voxel_box(solid, shape);
   if (box.empty()) return;
   fill_box(box, shape, fill,
-           [&](const Vector3d& lo, const Vector3d& hi) { return coverage(solid, lo, hi); });
+           [&](const Vector3d& lo, const Vector3d& hi) { return voxel_share(solid, lo, hi); });
 }
 
 void add_coverage(const PlacedSolid& solid, const terrain::Grid3Shape& shape,

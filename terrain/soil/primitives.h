@@ -38,6 +38,9 @@ struct Primitive {
   bool inside(const Eigen::Vector3d& p) const;  // p relative to the object's position
   // True if no point within r of p is inside (conservative for the ellipsoid).
   bool misses_ball(const Eigen::Vector3d& p, double r) const;
+  // True if every point within r of p is inside (sphere, cuboid, cylinder;
+  // false, undecided, for the ellipsoid and the cone).
+  bool holds_ball(const Eigen::Vector3d& p, double r) const;
   Eigen::Vector3d lower() const;  // bounding box
   Eigen::Vector3d upper() const;
 };

@@ -127,7 +127,7 @@ std::uint64_t soil_run_bytes(const terrain::Grid3Shape& shape) {
 }
 
 std::uint64_t Slippage::bytes_per_column() {
-  return HeightSpans::kMaxSpans * sizeof(HeightSpan) + sizeof(std::uint8_t) +
+  return HeightSpans::kMaxSpans * sizeof(HeightSpan) + 2 * sizeof(std::uint8_t) +
          kMaxPiles * (kDirections * sizeof(Out) + 2 * sizeof(float) + sizeof(std::int8_t) +
                       5 * sizeof(int));
 }
@@ -146,7 +146,8 @@ Slippage::Slippage(const terrain::Grid3Shape& shape)
       pile_wet_(shape.columns() * kMaxPiles, 0.0f),
       out_wet_(shape.columns() * kMaxPiles, 0.0f),
       out_from_(shape.columns() * kMaxPiles, -1),
-      overfilled_(shape.columns(), 0) {}
+      overfilled_(shape.columns(), 0),
+      sends_(shape.columns(), 0) {}
 
 void Slippage::step(SoilState& state, const SoilType& soil, double gravity, double dt) {
   build_height_spans(shape_, state.rho, state.psi, spans_);
@@ -429,20 +430,26 @@ void Slippage::apply(SoilState& state) {
       float* rho = state.rho.data() + col * nz;
       const float* wet = state.wet.data() + col * nz;
       const HeightSpan* spans = spans_.column(col);
+      bool gives = false;
       for (int pile = 0; pile < kMaxPiles; ++pile) {
         const std::size_t node = col * kMaxPiles + pile;
         out_from_[node] = -1;
         // NOLINTNEXTLINE(bugprone-signed-char-misuse): an int8_t index, -1 none
         const int s = pile_span_[node];
-        if (s < 0) continue;
+        if (s < 0) continue;  // its slots hold dh = 0 (compute_slices)
         float out = 0;
-        for (int d = 0; d < kDirections; ++d) out += out_[slot(col, pile, d)].dh;
+        for (int d = 0; d < kDirections; ++d) {
+          const float dh = out_[slot(col, pile, d)].dh;
+          out += dh;
+          gives |= dh > 0;
+        }
         if (out <= 0) continue;
         const HeightSpan& p = spans[s];
         const double water = remove_down(
             rho, wet, p.top_voxel, std::max(0, static_cast<int>(p.bottom)), out, out_from_[node]);
         out_wet_[node] = static_cast<float>(water / out);
       }
+      sends_[col] = gives;
     }
   });
   // Then every pile gathers what its 16 neighbours send, in a fixed order,
@@ -465,6 +472,9 @@ void Slippage::apply(SoilState& state) {
         const int sx = x - kDx[d], sy = y - kDy[d];  // sender sends along d to us
         if (sx < 0 || sy < 0 || sx >= shape_.nx || sy >= shape_.ny) continue;
         const std::size_t scol = static_cast<std::size_t>(sy) * shape_.nx + sx;
+        // Most columns give nothing: their 64 slots are not read (what is
+        // skipped has dh <= 0, so the sums keep their order and bits).
+        if (!sends_[scol]) continue;
         for (int p = 0; p < kMaxPiles; ++p) {
           const Out& o = out_[slot(scol, p, d)];
           if (o.dh <= 0) continue;

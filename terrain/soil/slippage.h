@@ -138,6 +138,7 @@ class Slippage {
   std::vector<float> pile_wet_;                     // per node: moisture of the pile's upper third
   std::vector<float> out_wet_;                      // per node: moisture of what it gave
   std::vector<int> out_from_;                       // per node: lowest voxel it gave from
+  std::vector<std::uint8_t> sends_;                 // per column: some pile gives soil
   std::vector<std::uint8_t> overfilled_;            // per column
   bool any_overfilled_ = false;
 };

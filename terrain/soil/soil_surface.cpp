@@ -170,20 +170,35 @@ float moisture_at(const SoilState& s, const Eigen::Vector3f& p) {
   // where rho crosses 0.5, so half its corner voxels are (nearly) empty and
   // must not dilute the moisture; a second ring covers a vertex whose corners
   // hold no soil at all (the ridge fix and the floor pad move the surface).
+  // The axes' weights are computed once per corner row (not per corner:
+  // 1.9 ms of a 64^3 frame went here), in the same expression and product
+  // order as before, so the wetness keeps its bits.
   for (int ring = 0; ring <= 1; ++ring) {
+    const int n = 2 + 2 * ring;
+    double wx[4], wy[4], wz[4];
+    for (int k = 0; k < n; ++k) {
+      wx[k] = std::max(0.0, 1 - std::abs(gx - (x0 - ring + k)) / (1 + ring));
+      wy[k] = std::max(0.0, 1 - std::abs(gy - (y0 - ring + k)) / (1 + ring));
+      wz[k] = std::max(0.0, 1 - std::abs(gz - (z0 - ring + k)) / (1 + ring));
+    }
     double w = 0, wm = 0;
-    for (int z = z0 - ring; z <= z0 + 1 + ring; ++z)
-      for (int y = y0 - ring; y <= y0 + 1 + ring; ++y)
-        for (int x = x0 - ring; x <= x0 + 1 + ring; ++x) {
-          if (!g.contains(x, y, z)) continue;
+    for (int kz = 0; kz < n; ++kz) {
+      const int z = z0 - ring + kz;
+      if (z < 0 || z >= g.nz) continue;
+      for (int ky = 0; ky < n; ++ky) {
+        const int y = y0 - ring + ky;
+        if (y < 0 || y >= g.ny) continue;
+        for (int kx = 0; kx < n; ++kx) {
+          const int x = x0 - ring + kx;
+          if (x < 0 || x >= g.nx) continue;
           const std::size_t i = g.index(x, y, z);
           if (s.rho[i] <= 0) continue;
-          const double t = std::max(0.0, 1 - std::abs(gx - x) / (1 + ring)) *
-                           std::max(0.0, 1 - std::abs(gy - y) / (1 + ring)) *
-                           std::max(0.0, 1 - std::abs(gz - z) / (1 + ring)) * s.rho[i];
+          const double t = wx[kx] * wy[ky] * wz[kz] * s.rho[i];
           w += t;
           wm += t * s.wet[i];
         }
+      }
+    }
     if (w > 0) return static_cast<float>(wm / w);
   }
   return 0.0f;

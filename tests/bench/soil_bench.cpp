@@ -84,6 +84,32 @@ BENCHMARK(BM_SoilStepAndSurface)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
 
+// A fixed stretch of the push: the 120 frames (step plus incremental
+// surface) after the first 20 steps, the same work on every run (the
+// benchmarks above run as many steps as their time allows, and the push ends
+// after 154 steps, so their mean mixes pushing and settling). For comparing
+// binaries: CPU time (of 120 frames) and, under load, `perf stat -e
+// instructions`.
+void BM_SoilPushFrames(benchmark::State& state) {
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
+  for (auto _ : state) {
+    state.PauseTiming();
+    SoilSimulation sim = pushing(64);
+    SurfaceExtractor extractor;
+    extractor.extract(sim.state());
+    state.ResumeTiming();
+    for (int k = 0; k < 120; ++k) {
+      sim.step();
+      benchmark::DoNotOptimize(extractor.extract(sim.state()).triangle_count());
+    }
+  }
+}
+BENCHMARK(BM_SoilPushFrames)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+
 // The step alone on 1 or 2 threads (process CPU and wall).
 void BM_SoilStep(benchmark::State& state) {
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism,

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "terrain/error.h"
+#include "terrain/soil/solid_mesh.h"
 
 namespace drift::soil {
 namespace {
@@ -121,6 +122,60 @@ TEST(SoilPrimitives, TurnedCuboidCoverageIsExact) {
       }
   EXPECT_LT(worst, 1e-9);
   EXPECT_NEAR(total * h * h * h, 8 * 0.37 * 0.23 * 0.31, 1e-9);
+}
+
+// The voxelisation of a turned or mesh body decides most voxels by their
+// bounding ball alone (wholly inside one convex primitive: 1; missing every
+// primitive of a body without a mesh: 0) and refines only the rest. Its
+// shares must be refined_share's on every voxel, bit for bit: a turned
+// cuboid, cylinder, sphere and a union, and a box mesh, each at a pose a
+// fraction of a voxel off the lattice (the push's blade moves a quarter of
+// a voxel a step), as the fresh computation gives them.
+TEST(SoilPrimitives, BallShortcutGivesRefinedShareBitForBit) {
+  const terrain::Grid3Shape g{36, 34, 30, 0.1, {-0.013, 0.021, -0.007}};
+  drift::terrain::Mesh box;
+  for (int c = 0; c < 8; ++c)
+    box.positions.emplace_back(c & 1 ? 0.4f : -0.4f, c & 2 ? 0.7f : -0.7f, c & 4 ? 0.5f : -0.5f);
+  box.triangles = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                   {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  const SolidMesh mesh(box, 0.05, "box");
+  const std::vector<std::vector<Primitive>> bodies = {
+      {{PrimitiveKind::Cuboid, {0.02, -0.03, 0.01}, {0.37, 0.73, 0.51}}},
+      {{PrimitiveKind::Cylinder, {0, 0, 0}, {0.63, 0, 0.47}}},
+      {{PrimitiveKind::Sphere, {0.1, 0, 0}, {0.71, 0, 0}}},
+      {{PrimitiveKind::Cuboid, {0, 0, -0.3}, {0.6, 0.4, 0.2}},
+       {PrimitiveKind::Cylinder, {0, 0, 0.2}, {0.35, 0, 0.4}}},
+      {}};
+  const std::vector<double> turns = {0.0, 20.0, 47.0};
+  int checked = 0, inside = 0;
+  for (std::size_t b = 0; b < bodies.size(); ++b)
+    for (const double turn : turns) {
+      if (turn == 0.0 && b + 1 < bodies.size()) continue;  // unturned primitives: closed form
+      Pose pose;
+      pose.position = {1.8 + 0.025 * static_cast<double>(b), 1.7 - 0.0125 * turn / 20, 1.4};
+      pose.rotation = (Eigen::AngleAxisd(turn * M_PI / 180, Eigen::Vector3d::UnitZ()) *
+                       Eigen::AngleAxisd(0.4 * turn * M_PI / 180, Eigen::Vector3d::UnitX()))
+                          .toRotationMatrix();
+      const PlacedSolid solid{&bodies[b], b + 1 == bodies.size() ? &mesh : nullptr, pose};
+      std::vector<float> got(g.count(), -1.0f);
+      for_each_covered_voxel(solid, g, [&got](std::size_t i, float c) { got[i] = c; });
+      const VoxelBox vb = voxel_box(solid, g);
+      for (int y = vb.lo.y(); y < vb.hi.y(); ++y)
+        for (int x = vb.lo.x(); x < vb.hi.x(); ++x)
+          for (int z = vb.lo.z(); z < vb.hi.z(); ++z) {
+            const Eigen::Vector3d lo = g.origin + g.voxel_size * Eigen::Vector3d(x, y, z);
+            const auto fresh = static_cast<float>(refined_share(
+                solid, lo, lo + Eigen::Vector3d::Constant(g.voxel_size), kRefineDepth));
+            const std::size_t i = g.index(x, y, z);
+            ASSERT_EQ(fresh > 0 ? fresh : -1.0f, got[i])
+                << "body " << b << " turned " << turn << " at voxel " << x << ", " << y << ", "
+                << z;
+            ++checked;
+            inside += fresh == 1.0f;
+          }
+    }
+  EXPECT_GT(checked, 50000);
+  EXPECT_GT(inside, 5000);
 }
 
 // Curved and several primitives converge to the exact share with a bound
