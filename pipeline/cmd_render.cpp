@@ -456,75 +456,8 @@ void add_product_flags(CLI::App& sub, RenderOptions& o) {
 
 }  // namespace
 
-void render_flags(CLI::App* sub, RenderOptions* o) {
-  sub->add_option("scene", o->scene, "scene file (TOML); see docs/rendering.md")->required();
-  sub->add_option("--set", o->variables,
-                  "NAME=VALUE: ${NAME} in the scene file's strings becomes VALUE (overrides its "
-                  "[variables]; e.g. --set OUT=build/out for the products it reads)")
-      ->allow_extra_args(false);  // one NAME=VALUE a flag: a scene after it stays the scene
-  whole_in_range(sub->add_option("--spp", o->spp, "samples per pixel (overrides the scene)"), 1,
-                 render::RenderSettings::kMaxSamplesPerPixel);
-  sub->add_option("--noise-target", o->noise_target,
-                  "adaptive sampling: stop a pixel when the relative standard error of its "
-                  "luminance is below this (e.g. 0.02; 0 turns it off; --spp is the most)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--size", o->size, "image size WIDTHxHEIGHT (overrides the scene)");
-  sub->add_option("-o,--output", o->outputs,
-                  "output file(s), .png and/or .exr (override the scene)");
-  sub->add_option("--terrain", o->terrain, "terrain raster (overrides [terrain] raster)");
-  add_product_flags(*sub, *o);
-  sub->add_option("--tile", o->tile,
-                  "render only band INDEX/COUNT of the frame (0-based, e.g. 3/16), or block "
-                  "INDEX/CxR of a grid of C columns and R rows (row by row, e.g. 5/4x4), to EXR; "
-                  "join the tiles with drift merge (docs/rendering.md)");
-  sub->add_option("--sun-time", o->sun_time,
-                  "put the sun where it stands over the DEM at this local time, "
-                  "\"YYYY-MM-DD HH:MM[:SS] [UTC offset]\" (e.g. \"2026-10-15 17:05 +09:00\"; "
-                  "default offset UTC); overrides [sun] azimuth/elevation or date/time");
-  sub->add_option(
-         "--exposure", o->exposure_ev,
-         "fixed exposure of the PNG in EV instead of the meter (overrides [output] exposure; "
-         "EXR stays linear)")
-      ->check(CLI::Range(-render::DisplayTransform::kMaxEv, render::DisplayTransform::kMaxEv));
-  sub->add_option("--exposure-compensation", o->compensation_ev,
-                  "EV added to the metered exposure (overrides [output] exposure_compensation)")
-      ->check(CLI::Range(-render::DisplayTransform::kMaxEv, render::DisplayTransform::kMaxEv));
-  sub->add_option("--time", o->time,
-                  "render the camera path ([[camera.keyframe]] or --camera-path) at this time, "
-                  "seconds (default: its first key)");
-  sub->add_option("--camera-path", o->camera_path,
-                  "a TOML file of [[camera.keyframe]] entries (time, from/from_lonlat, "
-                  "to/to_lonlat, fov) replacing the scene's camera");
-  sub->add_flag("--sidecar", o->sidecar,
-                "also write the frame's ground truth as JSON beside the first image output "
-                "(NAME.json: size, intrinsics, pose, sun, CRS, Cryptomatte IDs); -o NAME.json "
-                "names it");
-  sub->add_option("--from", o->from, "where the camera stands, X,Y,Z in the DEM's CRS (with --to)");
-  sub->add_option("--to", o->to, "where the camera looks, X,Y,Z in the DEM's CRS (with --from)");
-  sub->add_flag("--map", o->map,
-                "render a map: straight down over the DEM (or --map-box) at --cell metres a "
-                "pixel, georeferenced (.tif GeoTIFF; .png with a world file and .aux.xml)");
-  sub->add_option("--map-box", o->map_box,
-                  "the map's box WEST,SOUTH,EAST,NORTH in the DEM's CRS (implies --map; default "
-                  "the DEM's extent)");
-  sub->add_option("--cell", o->cell,
-                  "the map's cell size in metres (implies --map; default the "
-                  "DEM's)")
-      ->check(CLI::Range(1e-3, 1e6));
-  sub->add_option("--memory-budget", o->memory_budget,
-                  "render the terrain out of core: read its full-resolution heights in pages "
-                  "(e.g. from a VRT or tiled GeoTIFF of any size) through a cache of at most "
-                  "BYTES (e.g. 4G, 512M; docs/rendering.md); distant ground is traced at "
-                  "coarser levels by the pixel's footprint");
-  sub->add_flag("--full-resolution", o->full_resolution,
-                "with --memory-budget: trace every cell at full resolution (no level of detail)");
-  sub->add_option("--height-bits", o->height_bits,
-                  "16: hold the DEM in core as 16-bit heights quantised over each 16x16 block's "
-                  "range (2 B a cell instead of 4; error at most range/65535/2 a block, "
-                  "docs/rendering.md); 32 (default): float")
-      ->check(CLI::IsMember({16, 32}));
-  add_seed_option(*sub, o->seed);
-}
+// The flags, as data: pipeline/cmd_render_flags.toml.
+#include "pipeline/cmd_render_flags.inc"
 
 DRIFT_COMMAND(70, "render", "path-trace a scene file (TOML) to EXR and/or PNG", render_flags,
               run_render);

@@ -344,6 +344,19 @@ struct LodEntry {
 };
 constexpr std::size_t kLodEntries = 512;
 
+// A block's side x side nodes of one level of its tree (nx x ny nodes, row by
+// row), from node (x0, y0); empty ({inf, -inf}) beyond the level's edge.
+template <int side>
+void block_nodes(const HeightFieldBlocks::MinMax* nodes, int nx, int ny, int x0, int y0,
+                 HeightFieldBlocks::MinMax (&out)[side][side]) {
+  for (int j = 0; j < side; ++j)
+    for (int i = 0; i < side; ++i) {
+      const int x = x0 + i, y = y0 + j;
+      out[j][i] = x < nx && y < ny ? nodes[static_cast<std::size_t>(y) * nx + x]
+                                   : HeightFieldBlocks::MinMax{kInf, -kInf};
+    }
+}
+
 }  // namespace
 
 void HeightFieldBlocks::view_block(int bx, int by, BlockView& view) const {
@@ -360,22 +373,9 @@ void HeightFieldBlocks::view_block(int bx, int by, BlockView& view) const {
     if (!source_) {
       view.page = {0, 0, static_cast<std::size_t>(grid_->width), grid_->z.data()};
       if (quantised()) view.page = {0, 0, 0, nullptr, nullptr, 0, &quantised_};
-      for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) {
-          const int lx = bx * 4 + i, ly = by * 4 + j;
-          view.tree.leaf[j][i] =
-              lx < levels_[0].nx && ly < levels_[0].ny
-                  ? levels_[0].nodes[static_cast<std::size_t>(ly) * levels_[0].nx + lx]
-                  : MinMax{kInf, -kInf};
-        }
-      for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) {
-          const int mx = bx * 2 + i, my = by * 2 + j;
-          view.tree.mid[j][i] =
-              mx < levels_[1].nx && my < levels_[1].ny
-                  ? levels_[1].nodes[static_cast<std::size_t>(my) * levels_[1].nx + mx]
-                  : MinMax{kInf, -kInf};
-        }
+      const Level &leaves = levels_[0], &mids = levels_[1];
+      block_nodes(leaves.nodes.data(), leaves.nx, leaves.ny, bx * 4, by * 4, view.tree.leaf);
+      block_nodes(mids.nodes.data(), mids.nx, mids.ny, bx * 2, by * 2, view.tree.mid);
       return;
     }
     view.page = page_of_block();
@@ -383,12 +383,8 @@ void HeightFieldBlocks::view_block(int bx, int by, BlockView& view) const {
     const auto* leaves = reinterpret_cast<const MinMax*>(view.page.tree);
     const MinMax* mids = leaves + static_cast<std::size_t>(n) * n;
     const int lx0 = (c0 - view.page.c0) / kLeaf, ly0 = (r0 - view.page.r0) / kLeaf;
-    for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < 4; ++i)
-        view.tree.leaf[j][i] = leaves[static_cast<std::size_t>(ly0 + j) * n + lx0 + i];
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i)
-        view.tree.mid[j][i] = mids[static_cast<std::size_t>(ly0 / 2 + j) * m + lx0 / 2 + i];
+    block_nodes(leaves, n, n, lx0, ly0, view.tree.leaf);
+    block_nodes(mids, m, m, lx0 / 2, ly0 / 2, view.tree.mid);
     return;
   }
   // At the level of detail: the block's vertices into the view's own page.

@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "snow/stabilise_field.h"
 #include "terrain/error.h"
-#include "terrain/neighbours.h"
 
 namespace drift::snow {
 
@@ -20,57 +20,7 @@ namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
-// Snow on ground as flat arrays, with the repose drop k d to each neighbour.
-class Field {
- public:
-  Field(const terrain::Grid<float>& ground, terrain::Grid<double>& snow, double dx, double dy,
-        double k)
-      : g_(ground.values().data()),
-        h_(snow.values().data()),
-        w_(snow.width()),
-        ht_(snow.height()),
-        dx_(dx),
-        dy_(dy),
-        diag_(std::hypot(dx, dy)),
-        k_(k) {
-    for (int n = 0; n < 8; ++n) {
-      drop_[n] = k * std::hypot(terrain::kNeighbours8[n].dx * dx, terrain::kNeighbours8[n].dy * dy);
-      offset_[n] = static_cast<std::ptrdiff_t>(terrain::kNeighbours8[n].dy) * w_ +
-                   terrain::kNeighbours8[n].dx;
-    }
-  }
-  std::size_t cells() const { return static_cast<std::size_t>(w_) * ht_; }
-  double ground(std::size_t i) const { return g_[i]; }
-  double& snow(std::size_t i) const { return h_[i]; }
-  double surface(std::size_t i) const { return static_cast<double>(g_[i]) + h_[i]; }
-  // Calls fn(neighbour, direction) for the 8-neighbours inside the grid, in a fixed order.
-  template <class Fn>
-  void neighbours(std::size_t i, const Fn& fn) const {
-    const int x = static_cast<int>(i % w_), y = static_cast<int>(i / w_);
-    for (int n = 0; n < 8; ++n) {
-      const int nx = x + terrain::kNeighbours8[n].dx, ny = y + terrain::kNeighbours8[n].dy;
-      if (nx >= 0 && ny >= 0 && nx < w_ && ny < ht_) fn(i + offset_[n], n);
-    }
-  }
-  double drop(int n) const { return drop_[n]; }
-  // The cone's drop from its apex p to i: k x the 8-neighbour path distance
-  // (diagonal steps, then straight ones), so that it falls by exactly drop(n)
-  // or less along every step.
-  double cone_drop(std::size_t p, std::size_t i) const {
-    const long ax = std::labs(static_cast<long>(i % w_) - static_cast<long>(p % w_));
-    const long ay = std::labs(static_cast<long>(i / w_) - static_cast<long>(p / w_));
-    const long m = std::min(ax, ay);
-    return k_ * (m * diag_ + (ax - m) * dx_ + (ay - m) * dy_);
-  }
-
- private:
-  const float* g_;
-  double* h_;
-  int w_, ht_;
-  double dx_, dy_, diag_, k_;
-  std::array<double, 8> drop_{};
-  std::array<std::ptrdiff_t, 8> offset_{};
-};
+using Field = StabiliseField;
 
 // Step 1: the drained surface (greatest fixed point of E = min(H, max(ground,
 // min_n E(n) + k d))). Labels only fall, and a label set from a popped one is

@@ -9,7 +9,7 @@
 #include <queue>
 #include <utility>
 
-#include "terrain/neighbours.h"
+#include "snow/stabilise_field.h"
 
 namespace drift::snow {
 
@@ -17,34 +17,12 @@ namespace {
 
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 
-// Snow on ground as flat arrays, with the repose drop to each neighbour.
-class SnowSurface {
+// The grid's snow (stabilise_field.h) with the settling's tolerances.
+class SnowSurface : public StabiliseField {
  public:
   SnowSurface(const terrain::Grid<float>& ground, terrain::Grid<double>& snow,
               const SettleGeometry& geo)
-      : g_(ground.values().data()),
-        h_(snow.values().data()),
-        w_(snow.width()),
-        hgt_(snow.height()),
-        geo_(geo) {
-    for (int k = 0; k < 8; ++k) {
-      drop_[k] = geo.tan_repose * std::hypot(terrain::kNeighbours8[k].dx * geo.dx,
-                                             terrain::kNeighbours8[k].dy * geo.dy);
-      offset_[k] = static_cast<std::ptrdiff_t>(terrain::kNeighbours8[k].dy) * w_ +
-                   terrain::kNeighbours8[k].dx;
-    }
-  }
-  std::size_t cells() const { return static_cast<std::size_t>(w_) * hgt_; }
-  double ground(std::size_t i) const { return g_[i]; }
-  double& snow(std::size_t i) const { return h_[i]; }
-  double surface(std::size_t i) const { return static_cast<double>(g_[i]) + h_[i]; }
-  bool inside(std::size_t i, int k) const {
-    const int x = static_cast<int>(i % w_) + terrain::kNeighbours8[k].dx,
-              y = static_cast<int>(i / w_) + terrain::kNeighbours8[k].dy;
-    return x >= 0 && y >= 0 && x < w_ && y < hgt_;
-  }
-  std::size_t neighbour(std::size_t i, int k) const { return i + offset_[k]; }
-  double drop(int k) const { return drop_[k]; }
+      : StabiliseField(ground, snow, geo.dx, geo.dy, geo.tan_repose), geo_(geo) {}
   double tolerance() const { return geo_.tolerance; }
   // Excess below which snow running off the cut comes to rest: 10 x tol (1 cm
   // at the default), so that a heap still settling counts as a resting place.
@@ -53,23 +31,9 @@ class SnowSurface {
   // snow running onto it stops there, at its upper edge, as the passes would
   // stop it, instead of running on down its flank.
   double deposit_depth() const { return 100.0 * geo_.tolerance; }
-  // Height of the cone of slope k with apex at p, at cell i, below the apex
-  // (the octagonal distance: diagonal steps, then straight ones).
-  double cone_drop(std::size_t p, std::size_t i) const {
-    const int ax = std::abs(static_cast<int>(i % w_) - static_cast<int>(p % w_));
-    const int ay = std::abs(static_cast<int>(i / w_) - static_cast<int>(p / w_));
-    const int m = std::min(ax, ay);
-    const double d = m * std::hypot(geo_.dx, geo_.dy) + (ax - m) * geo_.dx + (ay - m) * geo_.dy;
-    return geo_.tan_repose * d;
-  }
 
  private:
-  const float* g_;
-  double* h_;
-  int w_, hgt_;
   SettleGeometry geo_;
-  std::array<double, 8> drop_{};
-  std::array<std::ptrdiff_t, 8> offset_{};
 };
 
 // Step 1: the repose envelope (largest fixed point of E = max(ground, min(H,

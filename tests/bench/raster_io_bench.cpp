@@ -19,9 +19,7 @@ void BM_GeoTiffRoundTrip(benchmark::State& state) {
     auto back = drift::terrain::read_raster(path);
     benchmark::DoNotOptimize(back.data());
   }
-  state.counters["cells/s"] = benchmark::Counter(static_cast<double>(n) * n * state.iterations(),
-                                                 benchmark::Counter::kIsRate);
-  state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
+  drift::bench::report_cells(state, static_cast<double>(n) * n);
   std::filesystem::remove(path);
 }
 BENCHMARK(BM_GeoTiffRoundTrip)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);

@@ -32,12 +32,6 @@ HeightField relief(int n) {
   return dem;
 }
 
-void report(benchmark::State& state, double cells) {
-  state.counters["cells/s"] = benchmark::Counter(cells * static_cast<double>(state.iterations()),
-                                                 benchmark::Counter::kIsRate);
-  state.counters["peak_MiB"] = drift::bench::peak_resident_mib();
-}
-
 void BM_Import(benchmark::State& state) {
   const auto source =
       std::filesystem::path(DRIFT_SOURCE_DIR) / "data" / "yarigatake_gsi_dem10b_jgd2000.tif";
@@ -47,30 +41,25 @@ void BM_Import(benchmark::State& state) {
     cells = static_cast<double>(result.grid.size());
     benchmark::DoNotOptimize(result.grid.data());
   }
-  report(state, cells);
+  drift::bench::report_cells(state, cells);
 }
 BENCHMARK(BM_Import)->Unit(benchmark::kMillisecond);
 
-void BM_Slope(benchmark::State& state) {
-  const HeightField dem = relief(static_cast<int>(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(drift::terrain::slope_degrees(dem).data());
-  report(state, static_cast<double>(dem.size()));
+// A raster derived from the relief at 1024^2 and 4096^2: slope, normals,
+// pyramid, each a benchmark of this one loop.
+template <class Derive>
+void BM_Derived(benchmark::State& state, Derive derive) {
+  drift::bench::time_over_cells(state, relief(static_cast<int>(state.range(0))), derive);
 }
-BENCHMARK(BM_Slope)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
-
-void BM_Normals(benchmark::State& state) {
-  const HeightField dem = relief(static_cast<int>(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(drift::terrain::normals(dem).data());
-  report(state, static_cast<double>(dem.size()));
+void at_two_sizes(benchmark::internal::Benchmark* b) {
+  b->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
 }
-BENCHMARK(BM_Normals)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
-
-void BM_Pyramid(benchmark::State& state) {
-  const HeightField dem = relief(static_cast<int>(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(drift::terrain::pyramid(dem).size());
-  report(state, static_cast<double>(dem.size()));
-}
-BENCHMARK(BM_Pyramid)->Arg(1024)->Arg(4096)->Unit(benchmark::kMillisecond);
+const float* slope(const HeightField& d) { return drift::terrain::slope_degrees(d).data(); }
+const void* normals(const HeightField& d) { return drift::terrain::normals(d).data(); }
+std::size_t pyramid(const HeightField& d) { return drift::terrain::pyramid(d).size(); }
+BENCHMARK_CAPTURE(BM_Derived, slope, slope)->Apply(at_two_sizes);
+BENCHMARK_CAPTURE(BM_Derived, normals, normals)->Apply(at_two_sizes);
+BENCHMARK_CAPTURE(BM_Derived, pyramid, pyramid)->Apply(at_two_sizes);
 
 // drift mesh on the imported Yarigatake DEM (1151 x 959 cells): the full
 // mesh, and --decimate's RTIN at 0, 1 and 5 m (arg: centimetres; -1 = full),
@@ -91,7 +80,7 @@ void BM_HeightMesh(benchmark::State& state) {
     benchmark::DoNotOptimize(m.positions.data());
   }
   state.counters["triangles"] = static_cast<double>(triangles);
-  report(state, static_cast<double>(dem.size()));
+  drift::bench::report_cells(state, static_cast<double>(dem.size()));
 }
 BENCHMARK(BM_HeightMesh)->Arg(-1)->Arg(0)->Arg(100)->Arg(500)->Unit(benchmark::kMillisecond);
 

@@ -160,24 +160,29 @@ void scenario(const std::uint8_t* data, std::size_t size) {
   });
 }
 
+// What every mesh reader must hand on, whatever the bytes: finite vertices,
+// faces naming vertices that exist, an attribute value a vertex.
+void check_mesh(const terrain::Mesh& m, const std::string& reader) {
+  for (const auto& p : m.positions)
+    if (!p.allFinite()) throw std::logic_error(reader + " let a non-finite vertex through");
+  for (const auto& t : m.triangles)
+    for (int v : t)
+      if (v < 0 || static_cast<std::size_t>(v) >= m.positions.size())
+        throw std::logic_error(reader + " let a face name a missing vertex");
+  for (const auto& [name, values] : m.vertex_attributes)
+    if (values.size() != m.positions.size())
+      throw std::logic_error(reader + " gave attribute '" + name + "' a wrong length");
+}
+
 void obj(const std::uint8_t* data, std::size_t size) {
   const fs::path file = as_file(data, size, "mesh.obj");
-  refusals_allowed([&] {
-    const terrain::Mesh m = terrain::read_obj(file, size > 0 && data[0] % 2);
-    for (const auto& p : m.positions) {
-      if (!p.allFinite()) throw std::logic_error("read_obj let a non-finite vertex through");
-    }
-  });
+  refusals_allowed(
+      [&] { check_mesh(terrain::read_obj(file, size > 0 && data[0] % 2), "read_obj"); });
 }
 
 void ply(const std::uint8_t* data, std::size_t size) {
   const fs::path file = as_file(data, size, "mesh.ply");
-  refusals_allowed([&] {
-    const terrain::Mesh m = terrain::read_ply(file);
-    for (const auto& p : m.positions) {
-      if (!p.allFinite()) throw std::logic_error("read_ply let a non-finite vertex through");
-    }
-  });
+  refusals_allowed([&] { check_mesh(terrain::read_ply(file), "read_ply"); });
 }
 
 // Meshes through Assimp (terrain/mesh_assimp.cpp), the format by the bytes'
@@ -189,34 +194,13 @@ void mesh(const std::uint8_t* data, std::size_t size) {
                      : head.rfind("; FBX", 0) == 0 ? "mesh.fbx"
                                                    : "mesh.stl";
   const fs::path file = as_file(data, size, name);
-  refusals_allowed([&] {
-    const terrain::Mesh m = terrain::read_mesh(file);
-    for (const auto& p : m.positions) {
-      if (!p.allFinite()) throw std::logic_error("read_mesh let a non-finite vertex through");
-    }
-    for (const auto& t : m.triangles)
-      for (int v : t)
-        if (v < 0 || static_cast<std::size_t>(v) >= m.positions.size())
-          throw std::logic_error("read_mesh let a face name a missing vertex");
-  });
+  refusals_allowed([&] { check_mesh(terrain::read_mesh(file), "read_mesh"); });
 }
 
 // drift's own GLB reader (terrain/mesh_glb.cpp: --snow-objects x.glb).
 void glb(const std::uint8_t* data, std::size_t size) {
   const fs::path file = as_file(data, size, "mesh.glb");
-  refusals_allowed([&] {
-    const terrain::Mesh m = terrain::read_glb(file);
-    for (const auto& p : m.positions) {
-      if (!p.allFinite()) throw std::logic_error("read_glb let a non-finite vertex through");
-    }
-    for (const auto& t : m.triangles)
-      for (int v : t)
-        if (v < 0 || static_cast<std::size_t>(v) >= m.positions.size())
-          throw std::logic_error("read_glb let a face name a missing vertex");
-    for (const auto& [name, values] : m.vertex_attributes)
-      if (values.size() != m.positions.size())
-        throw std::logic_error("read_glb gave attribute '" + name + "' a wrong length");
-  });
+  refusals_allowed([&] { check_mesh(terrain::read_glb(file), "read_glb"); });
 }
 
 // EXR and PNG tiles as merge and compare read them.

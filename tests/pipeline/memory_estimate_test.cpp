@@ -98,6 +98,32 @@ void write_dem(const fs::path& path, int n, double cell) {
                                 path, {"height", "m"});
 }
 
+// NAME.tif, a DEM of n x n cells of `cell` m, and NAME.toml, a scene over it,
+// in `d` for each (NAME, n).
+void write_dems(const fs::path& d, std::initializer_list<std::pair<const char*, int>> dems,
+                double cell = 10.0) {
+  for (const auto& [name, n] : dems) {
+    write_dem(d / (std::string(name) + ".tif"), n, cell);
+    put(d / (std::string(name) + ".toml"), std::string("[terrain]\nraster = \"") + name +
+                                               ".tif\"\n[sun]\nazimuth = 120\nelevation = 35\n");
+  }
+}
+
+// `command` run twice in `d`, each `IN` in it the raster `small`, then `big`,
+// and each `@` 0, then 1 (the outputs): the estimate within a quarter of the
+// peak on both.
+void expect_on_small_and_big(const fs::path& d, const std::string& command,
+                             const std::string& small, const std::string& big) {
+  auto on = [&](const std::string& in, char index) {
+    std::string args = command;
+    for (auto at = args.find("IN"); at != std::string::npos; at = args.find("IN", at + in.size()))
+      args.replace(at, 2, in);
+    for (char& c : args) c = c == '@' ? index : c;
+    return run_measured(args, d);
+  };
+  expect_estimate_within_a_quarter(on(small, '0'), on(big, '1'));
+}
+
 // A layer of sand over a whole n x n x nz grid, one step.
 std::string soil_scenario(int n, int nz) {
   std::ostringstream s;
@@ -143,8 +169,7 @@ TEST(MemoryEstimate, RastersOfImportSnowCoverAndMarks) {
   DRIFT_SKIP_UNDER_SANITIZER();
   // marks had counted 29 bytes a cell and used about 74 (issue 34).
   const fs::path d = dir();
-  write_dem(d / "small.tif", 32, 10.0);
-  write_dem(d / "big.tif", 3072, 10.0);
+  write_dems(d, {{"small", 32}, {"big", 3072}});
   drift::terrain::HeightField ground = drift::testing::flat_utm_ground(32, 2000.0f, 0.01);
   drift::terrain::write_geotiff(ground, d / "g_small.tif", {"height", "m"});
   ground = drift::testing::flat_utm_ground(3072, 2000.0f, 0.01);
@@ -175,9 +200,8 @@ TEST(MemoryEstimate, ImagesOfRenderCompareAndSheet) {
   // compare counted one image (137 MiB at 3000 x 2000) and used 740 MiB for
   // SSIM's planes; render counted twice its image and used 1.47 times.
   const fs::path d = dir();
-  write_dem(d / "dem.tif", 32, 10.0);
-  put(d / "scene.toml", "[terrain]\nraster = \"dem.tif\"\n[sun]\nazimuth = 120\nelevation = 35\n");
-  const std::string render = "render scene.toml --spp 1 --size ";
+  write_dems(d, {{"dem", 32}});
+  const std::string render = "render dem.toml --spp 1 --size ";
   expect_estimate_within_a_quarter(run_measured(render + "16x8 -o small.png", d),
                                    run_measured(render + "2000x1500 -o big.png", d));
   expect_estimate_within_a_quarter(run_measured(render + "16x8 -o small.exr", d),
@@ -202,22 +226,28 @@ TEST(MemoryEstimate, DunesWithAndWithoutSnapshots) {
       run_measured("dunes --size 2500 --steps 2 --snapshot-every 1 -o s.tif", d));
 }
 
+// snow fall on ground of 1 m cells, 32^2 against 1400^2: 1000 m + `ax` m
+// sin(x / 17) + `ay` m cos(y / 13) (each estimate within a quarter).
+void expect_snow_fall_estimate(const std::string& name, double ax, double ay) {
+  const fs::path d = dir();
+  for (const int n : {32, 1400}) {
+    const drift::terrain::HeightField ground =
+        drift::testing::dem_from(n, 1.0, 0.5, [ax, ay](double x, double y) {
+          return 1000 + ax * std::sin(x / 17.0) + ay * std::cos(y / 13.0);
+        });
+    drift::terrain::write_geotiff(ground, d / (name + std::to_string(n) + ".tif"), {"height", "m"});
+  }
+  expect_on_small_and_big(d, "snow fall IN --maps 2 -o " + name + "@.tif", name + "32.tif",
+                          name + "1400.tif");
+}
+
 TEST(MemoryEstimate, SnowFallOnGroundWhereSnowSlides) {
   DRIFT_SKIP_UNDER_SANITIZER();
   // Stabilisation's workspace, the passes' and the shortcut's, is counted up
   // front: on ground steeper than the repose (where snow slides, as in
   // mountains) it is all allocated. On ground that never slides the shortcut
   // never runs and the peak is about 0.78 of the estimate (docs/outputs.md).
-  const fs::path d = dir();
-  auto steep = [](int n) {
-    return drift::testing::dem_from(n, 1.0, 0.5, [](double x, double y) {
-      return 1000 + 40 * std::sin(x / 17.0) + 35 * std::cos(y / 13.0);
-    });
-  };
-  drift::terrain::write_geotiff(steep(32), d / "steep_small.tif", {"height", "m"});
-  drift::terrain::write_geotiff(steep(1400), d / "steep_big.tif", {"height", "m"});
-  expect_estimate_within_a_quarter(run_measured("snow fall steep_small.tif --maps 2 -o s0.tif", d),
-                                   run_measured("snow fall steep_big.tif --maps 2 -o s1.tif", d));
+  expect_snow_fall_estimate("steep", 40.0, 35.0);
 }
 
 TEST(MemoryEstimate, SnowFallOnGroundThatNeverSlides) {
@@ -225,16 +255,7 @@ TEST(MemoryEstimate, SnowFallOnGroundThatNeverSlides) {
   // Gentle ground, below the repose everywhere: the shortcut never runs, so
   // its workspace is never allocated and must not be counted (it was: the
   // estimate was 1.28 times the peak).
-  const fs::path d = dir();
-  auto gentle = [](int n) {
-    return drift::testing::dem_from(n, 1.0, 0.5, [](double x, double y) {
-      return 1000 + 2 * std::sin(x / 17.0) + 2 * std::cos(y / 13.0);
-    });
-  };
-  drift::terrain::write_geotiff(gentle(32), d / "gentle_small.tif", {"height", "m"});
-  drift::terrain::write_geotiff(gentle(1400), d / "gentle_big.tif", {"height", "m"});
-  expect_estimate_within_a_quarter(run_measured("snow fall gentle_small.tif --maps 2 -o g0.tif", d),
-                                   run_measured("snow fall gentle_big.tif --maps 2 -o g1.tif", d));
+  expect_snow_fall_estimate("gentle", 2.0, 2.0);
 }
 
 TEST(MemoryEstimate, SnowFallBlockByBlock) {
@@ -263,15 +284,12 @@ TEST(MemoryEstimate, MergeInfoAndMesh) {
   // counted the heights and GDAL's block cache held as much again (0.56);
   // mesh counted the raster only, and a GLB of a DEM used 50 times it.
   const fs::path d = dir();
-  write_dem(d / "dem.tif", 32, 10.0);
-  write_dem(d / "big.tif", 4000, 10.0);
-  write_dem(d / "mid.tif", 1200, 10.0);
-  put(d / "scene.toml", "[terrain]\nraster = \"dem.tif\"\n[sun]\nazimuth = 120\nelevation = 35\n");
+  write_dems(d, {{"dem", 32}, {"big", 4000}, {"mid", 1200}});
   for (const char* size : {"16x8", "1600x1200"})
     for (int t = 0; t < 2; ++t) {
       const std::string tile = std::to_string(t) + "/2";
       const Measured r =
-          run_measured(std::string("render scene.toml --spp 1 --size ") + size + " --tile " + tile +
+          run_measured(std::string("render dem.toml --spp 1 --size ") + size + " --tile " + tile +
                            " -o t" + size + "_" + std::to_string(t) + ".exr",
                        d);
       ASSERT_EQ(r.status, 0) << r.log;
@@ -279,12 +297,10 @@ TEST(MemoryEstimate, MergeInfoAndMesh) {
   expect_estimate_within_a_quarter(
       run_measured("merge t16x8_0.exr t16x8_1.exr -o m0.exr -o m0.png", d),
       run_measured("merge t1600x1200_0.exr t1600x1200_1.exr -o m1.exr -o m1.png", d));
-  expect_estimate_within_a_quarter(run_measured("info dem.tif", d),
-                                   run_measured("info big.tif", d));
+  expect_on_small_and_big(d, "info IN", "dem.tif", "big.tif");
   for (const char* ext : {"ply", "glb", "gltf", "stl"}) {
     SCOPED_TRACE(ext);
-    expect_estimate_within_a_quarter(run_measured(std::string("mesh dem.tif -o small.") + ext, d),
-                                     run_measured(std::string("mesh mid.tif -o big.") + ext, d));
+    expect_on_small_and_big(d, std::string("mesh IN -o mesh@.") + ext, "dem.tif", "mid.tif");
   }
 }
 
@@ -294,10 +310,8 @@ TEST(MemoryEstimate, MeshAsFbxAtSize) {
   // counted at 500 bytes a triangle from one rough figure: 1.38 times the
   // peak at 1024 x 1024 (its ASCII text is built whole, then copied).
   const fs::path d = dir();
-  write_dem(d / "dem.tif", 16, 10.0);
-  write_dem(d / "fbx.tif", 1024, 10.0);
-  expect_estimate_within_a_quarter(run_measured("mesh dem.tif -o small.fbx", d),
-                                   run_measured("mesh fbx.tif -o big.fbx", d));
+  write_dems(d, {{"dem", 16}, {"fbx", 1024}});
+  expect_on_small_and_big(d, "mesh IN -o mesh@.fbx", "dem.tif", "fbx.tif");
 }
 
 TEST(MemoryEstimate, RenderOutOfCoreAndMaps) {
@@ -307,12 +321,7 @@ TEST(MemoryEstimate, RenderOutOfCoreAndMaps) {
   // only, 3 MiB against 136 MiB measured at 6000^2 with a 32M budget).
   // --map: the image sized by the box over --cell, as a PNG or a GeoTIFF.
   const fs::path d = dir();
-  write_dem(d / "small.tif", 64, 10.0);
-  write_dem(d / "big.tif", 6000, 10.0);
-  write_dem(d / "map.tif", 200, 10.0);
-  for (const char* name : {"small", "big", "map"})
-    put(d / (std::string(name) + ".toml"), std::string("[terrain]\nraster = \"") + name +
-                                               ".tif\"\n[sun]\nazimuth = 120\nelevation = 35\n");
+  write_dems(d, {{"small", 64}, {"big", 6000}, {"map", 200}});
   // --full-resolution: every page is read, so the cache and GDAL's fill as the
   // estimate assumes; with the level of detail a far view reads a few pages
   // and the estimate is an upper bound (1.25 of the peak on this scene).
@@ -343,16 +352,13 @@ TEST(MemoryEstimate, MeshDecimated) {
   // peak was 1.8 times the estimate at --decimate 0 on 2000^2); counted at
   // worst, every triangle kept, which --decimate 0 on a curved DEM keeps.
   const fs::path d = dir();
-  write_dem(d / "dem.tif", 16, 10.0);
-  write_dem(d / "rtin.tif", 1500, 10.0);
-  expect_estimate_within_a_quarter(run_measured("mesh dem.tif --decimate 0 -o small.ply", d),
-                                   run_measured("mesh rtin.tif --decimate 0 -o big.ply", d));
+  write_dems(d, {{"dem", 16}, {"rtin", 1500}});
+  expect_on_small_and_big(d, "mesh IN --decimate 0 -o rtin@.ply", "dem.tif", "rtin.tif");
   // Where the bound drops most triangles (0.5 m on 2 m cells keeps 4 % of
   // them), the mesh is counted as kept, not at worst: every triangle counted,
   // the estimate was 7.7 times the peak (3000^2 at 2 m, 0.5 m).
-  write_dem(d / "smooth.tif", 2600, 2.0);
-  expect_estimate_within_a_quarter(run_measured("mesh dem.tif --decimate 0.5 -o s0.ply", d),
-                                   run_measured("mesh smooth.tif --decimate 0.5 -o s1.ply", d));
+  write_dems(d, {{"smooth", 2600}}, 2.0);
+  expect_on_small_and_big(d, "mesh IN --decimate 0.5 -o smooth@.ply", "dem.tif", "smooth.tif");
 }
 
 }  // namespace

@@ -21,18 +21,12 @@
 #include "terrain/simd.h"
 #include "terrain/slope_relax.h"
 #include "tests/dem_fixture.h"
+#include "tests/snow/stabilise_fixture.h"
 
 namespace {
 
-using drift::snow::max_repose_excess;
-using drift::snow::stabilise_grid;
-using drift::snow::StabiliseOptions;
 using drift::snow::StabiliseReport;
-using drift::terrain::Grid;
-
-double total(const Grid<double>& g) {
-  return std::accumulate(g.values().begin(), g.values().end(), 0.0);
-}
+using namespace drift::testing::stabilise;  // the solver's names, total()
 
 double tan_deg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
 

@@ -17,21 +17,15 @@
 
 #include "snow/stabilise_grid.h"
 #include "tests/dem_fixture.h"
+#include "tests/snow/stabilise_fixture.h"
 
 namespace {
 
-using drift::snow::max_repose_excess;
 using drift::snow::settle_at_rest;
-using drift::snow::stabilise_grid;
-using drift::snow::StabiliseOptions;
-using drift::terrain::Grid;
+using namespace drift::testing::stabilise;  // the solver's names, total()
 
 constexpr double kRepose = 40.0;
 const double kTan = std::tan(kRepose * std::numbers::pi / 180.0);
-
-double total(const Grid<double>& g) {
-  return std::accumulate(g.values().begin(), g.values().end(), 0.0);
-}
 
 // The passes' state (today's solver, with its shortcut) for comparison.
 Grid<double> by_passes(const Grid<float>& ground, Grid<double> snow, double dx, double dy) {

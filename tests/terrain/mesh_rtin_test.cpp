@@ -177,30 +177,35 @@ namespace reference {
 // box. The fast version must keep the very same triangles and error.
 constexpr float kMustSplit = INFINITY;
 
-std::int64_t edge(int px, int py, int qx, int qy, int rx, int ry) {
-  return static_cast<std::int64_t>(qx - px) * (ry - py) -
-         static_cast<std::int64_t>(qy - py) * (rx - px);
+// A grid point.
+struct Point {
+  int x, y;
+};
+
+// Twice the signed area of p, q, r: exact in integers.
+std::int64_t cross(Point p, Point q, Point r) {
+  return static_cast<std::int64_t>(q.x - p.x) * (r.y - p.y) -
+         static_cast<std::int64_t>(q.y - p.y) * (r.x - p.x);
 }
 
-float triangle_error(const HeightField& h, int ax, int ay, int bx, int by, int cx, int cy) {
-  const int w = h.width(), n = h.height();
-  const int x0 = std::min({ax, bx, cx}), x1 = std::max({ax, bx, cx});
-  const int y0 = std::min({ay, by, cy}), y1 = std::max({ay, by, cy});
-  if (x1 > w - 1 || y1 > n - 1) return (x0 < w - 1 && y0 < n - 1) ? kMustSplit : 0.0f;
-  const double za = h(ax, ay), zb = h(bx, by), zc = h(cx, cy);
-  const std::int64_t area = edge(ax, ay, bx, by, cx, cy);
+// Every grid point of the closed triangle a b c (the three cross products
+// never of opposite signs), its height against the plane through the
+// corners. A triangle reaching past the grid must split while it still
+// overlaps the grid, and is dropped once it lies wholly beyond.
+float triangle_error(const HeightField& h, Point a, Point b, Point c) {
+  const Point lo{std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y})};
+  const Point hi{std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y})};
+  if (hi.x >= h.width() || hi.y >= h.height())
+    return lo.x + 1 < h.width() && lo.y + 1 < h.height() ? kMustSplit : 0.0f;
+  const double area = static_cast<double>(cross(a, b, c));
+  const double za = h(a.x, a.y), zb = h(b.x, b.y), zc = h(c.x, c.y);
   double worst = 0.0;
-  for (int y = y0; y <= y1; ++y) {
-    for (int x = x0; x <= x1; ++x) {
-      const std::int64_t wa = edge(bx, by, cx, cy, x, y), wb = edge(cx, cy, ax, ay, x, y),
-                         wc = edge(ax, ay, bx, by, x, y);
-      const bool inside =
-          area > 0 ? (wa >= 0 && wb >= 0 && wc >= 0) : (wa <= 0 && wb <= 0 && wc <= 0);
-      if (!inside) continue;
-      const float z = h(x, y);
-      if (std::isnan(z)) return kMustSplit;
-      const double plane = (za * wa + zb * wb + zc * wc) / static_cast<double>(area);
-      worst = std::max(worst, std::abs(z - plane));
+  for (Point p = lo; p.y <= hi.y; ++p.y) {
+    for (p.x = lo.x; p.x <= hi.x; ++p.x) {
+      const std::int64_t wa = cross(b, c, p), wb = cross(c, a, p), wc = cross(a, b, p);
+      if (std::min({wa, wb, wc}) < 0 && std::max({wa, wb, wc}) > 0) continue;
+      if (std::isnan(h(p.x, p.y))) return kMustSplit;
+      worst = std::max(worst, std::abs(h(p.x, p.y) - (za * wa + zb * wb + zc * wc) / area));
     }
   }
   return static_cast<float>(worst);
@@ -234,31 +239,38 @@ drift::terrain::RtinMesh rtin(const HeightField& h, double max_error) {
       cx = mx, cy = my;
     }
     const int mx = (ax + bx) >> 1, my = (ay + by) >> 1;
-    float e = std::max(errors[at(mx, my)], triangle_error(h, ax, ay, bx, by, cx, cy));
+    float e = std::max(errors[at(mx, my)], triangle_error(h, {ax, ay}, {bx, by}, {cx, cy}));
     if (i < parents) {
       e = std::max({e, errors[at((ax + cx) >> 1, (ay + cy) >> 1)],
                     errors[at((bx + cx) >> 1, (by + cy) >> 1)]});
     }
     errors[at(mx, my)] = e;
   }
-  auto is_vertex = [&h](int x, int y) {
-    return x < h.width() && y < h.height() && !std::isnan(h(x, y));
+  // The leaves, depth first by a stack of triangles (hypotenuse a-b, right
+  // angle at c), a child c a m before b c m.
+  struct Triangle {
+    Point a, b, c;
+  };
+  std::vector<Triangle> stack = {{{tile, tile}, {0, 0}, {0, tile}},
+                                 {{0, 0}, {tile, tile}, {tile, 0}}};
+  const auto is_vertex = [&h](Point p) {
+    return p.x < h.width() && p.y < h.height() && !std::isnan(h(p.x, p.y));
   };
   drift::terrain::RtinMesh out;
-  auto visit = [&](auto&& self, int ax, int ay, int bx, int by, int cx, int cy) -> void {
-    const int mx = (ax + bx) >> 1, my = (ay + by) >> 1;
-    if (std::abs(ax - cx) + std::abs(ay - cy) > 1 && errors[at(mx, my)] > max_error) {
-      self(self, cx, cy, ax, ay, mx, my);
-      self(self, bx, by, cx, cy, mx, my);
-      return;
+  while (!stack.empty()) {
+    const Triangle t = stack.back();
+    stack.pop_back();
+    const Point m{(t.a.x + t.b.x) >> 1, (t.a.y + t.b.y) >> 1};
+    const bool legs_longer_than_a_cell = std::abs(t.a.x - t.c.x) + std::abs(t.a.y - t.c.y) > 1;
+    if (legs_longer_than_a_cell && errors[at(m.x, m.y)] > max_error) {
+      stack.push_back({t.b, t.c, m});
+      stack.push_back({t.c, t.a, m});
+    } else if (is_vertex(t.a) && is_vertex(t.b) && is_vertex(t.c)) {
+      out.triangles.push_back({{{t.a.x, t.a.y}, {t.b.x, t.b.y}, {t.c.x, t.c.y}}});
+      out.max_error =
+          std::max(out.max_error, static_cast<double>(triangle_error(h, t.a, t.b, t.c)));
     }
-    if (!is_vertex(ax, ay) || !is_vertex(bx, by) || !is_vertex(cx, cy)) return;
-    out.triangles.push_back({{{ax, ay}, {bx, by}, {cx, cy}}});
-    out.max_error =
-        std::max(out.max_error, static_cast<double>(triangle_error(h, ax, ay, bx, by, cx, cy)));
-  };
-  visit(visit, 0, 0, tile, tile, tile, 0);
-  visit(visit, tile, tile, 0, 0, 0, tile);
+  }
   return out;
 }
 
