@@ -321,9 +321,9 @@ TEST(MemoryEstimate, RenderSixteenBitHeightsReadStripByStrip) {
   DRIFT_SKIP_UNDER_SANITIZER();
   // --height-bits 16 in core reads the DEM strip by strip into 16-bit
   // heights (issue 36): the estimate counts the codes, the strips in flight,
-  // GDAL's cache, the tree and Embree's BVH, not the DEM's floats (it
-  // counted the whole raster read as floats beside 5 B a cell: 1.9 times
-  // the peak here).
+  // GDAL's cache, the tree and Embree's BVH, no longer the DEM's floats (the
+  // raster read whole, then 5 B a cell). Without the codes, strips and
+  // GDAL's cache the estimate was 0.24 of the peak.
   const fs::path d = dir();
   write_dem(d / "small.tif", 64, 10.0);
   write_dem(d / "big.tif", 6000, 10.0);
