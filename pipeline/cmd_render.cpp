@@ -25,6 +25,7 @@
 #include "terrain/error.h"
 #include "terrain/memory.h"
 #include "terrain/output_set.h"
+#include "terrain/raster_blocks.h"
 
 namespace drift::pipeline {
 
@@ -379,6 +380,11 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
           "--height-bits 16 quantises the heights held in core; with --memory-budget "
           "the pages hold float heights: give one of the two");
   }
+  // --height-bits 16 in core: the scene reads the DEM strip by strip and
+  // quantises it as it reads (the floats never all exist, issue 36) unless
+  // something before the scene needs the whole DEM.
+  const bool streamed = !budget && o.height_bits == 16 && !scene.needs_dem_before_scene();
+  if (streamed) scene.coarse_terrain_side = 1024;
   OutputSet outputs(written, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
@@ -393,6 +399,10 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
     scene.input.terrain = terrain::HeightField();
     scene.input.terrain.geo() = paged->geo();
     scene_holder = std::make_unique<render::TerrainScene>(scene.input, *paged);
+  } else if (streamed) {
+    scene_holder = std::make_unique<render::TerrainScene>(scene.input, scene.terrain_raster);
+    scene.input.terrain = terrain::HeightField();
+    scene.input.terrain.geo() = terrain::RasterBlockReader(scene.terrain_raster).geo();
   } else {
     const terrain::GeoReference dem_geo = scene.input.terrain.geo();
     scene_holder = std::make_unique<render::TerrainScene>(

@@ -83,7 +83,8 @@ void snow_cover_flags(CLI::App* sub, CoverCommand* c) {
   sub->add_option("--descriptor", c->descriptor, "also write t (0 snow, 1 rock)");
   sub->add_option("--accessibility", c->accessibility, "also write the TSA in metres");
   sub->add_option("--block", c->block,
-                  "cells a side of the blocks worked in (default: DRIFT_BLOCK_CELLS, else 2048)")
+                  "cells a side of the blocks worked in (default: DRIFT_BLOCK_CELLS, else 4 halos "
+                  "rounded up to 256, at least 2048, within half the memory; docs/snow.md)")
       ->check(CLI::Range(16, 1048576));
 }
 

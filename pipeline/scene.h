@@ -89,6 +89,12 @@ struct SceneFile {
   std::filesystem::path product_file(const std::string& key) const;
   // Whether stage section `name` makes products (has a loader).
   bool loads(const std::string& name) const;
+  // Whether anything before the scene reads the DEM's heights or its grid
+  // (a repeat, a camera or sun placed on it, a map's cells, topographic
+  // position, snow depth laid on it): if not, the scene may read the DEM
+  // itself (drift render --height-bits 16 quantises it strip by strip) and
+  // load_scene_terrain a coarse stand-in (coarse_terrain_side).
+  bool needs_dem_before_scene() const;
 };
 
 }  // namespace drift::pipeline

@@ -741,6 +741,12 @@ fs::path SceneFile::product_file(const std::string& key) const {
   return found == product_files.end() ? fs::path() : found->second;
 }
 
+bool SceneFile::needs_dem_before_scene() const {
+  return terrain_repeat > 1 || !keyframes.empty() || map || camera_from_lonlat ||
+         camera_to_lonlat || sun_time || uses_position(input.surface) ||
+         !product_file("snow.depth").empty();
+}
+
 bool SceneFile::loads(const std::string& name) const {
   return std::any_of(product_loaders.begin(), product_loaders.end(),
                      [&](const auto& loader) { return loader.first == name; });

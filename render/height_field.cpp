@@ -85,37 +85,45 @@ void HeightFieldBlocks::size_levels() {
 static_assert(QuantisedHeights::kBlock == HeightFieldBlocks::kBlock,
               "16-bit heights are quantised over the height field's blocks");
 
+QuantisedHeights::QuantisedHeights(int width, int height)
+    : width_(width),
+      height_(height),
+      blocks_x_(std::max(1, (width - 1 + kBlock - 1) / kBlock)),
+      blocks_y_(std::max(1, (height - 1 + kBlock - 1) / kBlock)),
+      q_(static_cast<std::size_t>(width) * height),
+      ranges_(static_cast<std::size_t>(blocks_x_) * blocks_y_) {}
+
 QuantisedHeights::QuantisedHeights(const HeightGrid& grid)
-    : width_(grid.width),
-      height_(grid.height),
-      blocks_x_(std::max(1, (grid.width - 1 + kBlock - 1) / kBlock)),
-      blocks_y_(std::max(1, (grid.height - 1 + kBlock - 1) / kBlock)),
-      q_(static_cast<std::size_t>(grid.width) * grid.height),
-      ranges_(static_cast<std::size_t>(blocks_x_) * blocks_y_) {
-  // Block row by block row: the range of the vertices each block owns, then
-  // each vertex's nearest step, rounded in double from the float step the
-  // decode uses (so |lo + step q - z| <= step / 2 exactly, before the
-  // decode's one rounding to float).
+    : QuantisedHeights(grid.width, grid.height) {
   tbb::parallel_for(0, blocks_y_, [&](int by) {
-    const int r0 = by * kBlock, r1 = by == blocks_y_ - 1 ? height_ : r0 + kBlock;
-    for (int bx = 0; bx < blocks_x_; ++bx) {
-      const int c0 = bx * kBlock, c1 = bx == blocks_x_ - 1 ? width_ : c0 + kBlock;
-      float lo = kInf, hi = -kInf;
-      for (int r = r0; r < r1; ++r)
-        for (int c = c0; c < c1; ++c)
-          lo = std::min(lo, grid.at(c, r)), hi = std::max(hi, grid.at(c, r));
-      Range& range = ranges_[static_cast<std::size_t>(by) * blocks_x_ + bx];
-      range.lo = lo;
-      range.step = static_cast<float>((static_cast<double>(hi) - lo) / kSteps);
-      for (int r = r0; r < r1; ++r)
-        for (int c = c0; c < c1; ++c) {
-          const double steps =
-              range.step > 0.0f ? (static_cast<double>(grid.at(c, r)) - lo) / range.step : 0.0;
-          q_[static_cast<std::size_t>(r) * width_ + c] =
-              static_cast<std::uint16_t>(std::clamp(std::nearbyint(steps), 0.0, kSteps));
-        }
-    }
+    quantise_block_row(by, grid.z.data() + static_cast<std::size_t>(block_row_first(by)) * width_);
   });
+}
+
+void QuantisedHeights::quantise_block_row(int by, const float* rows) {
+  // The range of the vertices each block owns, then each vertex's nearest
+  // step, rounded in double from the float step the decode uses (so
+  // |lo + step q - z| <= step / 2 exactly, before the decode's one rounding
+  // to float). Only this block row's codes and ranges are written: block
+  // rows may be quantised side by side, in any order, from any strips.
+  const int r0 = block_row_first(by), r1 = block_row_end(by);
+  const auto z = [&](int c, int r) { return rows[static_cast<std::size_t>(r - r0) * width_ + c]; };
+  for (int bx = 0; bx < blocks_x_; ++bx) {
+    const int c0 = bx * kBlock, c1 = bx == blocks_x_ - 1 ? width_ : c0 + kBlock;
+    float lo = kInf, hi = -kInf;
+    for (int r = r0; r < r1; ++r)
+      for (int c = c0; c < c1; ++c) lo = std::min(lo, z(c, r)), hi = std::max(hi, z(c, r));
+    Range& range = ranges_[static_cast<std::size_t>(by) * blocks_x_ + bx];
+    range.lo = lo;
+    range.step = static_cast<float>((static_cast<double>(hi) - lo) / kSteps);
+    for (int r = r0; r < r1; ++r)
+      for (int c = c0; c < c1; ++c) {
+        const double steps =
+            range.step > 0.0f ? (static_cast<double>(z(c, r)) - lo) / range.step : 0.0;
+        q_[static_cast<std::size_t>(r) * width_ + c] =
+            static_cast<std::uint16_t>(std::clamp(std::nearbyint(steps), 0.0, kSteps));
+      }
+  }
 }
 
 HeightFieldBlocks::HeightFieldBlocks(const HeightGrid& grid) : grid_(&grid) {

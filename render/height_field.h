@@ -68,6 +68,19 @@ class QuantisedHeights {
   QuantisedHeights() = default;
   // Quantises grid.z (grid.width x grid.height vertices, no NaN).
   explicit QuantisedHeights(const HeightGrid& grid);
+  // width x height vertices, all codes 0, to be quantised block row by block
+  // row (quantise_block_row) as the heights are read, so that the floats of
+  // a strip, never of the whole raster, exist at once (issue 36;
+  // TerrainScene's streamed 16-bit scene): the same codes and ranges as the
+  // constructor above gives for the same floats.
+  QuantisedHeights(int width, int height);
+  int block_rows() const { return blocks_y_; }
+  // Block row by owns vertex rows [block_row_first(by), block_row_end(by)).
+  int block_row_first(int by) const { return by * kBlock; }
+  int block_row_end(int by) const { return by == blocks_y_ - 1 ? height_ : (by + 1) * kBlock; }
+  // Quantises block row `by` from `rows`, its vertex rows (width() floats
+  // each, no NaN); block rows may be quantised concurrently.
+  void quantise_block_row(int by, const float* rows);
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -61,18 +61,18 @@ std::vector<double> outward_distances(double first, double reach) {
 
 SurroundHeight::SurroundHeight(const DemVertices& dem, const SurroundOptions& options)
     : dem_(dem), options_(&options) {
-  const std::vector<float>& v = dem.heights->z;
   x0_ = dem.heights->x0, y0_ = dem.heights->y0;
   x1_ = x0_ + (dem.width - 1) * dem.dx, y1_ = y0_ - (dem.height - 1) * dem.dy;
-  double s = 0.0, s2 = 0.0;
-  for (const float z : v) s += z, s2 += double(z) * z;
-  const double n = static_cast<double>(v.size());
+  double s = dem.sum, s2 = dem.sum_squares;
+  if (!dem.quantised)
+    for (const float z : dem.heights->z) s += z, s2 += double(z) * z;
+  const double n = static_cast<double>(dem.width) * dem.height;
   mean_ = static_cast<float>(s / n);
   deviation_ = static_cast<float>(std::sqrt(std::max(0.0, s2 / n - (s / n) * (s / n))));
   decay_ = 0.125f * ((x1_ - x0_) + (y0_ - y1_));
   // Cumulative integral of the heights along the perimeter (trapezoids),
   // clockwise from the north-west corner.
-  const auto z = [&](int c, int r) { return v[static_cast<std::size_t>(r) * dem.width + c]; };
+  const auto z = [&](int c, int r) { return dem.at(c, r); };
   std::vector<std::pair<float, float>> loop;  // (step length, height) per perimeter vertex
   loop.reserve(2 * static_cast<std::size_t>(dem.width + dem.height));
   for (int c = 0; c < dem.width; ++c) loop.emplace_back(c ? dem.dx : 0.0f, z(c, 0));
@@ -95,9 +95,7 @@ float SurroundHeight::dem_height(float x, float y) const {
   const int c = std::min(static_cast<int>(fx), dem_.width - 2);
   const int r = std::min(static_cast<int>(fr), dem_.height - 2);
   const float tx = fx - c, tr = fr - r;
-  const auto z = [&](int cc, int rr) {
-    return dem_.heights->at(cc, rr);
-  };
+  const auto z = [&](int cc, int rr) { return dem_.at(cc, rr); };
   return (1 - tr) * ((1 - tx) * z(c, r) + tx * z(c + 1, r)) +
          tr * ((1 - tx) * z(c, r + 1) + tx * z(c + 1, r + 1));
 }
@@ -116,8 +114,7 @@ float SurroundHeight::edge_mean(float x, float y, float half_width) const {
     t = 2 * w + h + (y - y1_);
   // The integral of the heights up to perimeter position u (wrapping).
   const std::size_t n = sat_.size();
-  const double total =
-      sat_.back() + 0.5 * dem_.dy * (dem_.heights->z[0] + dem_.heights->z[dem_.width]);
+  const double total = sat_.back() + 0.5 * dem_.dy * (dem_.at(0, 0) + dem_.at(0, 1));
   auto integral = [&](double u) {
     const double laps = std::floor(u / perimeter);
     u -= laps * perimeter;

@@ -48,6 +48,14 @@ struct DemVertices {
   float dx = 1.0f, dy = 1.0f;
   Eigen::Vector3d origin{0, 0, 0};  // local -> CRS shift (heights exaggerated)
   float exaggeration = 1.0f;
+  // The DEM as 16-bit heights with no floats in memory (TerrainScene's
+  // streamed 16-bit scene; heights->z is empty): the vertices read from
+  // `quantised`, and the sums of the heights and their squares over every
+  // vertex, added in row-major order as the floats would be (the ring's mean
+  // and spread), given by the scene that saw each strip once.
+  const QuantisedHeights* quantised = nullptr;
+  double sum = 0.0, sum_squares = 0.0;
+  float at(int c, int r) const { return quantised ? quantised->at(c, r) : heights->at(c, r); }
 };
 
 struct SurroundGrids {

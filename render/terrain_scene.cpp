@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "render/ground_detail.h"
 #include "render/paged_terrain.h"
 #include "render/snow_flakes.h"
+#include "render/streamed_heights.h"
 #include "terrain/angles.h"
 #include "terrain/bilinear.h"
 #include "terrain/derivatives.h"
@@ -23,6 +25,7 @@
 #include "terrain/local_frame.h"
 #include "terrain/memory.h"
 #include "terrain/products.h"
+#include "terrain/raster_blocks.h"
 
 namespace drift::render {
 
@@ -43,6 +46,10 @@ void check_device(RTCDevice device, const char* what) {
 
 // Embree grids are at most 32767 vertices a side (RTCGrid::width is 16-bit).
 constexpr int kMaxGridSide = 32767;
+// Embree's BVH over the height field's blocks in core (a user primitive a
+// block of 16 x 16 cells: its build's references and BVH4 nodes), counted in
+// the streamed scene's memory check.
+constexpr std::uint64_t kBvhBytesABlock = 128;
 
 // The ray's footprint (metres) where it hit.
 double footprint(const RayCone& cone, const Hit& hit) { return cone.width_at(hit.distance); }
@@ -197,6 +204,11 @@ TerrainScene::TerrainScene(const SceneInput& input, PagedTerrain& paged)
   build_paged(input, paged);
 }
 
+TerrainScene::TerrainScene(const SceneInput& input, const std::filesystem::path& dem)
+    : embree_(std::make_unique<Embree>()) {
+  build_streamed(input, dem);
+}
+
 void TerrainScene::build_paged(const SceneInput& input, PagedTerrain& paged) {
   if (!input.height_changes.empty())
     throw Error(
@@ -222,6 +234,49 @@ void TerrainScene::build_paged(const SceneInput& input, PagedTerrain& paged) {
                                                 paged.take_coarse(), PagedTerrain::kGroup);
   attach_blocks();
   // The surround ring reads the DEM's whole edge from memory: not built here.
+  for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
+  std::tie(bottom_, top_) = embree_->commit();
+}
+
+void TerrainScene::build_streamed(const SceneInput& input, const std::filesystem::path& dem) {
+  if (!input.height_changes.empty())
+    throw Error("height changes (snow depth) need the terrain raster '" + dem.string() +
+                "' whole in memory; lay them on the DEM first or render with float heights");
+  exaggeration_ = static_cast<float>(input.vertical_exaggeration);
+  // The codes and the strips in flight; the tree (0.67 B a cell) and
+  // Embree's BVH over the blocks follow once the strips are gone.
+  {
+    terrain::RasterBlockReader probe(dem);
+    const std::uint64_t cells = static_cast<std::uint64_t>(probe.width()) * probe.height();
+    require_memory(streamed_heights_bytes(probe.width(), probe.height(),
+                                          tbb::this_task_arena::max_concurrency()) +
+                       cells * 3 / 4 + cells / 256 * kBvhBytesABlock,
+                   "the terrain raster '" + dem.string() + "' as 16-bit heights",
+                   "give --memory-budget to render it out of core, or resample the DEM");
+  }
+  StreamedHeights read = read_streamed_heights(dem, exaggeration_);
+  heights_ = read.frame;
+  width_ = heights_.width;
+  height_ = heights_.height;
+  dx_ = heights_.dx;
+  dy_ = heights_.dy;
+  origin_ = read.origin;
+  highest_ = read.highest;
+  lowest_ = read.lowest;
+  extent_ = {(width_ - 1) * dx_, (height_ - 1) * dy_};
+  surface_ = input.surface;
+  surface_.cell = std::min(std::abs(read.geo.cell_size_x()), std::abs(read.geo.cell_size_y()));
+  coverage_ = coverage_channels(surface_);
+  embree_->open();
+  // As attach_quantised_height_field: the ring from the decoded heights,
+  // then the tree over them.
+  SurroundGrids ring =
+      build_surround(DemVertices{&heights_, width_, height_, dx_, dy_, origin_, exaggeration_,
+                                 &read.heights, read.sum, read.sum_squares},
+                     input.surround);
+  blocks_ = std::make_unique<HeightFieldBlocks>(heights_, std::move(read.heights));
+  attach_blocks();
+  attach_ring(std::move(ring));
   for (const terrain::PlacedMesh& placed : input.meshes) attach_mesh(placed);
   std::tie(bottom_, top_) = embree_->commit();
 }

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -80,6 +81,14 @@ class TerrainScene {
   // for what needs the whole DEM in memory (height changes laid on it, the
   // surround ring).
   TerrainScene(const SceneInput& input, PagedTerrain& paged);
+  // The terrain read from the raster `dem` (band 1) strip by strip and held
+  // as 16-bit heights (TerrainGeometry::HeightField16), each strip quantised
+  // as it is read, so the DEM's floats never all exist (issue 36: the peak
+  // of `drift render --height-bits 16`); input.terrain is not read. The same
+  // heights, tree, ring and images bit for bit as the scene of the whole DEM
+  // read as floats with HeightField16. Throws drift::Error naming the file
+  // as PagedTerrain does, and for height changes (they need the DEM whole).
+  TerrainScene(const SceneInput& input, const std::filesystem::path& dem);
   ~TerrainScene();
   TerrainScene(const TerrainScene&) = delete;
   TerrainScene& operator=(const TerrainScene&) = delete;
@@ -157,6 +166,7 @@ class TerrainScene {
   void attach_height_field();
   void attach_blocks();
   void build_paged(const SceneInput& input, PagedTerrain& paged);
+  void build_streamed(const SceneInput& input, const std::filesystem::path& dem);
   // Vertex (c, r)'s height, local frame: from heights_ or the pages.
   float z_at(int c, int r) const;
   void attach_mesh(const terrain::PlacedMesh& placed);

@@ -335,6 +335,21 @@ std::uint64_t smoothing_bytes(int width, int region) {
   return threads * (2 * std::uint64_t(region) + 3) * (width + 2 * std::uint64_t(region) + 2) * 32;
 }
 
+}  // namespace
+
+int default_cover_block(int halo, std::uint64_t available) {
+  constexpr int kTile = 256;
+  const auto window_bytes = [&](int block) {
+    const std::uint64_t side = std::uint64_t(block) + 2 * std::uint64_t(halo);
+    return side * side * kCoverBytesPerCell;
+  };
+  int block = std::max(kCoverBlock, (4 * halo + kTile - 1) / kTile * kTile);
+  while (block > kCoverBlock && window_bytes(block) > available / 2) block -= kTile;
+  return block;
+}
+
+namespace {
+
 void validate(const HeightField& dem, const CoverOptions& o) {
   validate_grid(dem.width(), dem.height(), dem.geo(), o);
   std::size_t nodata = 0;
@@ -502,8 +517,9 @@ CoverFilesResult snow_cover_to_files(const CoverFiles& files, const CoverOptions
   const terrain::GeoReference& geo = reader.geo();
   validate_grid(width, height, geo, o);
   const double cell = geo.cell_size_x();
-  const int block = terrain::block_cells(files.block, kCoverBlock);
   const int halo = cover_halo(o, cell), n = region_in_cells(o, cell);
+  const int block =
+      terrain::block_cells(files.block, default_cover_block(halo, available_memory_bytes()));
   // The largest window: a block with its halo on every side.
   const int side_x = std::min(width, block + 2 * halo), side_y = std::min(height, block + 2 * halo);
   const std::uint64_t window_cells = std::uint64_t(side_x) * side_y;

@@ -89,12 +89,20 @@ int cover_halo(const CoverOptions& o, double cell_m);
 // (block + 2 halo)^2 cells at 24 bytes, the smoothing's prefix sums and
 // GDAL's cache, checked (DRIFT_MEMORY_LIMIT) before any work.
 constexpr int kCoverBlock = 2048;
+// The default block for a halo of `halo` cells (issue 36): a block of 2048
+// beside the 753-cell halo of the metric defaults on a 1 m DEM was a window
+// of 3554^2 cells of which the block was a third. At least 4 halos a side
+// (the block then at least 4/9 of its window), a multiple of 256 (the
+// output's tiles), never below kCoverBlock; shrunk (not below kCoverBlock)
+// while its window, at kCoverBytesPerCell, would need more than half of
+// `available` bytes.
+int default_cover_block(int halo, std::uint64_t available);
 struct CoverFiles {
   std::filesystem::path dem;            // the DEM (any raster GDAL reads, in metres)
   std::filesystem::path cover;          // 1 - t (empty: not written)
   std::filesystem::path descriptor;     // t (empty: not written)
   std::filesystem::path accessibility;  // TSA in metres (empty: not written)
-  int block = 0;  // cells a side; 0: DRIFT_BLOCK_CELLS if set, else kCoverBlock
+  int block = 0;  // cells a side; 0: DRIFT_BLOCK_CELLS if set, else default_cover_block
 };
 struct CoverFilesResult {
   int width = 0, height = 0, block = 0, halo = 0;

@@ -16,6 +16,7 @@
 
 #include "snow/snow_cover.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 #include "terrain/raster_io.h"
 #include "tests/dem_fixture.h"
 #include "tests/test_files.h"
@@ -202,4 +203,34 @@ TEST(SnowCoverTiled, CommandWithSmallBlocksGivesTheOnePassCover) {
             0);
   EXPECT_NE(run("DRIFT_BLOCK_CELLS=7", dir() / "bad.tif"), 0) << "a block under 16 is refused";
   EXPECT_FALSE(fs::exists(dir() / "bad.tif"));
+}
+
+TEST(SnowCoverTiled, DefaultBlockIsFourHalosWithinMemory) {
+  // The metric defaults on a 1 m DEM: a 753-cell halo, beside which the old
+  // default block of 2048 was a third of its window (issue 36).
+  const int halo = cover_halo(CoverOptions{}, 1.0);
+  constexpr std::uint64_t kGiB = std::uint64_t{1} << 30;
+  const auto window = [&](int block) {
+    return (std::uint64_t(block) + 2 * halo) * (std::uint64_t(block) + 2 * halo) * 24;
+  };
+  const int roomy = default_cover_block(halo, 16 * kGiB);
+  EXPECT_GE(roomy, 4 * halo);
+  EXPECT_LT(roomy, 4 * halo + 256);
+  EXPECT_EQ(roomy % 256, 0);
+  EXPECT_EQ(default_cover_block(cover_halo(CoverOptions{}, 10.0), 16 * kGiB), kCoverBlock)
+      << "a small halo keeps the 2048 block";
+  // Bounded by memory: the window within half of what is available, never
+  // below kCoverBlock.
+  const int tight = default_cover_block(halo, 800u << 20);
+  EXPECT_LT(tight, roomy);
+  EXPECT_GE(tight, kCoverBlock);
+  EXPECT_LE(window(tight), (800u << 20) / 2);
+  EXPECT_GT(window(tight + 256), (800u << 20) / 2) << "shrunk no more than needed";
+  EXPECT_EQ(default_cover_block(halo, 1u << 20), kCoverBlock);
+  // The files' descriptor takes it when no block is given.
+  const fs::path dem = relief(70, 60, 1.0, false, "one_metre");
+  const fs::path c = dir() / "block_cover.tif";
+  const CoverFilesResult r = snow_cover_to_files({dem, c, {}, {}, 0}, CoverOptions{});
+  EXPECT_EQ(r.halo, halo);
+  EXPECT_EQ(r.block, default_cover_block(halo, drift::available_memory_bytes()));
 }
