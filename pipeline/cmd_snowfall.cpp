@@ -71,7 +71,7 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   if (o.direct_stabilise && sub.count("--coarse-levels") > 0)
     usage_error(
         "--coarse-levels applies to --stabilise passes only; drop --coarse-levels, or "
-        "--stabilise direct");
+        "use --stabilise passes");
   if (c.block < 0) usage_error("--block takes a number of cells, 0 or more");
   // Blocks tile the ground's horizon sweep only: refused, not ignored, with
   // the objects' depth maps or OSMesa's (issue 34: no value dropped silently).
