@@ -157,6 +157,9 @@ void run_marks_by_blocks(MarksCommand& c, const CLI::App& sub) {
 
 void run_marks(MarksCommand& c, const CLI::App& sub) {
   if (c.block > 0) return run_marks_by_blocks(c, sub);
+  // The halo is a block's: refused without blocks, not ignored (issue 34).
+  if (sub.count("--halo") > 0)
+    usage_error("--halo applies to --block only; add --block N, or drop --halo");
   if (c.add_snow && c.snow_depth.empty()) usage_error("--add-snow needs --snow-depth");
   if (!c.materials.empty() && (!c.snow_depth.empty() || !c.material.empty()))
     usage_error("--materials gives every cell its material; drop --snow-depth and --material");

@@ -99,6 +99,16 @@ void run_snowfall(SnowfallCommand& c, const CLI::App& sub) {
   o.occlusion.terrain =
       c.occlusion == "opengl" ? snow::TerrainOcclusion::OpenGL : snow::TerrainOcclusion::Sweep;
   o.direct_stabilise = c.stabilise == "direct";
+  // Each stabilisation's own setting is refused with the other, not ignored
+  // (issue 34: no value dropped silently).
+  if (!o.direct_stabilise && sub.count("--direct-layers") > 0)
+    usage_error(
+        "--direct-layers applies to --stabilise direct only; add --stabilise direct, or "
+        "drop --direct-layers");
+  if (o.direct_stabilise && sub.count("--coarse-levels") > 0)
+    usage_error(
+        "--coarse-levels applies to --stabilise passes only; drop --coarse-levels, or "
+        "use --stabilise passes");
   if (c.block < 0) usage_error("--block takes a number of cells, 0 or more");
   // Blocks tile the ground's horizon sweep only: refused, not ignored, with
   // the objects' depth maps or OSMesa's (issue 34: no value dropped silently).

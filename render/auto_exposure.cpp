@@ -50,12 +50,14 @@ struct Reading {
 
 // The readings of the nearer half of the ground (all if no depth was read):
 // far ground's light is inflated by the air's (auto_exposure.h).
-std::vector<std::pair<double, double>> nearer_half(std::vector<Reading> readings, bool has_depth) {
+std::vector<std::pair<double, double>> nearer_half(const std::vector<Reading>& readings,
+                                                   bool has_depth) {
   std::vector<std::pair<double, double>> out;
   if (readings.empty()) return out;
   double cut = std::numeric_limits<double>::infinity();
   if (has_depth) {
     std::vector<double> depths;
+    depths.reserve(readings.size());
     for (const Reading& r : readings) depths.push_back(r.depth);
     auto mid = depths.begin() + static_cast<std::ptrdiff_t>((depths.size() - 1) / 2);
     std::nth_element(depths.begin(), mid, depths.end());
@@ -100,7 +102,7 @@ Metering meter_exposure(const Image& linear, const std::array<float, 3>& white_b
   Metering m;
   const std::size_t pixels = static_cast<std::size_t>(linear.width) * linear.height;
   m.incident = !readings.empty() && readings.size() * 100 >= pixels;
-  const auto incident = nearer_half(std::move(readings), depth >= 0);
+  const auto incident = nearer_half(readings, depth >= 0);
   const auto& chosen = m.incident ? incident : reflected;
   if (chosen.empty()) return m;  // black: nothing to meter
   m.light = std::exp(weighted_quantile(chosen, kQuantile));

@@ -153,7 +153,7 @@ Image merge_tiles(const std::vector<Image>& tiles,
     const Image& t = tiles[i];
     const std::size_t row_floats = static_cast<std::size_t>(t.width) * channels;
     for (int r = 0; r < t.height; ++r) {
-      const std::size_t y = static_cast<std::size_t>(t.frame.y + r);
+      const std::size_t y = static_cast<std::size_t>(t.frame.y) + static_cast<std::size_t>(r);
       std::memcpy(&out.pixels[(y * width + t.frame.x) * channels],
                   &t.pixels[static_cast<std::size_t>(r) * row_floats], row_floats * sizeof(float));
     }

@@ -164,9 +164,10 @@ SnowfallResult simulate_snowfall(const terrain::HeightField& ground,
   options.validate();
   const ProgressFn report = progress ? progress : ProgressFn(no_progress);
   if (!report(0.0, "snowfall")) throw Cancelled();
-  // Ground copy, probability (+ facing), depth as double and its double buffer, output rasters.
-  require_memory(ground.size() * (4 + 8 + 8 + 8 + 8 + 4 + 4), "snowfall on the ground raster",
-                 "crop or resample the ground raster");
+  // Ground copy, probability (+ facing), depth as double and the passes' double
+  // buffer (not with --stabilise direct, which counts its own), output rasters.
+  require_memory(ground.size() * (4 + 8 + 8 + 8 + (options.direct_stabilise ? 0 : 8) + 4 + 4),
+                 "snowfall on the ground raster", "crop or resample the ground raster");
   const SnowScene scene = make_snow_scene(ground, objects, options.mesh_max_edge);
   const auto dirs = jittered_directions(options.azimuth_deg, options.elevation_deg,
                                         options.spread_deg, options.maps, options.seed);

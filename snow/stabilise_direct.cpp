@@ -8,11 +8,13 @@
 #include <limits>
 #include <queue>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "snow/stabilise_field.h"
 #include "terrain/error.h"
+#include "terrain/memory.h"
 
 namespace drift::snow {
 
@@ -22,36 +24,116 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
 using Field = StabiliseField;
 
+// The cells whose snow can move at all: a cell's drained surface E is at
+// least min_n (ground(n) + k d) (E(n) >= ground(n)), so where the snow's
+// surface stands no higher than that over every neighbour nothing is cut (and
+// nothing runs onto a cell unless something is cut). A bound on the cut, known
+// before anything is allocated: 0 on ground where nothing slides.
+std::size_t cells_that_can_move(const Field& f) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < f.cells(); ++i) {
+    if (!(f.snow(i) > 0.0)) continue;
+    const double hi = f.surface(i);
+    bool moves = false;
+    f.neighbours(i, [&](std::size_t n, int k) { moves = moves || hi > f.ground(n) + f.drop(k); });
+    count += moves;
+  }
+  return count;
+}
+
+// A binary min-heap of cells ordered by (label, index), at most one entry a
+// cell (its label lowered in place): the heap holds at most the cells that
+// can move, where a queue of (label, cell) pairs holds one entry a lowering.
+// The label is kept in the entry, so that comparing two reads no scattered
+// memory; 4 bytes a cell for the positions. Pops in the same order as such a
+// queue would (a strict order), so the same bits.
+struct Labelled {
+  double label;
+  std::uint32_t cell;
+};
+class CellHeap {
+ public:
+  CellHeap(std::size_t cells, std::vector<Labelled>& heap) : heap_(heap), pos_(cells, kNone) {
+    heap_.clear();
+  }
+  bool empty() const { return heap_.empty(); }
+  // Adds cell i with `label`, or moves it up after its label fell to `label`.
+  void lowered(std::uint32_t i, double label) {
+    if (pos_[i] == kNone) {
+      heap_.push_back({label, i});
+      up(heap_.size() - 1);
+    } else {
+      heap_[pos_[i]].label = label;
+      up(pos_[i]);
+    }
+  }
+  Labelled pop() {
+    const Labelled top = heap_.front();
+    pos_[top.cell] = kNone;
+    const Labelled last = heap_.back();
+    heap_.pop_back();
+    if (!heap_.empty()) heap_.front() = last, pos_[last.cell] = 0, down(0);
+    return top;
+  }
+
+ private:
+  static bool before(const Labelled& a, const Labelled& b) {
+    return a.label < b.label || (a.label == b.label && a.cell < b.cell);
+  }
+  void place(std::size_t at, const Labelled& entry) {
+    heap_[at] = entry, pos_[entry.cell] = static_cast<std::uint32_t>(at);
+  }
+  void up(std::size_t at) {
+    const Labelled entry = heap_[at];
+    while (at > 0) {
+      const std::size_t parent = (at - 1) / 2;
+      if (!before(entry, heap_[parent])) break;
+      place(at, heap_[parent]), at = parent;
+    }
+    place(at, entry);
+  }
+  void down(std::size_t at) {
+    const Labelled entry = heap_[at];
+    const std::size_t n = heap_.size();
+    for (;;) {
+      std::size_t child = 2 * at + 1;
+      if (child >= n) break;
+      if (child + 1 < n && before(heap_[child + 1], heap_[child])) ++child;
+      if (!before(heap_[child], entry)) break;
+      place(at, heap_[child]), at = child;
+    }
+    place(at, entry);
+  }
+  std::vector<Labelled>& heap_;
+  std::vector<std::uint32_t> pos_;
+};
+
 // Step 1: the drained surface (greatest fixed point of E = min(H, max(ground,
-// min_n E(n) + k d))). Labels only fall, and a label set from a popped one is
-// higher than it, so each is final when popped (Dijkstra).
-std::vector<double> drained_surface(const Field& f) {
-  std::vector<double> e(f.cells());
+// min_n E(n) + k d))) into e. Labels only fall, and a label set from a popped
+// one is higher than it, so each is final when popped (Dijkstra). `heap`:
+// room for the lowered cells (at most those cells_that_can_move counts).
+void drained_surface(const Field& f, std::vector<double>& e, std::vector<Labelled>& heap) {
   for (std::size_t i = 0; i < e.size(); ++i) e[i] = f.surface(i);
-  using Item = std::pair<double, std::size_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  CellHeap queue(e.size(), heap);
   for (std::size_t i = 0; i < e.size(); ++i) {
     if (!(f.snow(i) > 0.0)) continue;
     double limit = e[i];
     f.neighbours(i, [&](std::size_t n, int k) { limit = std::min(limit, e[n] + f.drop(k)); });
     limit = std::max(limit, f.ground(i));
-    if (limit < e[i]) e[i] = limit, queue.push({limit, i});
+    if (limit < e[i]) e[i] = limit, queue.lowered(static_cast<std::uint32_t>(i), limit);
   }
   // Lowered cells are relaxed only once popped, from their final label; cells
   // never lowered were checked against their neighbours above.
   while (!queue.empty()) {
-    // Named copies, not a structured binding: the lambda below captures them.
-    const double v = queue.top().first;
-    const std::size_t i = queue.top().second;
-    queue.pop();
-    if (v > e[i]) continue;
+    const Labelled top = queue.pop();
+    const std::uint32_t i = top.cell;
+    const double v = top.label;
     f.neighbours(i, [&](std::size_t n, int k) {
       if (!(f.snow(n) > 0.0)) return;
       const double limit = std::max(v + f.drop(7 - k), f.ground(n));
-      if (limit < e[n]) e[n] = limit, queue.push({limit, n});
+      if (limit < e[n]) e[n] = limit, queue.lowered(static_cast<std::uint32_t>(n), limit);
     });
   }
-  return e;
 }
 
 // Step 2: the next cell down, or kNone where the snow stops. From a cut cell
@@ -171,10 +253,14 @@ std::size_t runs_to(const Field& f, std::size_t i) {
 // remainder, so mass moves as the same doubles.
 void route_shared(const Field& f, const std::vector<std::uint32_t>& cut_cells,
                   const std::vector<double>& loose, const std::vector<std::uint8_t>& cut,
-                  std::vector<double>& load, std::vector<std::uint32_t>& heaps,
-                  DirectReport& report, std::uint8_t* touched) {
+                  std::vector<double>& load, std::vector<std::pair<double, std::uint32_t>>& room,
+                  std::vector<std::uint32_t>& heaps, DirectReport& report,
+                  std::uint8_t* touched) {
+  // Highest surface first, ties by index; each cell queued once, in `room`
+  // (one entry a cell at most, reserved by the caller).
   using Item = std::pair<double, std::uint32_t>;
-  std::priority_queue<Item> queue;                // highest surface first; ties by index
+  room.clear();
+  std::priority_queue<Item> queue(std::less<Item>(), std::move(room));
   std::vector<double>& flow = load;               // pending inflow; becomes the load where it rests
   std::vector<std::uint8_t> state(f.cells(), 0);  // 1 queued, 2 resting
   for (std::size_t c = 0; c < cut_cells.size(); ++c) {
@@ -253,11 +339,40 @@ DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<do
     throw Error("settle_at_rest: more than 2^32 - 1 cells; settle the raster in parts");
   const Field f(ground, snow, dx, dy, tan_repose);
   DirectReport report;
+  // Counted before each allocation, from what this layer will hold (the
+  // caller's grids are held by stabilise_grid's HeldMemory): nothing where no
+  // snow can move (the state is at rest as it is); else, while the drained
+  // surface is found, its array (then the loads) 8 bytes a cell, the heap's
+  // positions 4 and an entry of 16 for each cell that can move; then, once it
+  // says how many cells are cut, the loads, the cut marks and the routing
+  // state (1 each), the routing queue's room (16: one entry a cell at most,
+  // reserved; its pages are touched only as far as it fills) and 12 a cut
+  // cell, its index and loose snow (MemoryEstimate.
+  // SnowFallDirectOnFlatAndSteepGround: the worst case, a queue entry and a
+  // cut cell for every cell, counted up front, was 1.5-1.85 times the peak
+  // where nothing slides).
+  const std::uint64_t cells = f.cells();
+  const std::size_t can_move = cells_that_can_move(f);
+  if (can_move == 0) return report;
+  const std::string what = "snow stabilisation's workspace (direct)";
+  const std::string fix = "use a smaller or coarser ground raster";
+  require_memory(cells * 12 + can_move * sizeof(Labelled), what, fix);
   // The drained surface's array holds each resting cell's load once the cut is made.
-  std::vector<double> drained_then_load = drained_surface(f);
+  std::vector<double> drained_then_load(cells);
+  {
+    std::vector<Labelled> heap;
+    heap.reserve(can_move);
+    drained_surface(f, drained_then_load, heap);
+  }
+  std::size_t cut_count = 0;
+  for (std::size_t i = 0; i < f.cells(); ++i) cut_count += drained_then_load[i] < f.surface(i);
+  require_memory(cells * (8 + 1 + 1 + 16) + cut_count * 12, what, fix);
+  std::vector<std::pair<double, std::uint32_t>> room;
+  room.reserve(cells);
   std::vector<std::uint8_t> cut(f.cells(), 0);
   std::vector<std::uint32_t> cut_cells;
   std::vector<double> loose;
+  cut_cells.reserve(cut_count), loose.reserve(cut_count);
   for (std::size_t i = 0; i < f.cells(); ++i) {
     if (!(drained_then_load[i] < f.surface(i))) continue;
     const double before = f.snow(i);
@@ -271,7 +386,10 @@ DirectReport settle_at_rest(const terrain::Grid<float>& ground, terrain::Grid<do
   std::fill(load.begin(), load.end(), 0.0);
   std::vector<std::uint32_t> heaps;
   std::uint8_t* const marks = touched ? touched->data() : nullptr;
-  route_shared(f, cut_cells, loose, cut, load, heaps, report, marks);
+  route_shared(f, cut_cells, loose, cut, load, room, heaps, report, marks);
+  // The heaps' list and their queue's nodes (about 48 bytes each), beside the
+  // loads and marks (the routing's state and room are freed).
+  require_memory(cells * 9 + cut_count * 12 + heaps.size() * (4 + 48), what, fix);
   // Heaps in ascending cell order; spilled snow queued at its new resting
   // cell (a fixed order, so the same bits on any machine).
   std::set<std::size_t> queue(heaps.begin(), heaps.end());

@@ -435,12 +435,14 @@ StabiliseReport stabilise_grid(const terrain::Grid<float>& ground, terrain::Grid
   if (ground.width() != snow.width() || ground.height() != snow.height())
     throw Error("stabilise_grid: the ground and the snow grids differ in size");
   if (options.direct) {
-    // Drained surface (then loads) 8, marks 1, routing state 1, cut list and
-    // its loose snow 12 at worst, a queue entry 16 a cell at worst; with
-    // layers, the snow given (8).
-    require_memory(
-        snow.size() * (options.held_bytes_per_cell + 38 + (options.direct_layers > 1 ? 8 : 0)),
-        "snow stabilisation's workspace (direct)", "use a smaller or coarser ground raster");
+    // The caller's grids and, with layers, the snow given (8 bytes a cell),
+    // held while settle_at_rest counts its own workspace from what it will
+    // hold (nothing where no snow can move; snow/stabilise_direct.cpp).
+    const std::uint64_t held =
+        snow.size() * (options.held_bytes_per_cell + (options.direct_layers > 1 ? 8 : 0));
+    require_memory(held, "snow stabilisation's workspace (direct)",
+                   "use a smaller or coarser ground raster");
+    const HeldMemory held_memory(held, "the ground's grids");
     progress(0.0, "stabilising snow");
     settle_at_rest(ground, snow, dx, dy, terrain::tan_degrees(options.repose_deg),
                    options.direct_layers);

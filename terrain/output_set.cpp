@@ -82,7 +82,7 @@ class FolderLocks {
 
 }  // namespace
 
-OutputSet::OutputSet(std::vector<fs::path> outputs, std::vector<fs::path> inputs)
+OutputSet::OutputSet(const std::vector<fs::path>& outputs, std::vector<fs::path> inputs)
     : inputs_(std::move(inputs)) {
   std::erase_if(inputs_, [](const fs::path& p) { return p.empty(); });
   try {

@@ -22,7 +22,7 @@ namespace drift {
 
 class OutputSet {
  public:
-  OutputSet(std::vector<std::filesystem::path> outputs,
+  OutputSet(const std::vector<std::filesystem::path>& outputs,
             std::vector<std::filesystem::path> inputs = {});
   ~OutputSet();  // removes every temporary file unless commit() succeeded
   OutputSet(const OutputSet&) = delete;

@@ -270,6 +270,10 @@ TEST(MarksCli, BlocksGiveTheOnePassGroundAndRefuseWhatTheyCannotDo) {
       << output(d);
   EXPECT_NE(output(d).find("--block works on one ground raster"), std::string::npos) << output(d);
   EXPECT_FALSE(fs::exists(d / "f.tif"));
+  // --halo without --block was ignored (exit 0): refused, naming the flag.
+  EXPECT_EQ(run(common + " -o " + (d / "h.tif").string() + " --halo 5", d), 2) << output(d);
+  EXPECT_NE(output(d).find("--halo applies to --block only"), std::string::npos) << output(d);
+  EXPECT_FALSE(fs::exists(d / "h.tif"));
 }
 
 }  // namespace

@@ -278,6 +278,40 @@ TEST(MemoryEstimate, SnowFallBlockByBlock) {
       run_measured("snow fall blocks_big.tif --block 1024" + args + "b1.tif", d));
 }
 
+TEST(MemoryEstimate, SnowFallDirectOnFlatAndSteepGround) {
+  DRIFT_SKIP_UNDER_SANITIZER();
+  // --stabilise direct counted a queue entry and a cut cell for every cell up
+  // front (38 bytes a cell beside the caller's grids): 1.64 times the peak on
+  // ground where nothing slides (nothing is cut, nothing queued), and 0.80 on
+  // steep ground with 4 layers (vectors grown by doubling, the old and new
+  // buffers both alive). It now counts what each layer will hold: nothing
+  // where no snow can move, else the drained surface, one queue entry a cell
+  // at most and the cut cells once they are known.
+  const fs::path d = dir();
+  auto ground = [](int n, double amplitude) {
+    return drift::testing::dem_from(n, 1.0, 0.5, [amplitude](double x, double y) {
+      return 1000 + amplitude * (std::sin(x / 17.0) + std::cos(y / 13.0));
+    });
+  };
+  drift::terrain::write_geotiff(ground(32, 2), d / "flat_small.tif", {"height", "m"});
+  drift::terrain::write_geotiff(ground(1800, 2), d / "flat_big.tif", {"height", "m"});
+  drift::terrain::write_geotiff(ground(32, 40), d / "steep_small.tif", {"height", "m"});
+  drift::terrain::write_geotiff(ground(1400, 40), d / "steep_big.tif", {"height", "m"});
+  const std::string direct = " --maps 2 --stabilise direct ";
+  {
+    SCOPED_TRACE("flat, 4 layers");
+    expect_estimate_within_a_quarter(
+        run_measured("snow fall flat_small.tif" + direct + "-o f0.tif", d),
+        run_measured("snow fall flat_big.tif" + direct + "-o f1.tif", d));
+  }
+  {
+    SCOPED_TRACE("steep, 1 layer");
+    expect_estimate_within_a_quarter(
+        run_measured("snow fall steep_small.tif" + direct + "--direct-layers 1 -o s0.tif", d),
+        run_measured("snow fall steep_big.tif" + direct + "--direct-layers 1 -o s1.tif", d));
+  }
+}
+
 TEST(MemoryEstimate, MergeInfoAndMesh) {
   DRIFT_SKIP_UNDER_SANITIZER();
   // merge counted its merged frame and held the tiles beside it (0.51); info

@@ -221,6 +221,15 @@ TEST(SnowfallCli, BadInputIsRefusedWithAMessageAndNoOutput) {
     EXPECT_NE(output(d).find("--coarse-levels"), std::string::npos) << output(d);
   }
   EXPECT_EQ(run(ground.string() + out + " --mesh-out " + (d / "m.ply").string(), d), 2);
+  // A stabilisation's setting given with the other stabilisation was ignored
+  // (exit 0): refused, naming the flag.
+  EXPECT_EQ(run(ground.string() + out + " --direct-layers 3", d), 2);
+  EXPECT_NE(output(d).find("--direct-layers applies to --stabilise direct only"), std::string::npos)
+      << output(d);
+  EXPECT_EQ(run(ground.string() + out + " --stabilise direct --coarse-levels 2", d), 2);
+  EXPECT_NE(output(d).find("--coarse-levels applies to --stabilise passes only"), std::string::npos)
+      << output(d);
+  EXPECT_FALSE(fs::exists(d / "depth.tif"));
   std::ofstream(d / "bad.toml") << "[[objects]]\nmesh = \"rock.obj\"\nsize = 2\n";
   EXPECT_EQ(run(ground.string() + out + " --objects " + (d / "bad.toml").string(), d), 1);
   EXPECT_NE(output(d).find("objects.size"), std::string::npos) << output(d);

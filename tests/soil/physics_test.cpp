@@ -74,11 +74,18 @@ TEST(SoilPhysics, SoilNeverPassesThroughABody) {
   SoilScenario sc;
   sc.name = "lid";
   sc.shape = {30, 12, 12, 0.1, {0, 0, 0}};
-  sc.soil.push_back(
-      {"layer", {{PrimitiveKind::Cuboid, {1.5, 0.6, 0.3}, {1.5, 0.6, 0.3}}}, {0, 0, 0}});
-  sc.bodies.push_back(
-      {"lid", {{PrimitiveKind::Cuboid, {1.3, 0.6, 0.7}, {1.1, 0.6, 0.1}}}, {{0.0, {0, 0, 0}}}});
-  RigidObject piston{"piston", {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.1, 0.6, 0.6}}}, {}};
+  sc.soil.push_back({"layer",
+                     {{PrimitiveKind::Cuboid, {1.5, 0.6, 0.3}, {1.5, 0.6, 0.3}}},
+                     {0, 0, 0},
+                     false,
+                     std::nullopt});
+  sc.bodies.push_back({"lid",
+                       {{PrimitiveKind::Cuboid, {1.3, 0.6, 0.7}, {1.1, 0.6, 0.1}}},
+                       {{0.0, {0, 0, 0}}},
+                       {0, 0, 0},
+                       nullptr});
+  RigidObject piston{
+      "piston", {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.1, 0.6, 0.6}}}, {}, {0, 0, 0}, nullptr};
   piston.path = {{0.0, {0.1, 0.6, 0.6}}, {0.8, {0.5, 0.6, 0.6}}};
   sc.bodies.push_back(piston);
   SoilSimulation sim = make_simulation(sc);
@@ -115,9 +122,13 @@ TEST(SoilPhysics, PushLeavesItsPathCut) {
   sc.name = "push";
   sc.shape = {96, 64, 40, 0.05, {0, 0, 0}};
   sc.options.soil = {"custom", 25.0, 0.0, 2.0, 0.0};
-  sc.soil.push_back(
-      {"layer", {{PrimitiveKind::Cuboid, {2.4, 1.6, 0.25}, {2.4, 1.6, 0.25}}}, {0, 0, 0}});
-  RigidObject blade{"blade", {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.1, 0.6, 0.6}}}, {}};
+  sc.soil.push_back({"layer",
+                     {{PrimitiveKind::Cuboid, {2.4, 1.6, 0.25}, {2.4, 1.6, 0.25}}},
+                     {0, 0, 0},
+                     false,
+                     std::nullopt});
+  RigidObject blade{
+      "blade", {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.1, 0.6, 0.6}}}, {}, {0, 0, 0}, nullptr};
   blade.path = {{0.0, {0.5, 1.6, 0.88}}, {3.0, {3.5, 1.6, 0.88}}};
   sc.bodies.push_back(blade);
   SoilSimulation sim = make_simulation(sc);

@@ -207,8 +207,11 @@ TEST(SoilRest, SoilOnASteepSlopeSlidesToTheFoot) {
   for (int row = 0; row < 8; ++row)
     for (int x = 0; x < 40; ++x)
       sc.terrain.heights(x, row) = static_cast<float>(2.0 + std::max(0.0, 20.0 - (x + 0.5)));
-  sc.soil.push_back(
-      {"layer", {{PrimitiveKind::Cuboid, {0, 0, 0.6}, {6.0, 4.0, 0.6}}}, {10.0, 4.0, 0.0}, true});
+  sc.soil.push_back({"layer",
+                     {{PrimitiveKind::Cuboid, {0, 0, 0.6}, {6.0, 4.0, 0.6}}},
+                     {10.0, 4.0, 0.0},
+                     true,
+                     std::nullopt});
   SoilSimulation sim = make_simulation(sc);
   const double total = sim.state().mass();
   ASSERT_GT(total, 50.0);

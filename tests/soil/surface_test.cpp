@@ -138,8 +138,11 @@ TEST(SoilSurface, NoSoilGivesNoTriangles) {
   sc.shape = {32, 32, 24, 0.1, {0, 0, 0}};
   sc.terrain.kind = TerrainSource::Kind::Voxel;
   sc.terrain.base = 0.6;
-  sc.bodies.push_back(
-      {"block", {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.4, 0.4, 0.3}}}, {{0.0, {1.6, 1.6, 1.6}}}});
+  sc.bodies.push_back({"block",
+                       {{PrimitiveKind::Cuboid, {0, 0, 0}, {0.4, 0.4, 0.3}}},
+                       {{0.0, {1.6, 1.6, 1.6}}},
+                       {0, 0, 0},
+                       nullptr});
   SoilSimulation sim = make_simulation(sc);
   sim.run(3);
   ASSERT_EQ(sim.state().mass(), 0.0);
