@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <utility>
 #include <cmath>
+#include <utility>
 
 #include "terrain/hash.h"
 #include "terrain/neighbours.h"
@@ -245,12 +245,11 @@ class SlopeRelaxer {
   double tan_of(std::size_t i, const SlopeRule& r) const {
     if (!r.rough) return r.tan_repose;
     std::uint64_t cell = i;
-    if (o_.index_width > 0)
-    {
+    if (o_.index_width > 0) {
       const auto [x, y] = split(static_cast<int>(i));
-      cell = static_cast<std::uint64_t>((static_cast<std::int64_t>(y) + o_.index_y0) *
-                                            o_.index_width +
-                                        static_cast<std::int64_t>(x) + o_.index_x0);
+      cell =
+          static_cast<std::uint64_t>((static_cast<std::int64_t>(y) + o_.index_y0) * o_.index_width +
+                                     static_cast<std::int64_t>(x) + o_.index_x0);
     }
     return r.tan_repose * (1.0 - r.fraction * unit_double(mix64(seed_ ^ cell)));
   }

@@ -123,7 +123,7 @@ class SlopeRelaxWorkspace {
   // Per giver of a pass: its eight excesses, its factor (0: gives nothing),
   // its offers' factor and its flows'.
   std::vector<double> excess_, factor_, mult_, post_;
-  std::vector<std::uint8_t> offers_;  // per giver: it gives this pass (factor > 0)
+  std::vector<std::uint8_t> offers_;                   // per giver: it gives this pass (factor > 0)
   std::vector<std::uint8_t> active_, touched_, ever_;  // per cell
   // Cell lists as a bitmap (a bit a cell, zero between uses) and, per row, the
   // words in use (lo > hi: none).

@@ -118,7 +118,8 @@ class WindowMaterials {
       for (const char* name : {"sand", "mud", "snow"}) table_.push_back(*material_preset(name));
     }
     if (!f.snow_depth.empty())
-      snow_depth_ = open(f.snow_depth, "snow depth", "give the depth drift snow fall made on this ground");
+      snow_depth_ =
+          open(f.snow_depth, "snow depth", "give the depth drift snow fall made on this ground");
   }
   MaterialField of(const Rect& win) const {
     if (!materials_ && !snow_depth_) return MaterialField{{ground_}, {}};
@@ -251,7 +252,8 @@ MarksBlockReport marks_to_files(const MarksBlockFiles& files,
             const std::size_t slot =
                 static_cast<std::size_t>(e.step) * n_objects + static_cast<std::size_t>(e.object);
             if (have[slot] || box_of[slot] < 0) continue;
-            const Rect box = boxes[static_cast<std::size_t>(box_of[slot])].box.clipped(width, height);
+            const Rect box =
+                boxes[static_cast<std::size_t>(box_of[slot])].box.clipped(width, height);
             if (box.width() > 0 && box.height() > 0 && !win.holds(box)) continue;
             taken[slot] = e, have[slot] = 1;
           }

@@ -136,8 +136,8 @@ TEST(MarksBlocks, MaterialRastersGiveTheOnePassRunBitForBit) {
   std::vector<Material> table;
   for (const char* name : {"sand", "mud", "snow"}) table.push_back(*material_preset(name));
   {
-    const MarksResult one = simulate_marks(ground, objects(ground),
-                                           materials_from_raster(indices, table, "m"), {});
+    const MarksResult one =
+        simulate_marks(ground, objects(ground), materials_from_raster(indices, table, "m"), {});
     const MarksResult sand = simulate_marks(ground, objects(ground), testing::only("sand"), {});
     EXPECT_GT(differing(one.heights, sand.heights), 100u);  // the materials matter
     MarksBlockFiles f;
@@ -149,8 +149,8 @@ TEST(MarksBlocks, MaterialRastersGiveTheOnePassRunBitForBit) {
   }
   {
     const Material sand = *material_preset("sand"), snow = *material_preset("snow");
-    const MarksResult one = simulate_marks(
-        ground, objects(ground), materials_from_snow_depth(depth, 0.01, sand, snow), {});
+    const MarksResult one = simulate_marks(ground, objects(ground),
+                                           materials_from_snow_depth(depth, 0.01, sand, snow), {});
     MarksBlockFiles f;
     f.snow_depth = dir / "depth.tif", f.snow_min = 0.01;
     const BlockRun blocks = by_blocks(dir, ground, 32, 16, f);
@@ -160,20 +160,23 @@ TEST(MarksBlocks, MaterialRastersGiveTheOnePassRunBitForBit) {
 }
 
 // A material raster's bad cell is named in the raster's own cells, not the
-// window's.
+// window's: only the box (columns 63-130, rows 31-98 with its reach) is run,
+// so every window that reads the cell starts away from the raster's corner.
 TEST(MarksBlocks, ABadMaterialCellIsNamedInTheRastersCells) {
   const terrain::HeightField ground = rolling();
   const auto dir = drift::testing::test_dir("marks_blocks_bad_material");
+  terrain::write_geotiff(ground, dir / "ground.tif");
   terrain::HeightField indices(kWidth, kHeight, 0.0f, ground.geo());
-  indices(100, 100) = 7.0f;  // first read by windows that start at row 4
+  indices(100, 60) = 7.0f;
   terrain::write_geotiff(indices, dir / "materials.tif");
   MarksBlockFiles f;
+  f.ground = dir / "ground.tif", f.output = dir / "out.tif", f.block = 32, f.halo = 16;
   f.materials = dir / "materials.tif";
   try {
-    by_blocks(dir, ground, 32, 16, f);
+    marks_to_files(f, {objects(ground)[1]}, *material_preset("sand"), {});
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("cell (100, 100) holds 7"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cell (100, 60) holds 7"), std::string::npos) << e.what();
   }
 }
 

@@ -146,7 +146,8 @@ TEST(SlopeRelax, SeededCellListsGiveTheTilesBitsAcrossWordBoundaries) {
   std::vector<int> moved;
   relax_slopes(lists, seeds, cells, o, moved);
   int differ = 0;
-  for (std::size_t i = 0; i < h.values().size(); ++i) differ += tiles.values()[i] != lists.values()[i];
+  for (std::size_t i = 0; i < h.values().size(); ++i)
+    differ += tiles.values()[i] != lists.values()[i];
   EXPECT_EQ(differ, 0) << "cells where the seeded lists and the tiles differ";
   EXPECT_NEAR(sum(lists), 6.0 * std::size(columns), 1e-9);
 }
