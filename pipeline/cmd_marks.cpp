@@ -51,16 +51,20 @@ terrain::HeightField read_snow_depth(const MarksCommand& c, const terrain::Heigh
   return depth;
 }
 
-// The --materials raster: per cell 0 sand, 1 mud, 2 snow (the presets' order).
-marks::MaterialField read_material_raster(const MarksCommand& c,
-                                          const terrain::HeightField& ground) {
-  // One band of material indices: which band of several holds them is not
-  // guessed (band 1 was read without a word; issue 34, class 6).
+// One band of material indices: which band of several holds them is not
+// guessed (band 1 was read without a word; issue 34, class 6).
+void require_single_band(const MarksCommand& c) {
   const int bands = terrain::read_raster_header(c.materials).bands;
   if (bands != 1) {
     throw Error("material raster '" + c.materials + "' has " + std::to_string(bands) +
                 " bands; give a single-band raster of material indices (0 sand, 1 mud, 2 snow)");
   }
+}
+
+// The --materials raster: per cell 0 sand, 1 mud, 2 snow (the presets' order).
+marks::MaterialField read_material_raster(const MarksCommand& c,
+                                          const terrain::HeightField& ground) {
+  require_single_band(c);
   // Indices, not heights: 1e30 or inf is refused below as no material (it was
   // refused as "a height beyond any ground").
   terrain::ReadOptions indices;
@@ -122,12 +126,31 @@ void warn_about_misses(const marks::MarksReport& report) {
 // --block: the ground read, marked and written a block at a time (issue 36
 // item 3), for rasters larger than memory.
 void run_marks_by_blocks(MarksCommand& c, const CLI::App& sub) {
-  if (!c.frames.empty() || !c.materials.empty() || !c.snow_depth.empty() || !c.posed.empty())
+  // Frames are the whole field after every step, and a block's window holds
+  // the whole track's steps at once: a frame would need every block at that
+  // step (all of them in memory, or every block rerun per frame). --posed
+  // places objects that follow the ground on heights read from the whole
+  // raster at one time; it is not refused for a reason of principle, but the
+  // mesh does not depend on the blocks: make it with a run without --block
+  // (or on a crop that holds the objects).
+  if (!c.frames.empty())
     usage_error(
-        "--block works on one ground raster with one material: drop --frames, --materials, "
-        "--snow-depth and --posed, or drop --block");
+        "--frames writes the whole field after every step, and --block works a window through "
+        "the whole track at a time, so no step's field is ever whole; drop --block for frames "
+        "(crop the ground around the track with drift import --crop if it does not fit)");
+  if (!c.posed.empty())
+    usage_error(
+        "--posed is not made block by block; run drift marks --posed without --block on the "
+        "same track (a crop of the ground around the objects gives the same mesh)");
+  if (c.add_snow)
+    usage_error(
+        "--add-snow is not made block by block; lay the snow on the ground first (GROUND + "
+        "depth) and give that surface as the ground, with --snow-depth for the materials");
+  if (!c.materials.empty() && (!c.snow_depth.empty() || !c.material.empty()))
+    usage_error("--materials gives every cell its material; drop --snow-depth and --material");
   c.parameters.apply(sub, c.options);
-  std::vector<fs::path> inputs = {c.ground, c.track};
+  if (!c.materials.empty()) require_single_band(c);
+  std::vector<fs::path> inputs = {c.ground, c.track, c.snow_depth, c.materials};
   for (const fs::path& mesh : object_mesh_paths(c.track, "track file")) inputs.push_back(mesh);
   OutputSet outputs({c.output, c.disturbed}, inputs);
   TrackFile track = read_track_file(c.track);
@@ -141,18 +164,22 @@ void run_marks_by_blocks(MarksCommand& c, const CLI::App& sub) {
   if (!c.material.empty()) base = *marks::material_preset(c.material);
   require_metric_crs(terrain::HeightField(1, 1, 0.0f, terrain::read_raster_header(c.ground).geo),
                      c.ground);
+  marks::MarksBlockFiles files;
+  files.ground = c.ground, files.output = c.output, files.disturbed = c.disturbed;
+  files.block = c.block, files.halo = c.halo;
+  files.materials = c.materials, files.snow_depth = c.snow_depth, files.snow_min = c.snow_min;
+  if (!c.material.empty()) files.snow = *marks::material_preset(c.material);  // as one pass
   const marks::MarksBlockReport r =
-      marks::marks_to_files({c.ground, c.output, c.disturbed, c.block, c.halo}, track.objects, base,
-                            o, terminal_progress("marks"));
+      marks::marks_to_files(files, track.objects, base, o, terminal_progress("marks"));
   outputs.commit();
   std::printf("marks: wrote %s\n", c.output.c_str());
   if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
   warn_about_misses(r.report);
   std::printf(
-      "marks: %d steps, %d with contact (in the busiest block); %d of %d blocks of %d cells "
-      "worked, halo %d cells (%d widened, widest %d)\n",
-      r.report.steps, r.report.contact_steps, r.simulated, r.blocks, r.block, r.halo, r.widened,
-      r.largest_halo);
+      "marks: %d steps, %d with contact; %.6g m3 under objects: %.6g displaced, %.6g compressed "
+      "away; %d of %d blocks of %d cells worked, halo %d cells (%d widened, widest %d)\n",
+      r.report.steps, r.report.contact_steps, r.report.collided, r.report.displaced,
+      r.report.compressed, r.simulated, r.blocks, r.block, r.halo, r.widened, r.largest_halo);
 }
 
 void run_marks(MarksCommand& c, const CLI::App& sub) {

@@ -58,7 +58,7 @@ RasterBlockReader::RasterBlockReader(const std::filesystem::path& path)
 
 RasterBlockReader::~RasterBlockReader() = default;
 
-std::vector<float> RasterBlockReader::read(int x, int y, int w, int h) const {
+std::vector<float> RasterBlockReader::read(int x, int y, int w, int h, bool heights) const {
   if (w < 1 || h < 1 || x < 0 || y < 0 || x + w > width_ || y + h > height_) {
     throw Error("window " + std::to_string(w) + "x" + std::to_string(h) + "+" + std::to_string(x) +
                 "+" + std::to_string(y) + " lies outside '" + path_.string() + "'");
@@ -78,7 +78,7 @@ std::vector<float> RasterBlockReader::read(int x, int y, int w, int h) const {
     float& v = cells[i];
     if (has_nodata && v == nd) {
       v = std::numeric_limits<float>::quiet_NaN();
-    } else if (std::fabs(v) > kMaxAbsHeight) {
+    } else if (heights && std::fabs(v) > kMaxAbsHeight) {
       char value[32];
       std::snprintf(value, sizeof value, "%g", static_cast<double>(v));
       throw Error("raster '" + path_.string() + "' holds a height of " + value + " at column " +

@@ -40,7 +40,9 @@ class RasterBlockReader {
   // Cells [x, x + w) x [y, y + h), row-major, nodata as NaN (as read_raster
   // gives them). Throws drift::Error on a read failure or an infinite or
   // absurd height (|z| > 1e7 m, as read_raster refuses).
-  std::vector<float> read(int x, int y, int w, int h) const;
+  // heights = false: values that are not heights (material indices) are
+  // returned as they are, nodata as NaN.
+  std::vector<float> read(int x, int y, int w, int h, bool heights = true) const;
 
   // The whole raster resampled to at most `max_side` cells a side (nearest
   // cell; GDAL reads its overviews for it when it has them), with the

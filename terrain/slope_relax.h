@@ -123,9 +123,13 @@ class SlopeRelaxWorkspace {
   // Per giver of a pass: its eight excesses, its factor (0: gives nothing),
   // its offers' factor and its flows'.
   std::vector<double> excess_, factor_, mult_, post_;
+  std::vector<std::uint8_t> offers_;                   // per giver: it gives this pass (factor > 0)
   std::vector<std::uint8_t> active_, touched_, ever_;  // per cell
-  std::vector<std::uint32_t> stamp_;                   // per cell: the list it was last added to
-  std::uint32_t stamp_now_ = 0;
+  // Cell lists as a bitmap (a bit a cell, zero between uses) and, per row, the
+  // words in use (lo > hi: none).
+  int words_ = 0;  // per row
+  std::vector<std::uint64_t> bits_;
+  std::vector<int> row_lo_, row_hi_;
   std::vector<std::uint8_t> tile_active_, tile_touched_, tile_ever_, tile_mark_;
 };
 

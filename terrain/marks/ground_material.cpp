@@ -53,7 +53,8 @@ std::uint8_t MaterialField::add(const Material& m) {
 }
 
 MaterialField materials_from_raster(const terrain::Grid<float>& indices,
-                                    const std::vector<Material>& table, const std::string& what) {
+                                    const std::vector<Material>& table, const std::string& what,
+                                    int col0, int row0) {
   if (table.empty() || table.size() > 255)
     throw Error(what + ": a material raster needs 1 to 255 materials");
   MaterialField f;
@@ -62,8 +63,8 @@ MaterialField materials_from_raster(const terrain::Grid<float>& indices,
   for (std::size_t i = 0; i < indices.size(); ++i) {
     const float v = indices.values()[i];
     if (!(v >= 0.0f && v < static_cast<float>(table.size()) && v == std::floor(v))) {
-      const int col = static_cast<int>(i % static_cast<std::size_t>(indices.width()));
-      const int row = static_cast<int>(i / static_cast<std::size_t>(indices.width()));
+      const int col = col0 + static_cast<int>(i % static_cast<std::size_t>(indices.width()));
+      const int row = row0 + static_cast<int>(i / static_cast<std::size_t>(indices.width()));
       char value[32];  // %g: 1e+30 and inf as such, not 31 digits
       std::snprintf(value, sizeof value, "%g", static_cast<double>(v));
       throw Error(what + ": cell (" + std::to_string(col) + ", " + std::to_string(row) +

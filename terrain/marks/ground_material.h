@@ -67,8 +67,11 @@ struct MaterialField {
 // material belongs to the ground): each cell holds the index of its material
 // in `table` (0, 1, ...; whole numbers). Throws drift::Error naming `what`,
 // the cell and the value for anything else (NaN, a fraction, out of range).
+// `col0`, `row0`: where the grid lies in the raster `what` names (a window of
+// it, marks_blocks.h), for the message.
 MaterialField materials_from_raster(const terrain::Grid<float>& indices,
-                                    const std::vector<Material>& table, const std::string& what);
+                                    const std::vector<Material>& table, const std::string& what,
+                                    int col0 = 0, int row0 = 0);
 
 // Per-region materials from a snow-depth raster (drift snow fall): `snow` where
 // the snow is deeper than `min_depth` (m), `ground` elsewhere. The raster must

@@ -122,11 +122,21 @@ struct ObjectReport {
   double bottom = 0.0, ground = 0.0;                           // m, where it came nearest
 };
 
+// One object's step: what it pressed (m3) and whether it touched.
+struct ObjectStep {
+  int step = 0, object = 0;
+  double collided = 0.0, displaced = 0.0, compressed = 0.0;
+  bool contact = false;
+};
+
 struct MarksReport {
   int steps = 0;
   int contact_steps = 0;  // steps in which some object touched the ground
   double collided = 0.0, displaced = 0.0, compressed = 0.0;  // m3 over the run
   std::vector<ObjectReport> objects;                         // in the objects' order
+  // Per object and step, on a window of a larger raster only (options.window):
+  // marks_blocks.h adds up each step once, from a window that holds it whole.
+  std::vector<ObjectStep> object_steps;
 };
 
 struct MarksResult {

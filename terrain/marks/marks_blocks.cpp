@@ -39,13 +39,17 @@ int round_up4(int n) { return (n + 3) / 4 * 4; }
 // cells: its bounding sphere about its origin at the step and the step before
 // (a swept drag covers both), grown by the rim's margin at the coarsest level
 // and two cells; the steps of simulate_marks. Counts each object's steps.
-std::vector<Rect> footprints(const std::vector<MarkObject>& objects, const MarksOptions& o,
-                             const GridFrame& f, MarksReport& report) {
+struct Footprint {
+  Rect box;
+  int object = 0, step = 0;
+};
+std::vector<Footprint> footprints(const std::vector<MarkObject>& objects, const MarksOptions& o,
+                                  const GridFrame& f, MarksReport& report) {
   double t0 = 1e300, t1 = -1e300;
   for (const MarkObject& ob : objects)
     t0 = std::min(t0, ob.trajectory.start()), t1 = std::max(t1, ob.trajectory.end());
   const int steps = static_cast<int>(std::ceil((t1 - t0) / o.step - 1e-9));
-  std::vector<Rect> out;
+  std::vector<Footprint> out;
   report.steps = steps + 1;
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const MarkObject& ob = objects[i];
@@ -69,7 +73,7 @@ std::vector<Rect> footprints(const std::vector<MarkObject>& objects, const Marks
                static_cast<int>(std::ceil(std::min(r + ry, 1e9))) + 1};
       Rect step = box;
       if (had) step.add(last);
-      out.push_back(step);
+      out.push_back({step, static_cast<int>(i), k});
       last = box, had = true;
     }
   }
@@ -91,6 +95,54 @@ bool reaches_edge(const Rect& win, int width, int height, int band,
   return false;
 }
 
+// The ground's materials on a window: one material, or per region from a
+// raster read through GDAL a window at a time, as the ground is, giving each
+// cell the one-pass run's material (the same table, the same indices).
+class WindowMaterials {
+ public:
+  WindowMaterials(const MarksBlockFiles& f, const Material& ground, int width, int height)
+      : ground_(ground), snow_min_(f.snow_min), snow_(f.snow) {
+    if (!f.materials.empty() && !f.snow_depth.empty())
+      throw Error("marks: give --materials or --snow-depth, not both");
+    auto open = [&](const std::filesystem::path& p, const char* what, const char* fix) {
+      auto r = std::make_unique<terrain::RasterBlockReader>(p);
+      if (r->width() != width || r->height() != height)
+        throw Error(std::string(what) + " '" + p.string() + "' is " + std::to_string(r->width()) +
+                    " x " + std::to_string(r->height()) + " cells but the ground is " +
+                    std::to_string(width) + " x " + std::to_string(height) + "; " + fix);
+      return r;
+    };
+    if (!f.materials.empty()) {
+      materials_ = open(f.materials, "material raster", "give one value a cell of the ground");
+      what_ = "material raster '" + f.materials.string() + "'";
+      for (const char* name : {"sand", "mud", "snow"}) table_.push_back(*material_preset(name));
+    }
+    if (!f.snow_depth.empty())
+      snow_depth_ =
+          open(f.snow_depth, "snow depth", "give the depth drift snow fall made on this ground");
+  }
+  MaterialField of(const Rect& win) const {
+    if (!materials_ && !snow_depth_) return MaterialField{{ground_}, {}};
+    const terrain::RasterBlockReader& r = materials_ ? *materials_ : *snow_depth_;
+    // Indices are not heights: read them as they are (materials_from_raster
+    // names a cell that holds no index); depths are read as heights.
+    const std::vector<float> v =
+        r.read(win.x0, win.y0, win.width(), win.height(), /*heights=*/!materials_);
+    terrain::Grid<float> g(win.width(), win.height(), 0.0f);
+    std::copy(v.begin(), v.end(), g.values().begin());
+    if (materials_) return materials_from_raster(g, table_, what_, win.x0, win.y0);
+    return materials_from_snow_depth(g, snow_min_, ground_, snow_);
+  }
+
+ private:
+  Material ground_;
+  double snow_min_;
+  Material snow_;
+  std::unique_ptr<terrain::RasterBlockReader> materials_, snow_depth_;
+  std::vector<Material> table_;
+  std::string what_;
+};
+
 }  // namespace
 
 MarksBlockReport marks_to_files(const MarksBlockFiles& files,
@@ -108,7 +160,18 @@ MarksBlockReport marks_to_files(const MarksBlockFiles& files,
   out.block = round_up4(terrain::block_cells(files.block, kBlock));
   out.halo = round_up4(files.halo);
   for (const MarkObject& ob : objects) out.report.objects.push_back({ob.name});
-  const std::vector<Rect> boxes = footprints(objects, options, frame, out.report);
+  const std::vector<Footprint> boxes = footprints(objects, options, frame, out.report);
+  // Each object's step once (slot step x objects + object), from the first
+  // accepted window that holds its footprint whole: a window runs every
+  // object along its whole track, so the same step comes from several.
+  const std::size_t n_objects = objects.size();
+  std::vector<ObjectStep> taken(static_cast<std::size_t>(out.report.steps) * n_objects);
+  std::vector<char> have(taken.size(), 0);
+  std::vector<int> box_of(taken.size(), -1);
+  for (std::size_t b = 0; b < boxes.size(); ++b)
+    box_of[static_cast<std::size_t>(boxes[b].step) * n_objects +
+           static_cast<std::size_t>(boxes[b].object)] = static_cast<int>(b);
+  const WindowMaterials window_materials(files, material, width, height);
 
   // Objects that follow the ground stand on the raster's heights (simulate's
   // ground_under on the whole raster: the same cell, fractions and blend).
@@ -144,7 +207,7 @@ MarksBlockReport marks_to_files(const MarksBlockFiles& files,
               width, height);
       const int bw = block.width(), bh = block.height();
       bool near = false;
-      for (const Rect& b : boxes) near = near || b.meets(block.grown(out.halo));
+      for (const Footprint& b : boxes) near = near || b.box.meets(block.grown(out.halo));
       if (!near) {  // no object comes within the halo: the ground as it was
         cells = reader.read(block.x0, block.y0, bw, bh);
         heights_out.write(block.x0, block.y0, bw, bh, cells.data());
@@ -159,8 +222,8 @@ MarksBlockReport marks_to_files(const MarksBlockFiles& files,
           // comes into it, from a multiple of 4 cells (the coarse levels').
           const Rect first = block.grown(halo);
           Rect win = first;
-          for (const Rect& b : boxes)
-            if (b.meets(first)) win.add(b);
+          for (const Footprint& b : boxes)
+            if (b.box.meets(first)) win.add(b.box);
           win.x0 = win.x0 / 4 * 4, win.y0 = win.y0 / 4 * 4;
           win = win.clipped(width, height);
           terrain::HeightField ground(win.width(), win.height(), 0.0f, geo);
@@ -172,7 +235,7 @@ MarksBlockReport marks_to_files(const MarksBlockFiles& files,
           o.track_disturbed = true;  // the edge check reads it
           o.window = MarksOptions::Window{win.x0, win.y0, width, frame.x0, frame.y0};
           const MarksResult r =
-              simulate_marks_on(ground, objects, MaterialField{{material}, {}}, o, ground_at);
+              simulate_marks_on(ground, objects, window_materials.of(win), o, ground_at);
           const bool whole = win.x0 == 0 && win.y0 == 0 && win.x1 == width && win.y1 == height;
           if (!whole && reaches_edge(win, width, height, band, ground, r)) {
             ++out.widened;
@@ -182,11 +245,18 @@ MarksBlockReport marks_to_files(const MarksBlockFiles& files,
           for (std::size_t k = 0; k < objects.size(); ++k) {
             const ObjectReport& a = r.report.objects[k];
             ObjectReport& b = out.report.objects[k];
-            b.contact_steps = std::max(b.contact_steps, a.contact_steps);
             if (a.clearance < b.clearance)
               b.clearance = a.clearance, b.bottom = a.bottom, b.ground = a.ground;
           }
-          out.report.contact_steps = std::max(out.report.contact_steps, r.report.contact_steps);
+          for (const ObjectStep& e : r.report.object_steps) {
+            const std::size_t slot =
+                static_cast<std::size_t>(e.step) * n_objects + static_cast<std::size_t>(e.object);
+            if (have[slot] || box_of[slot] < 0) continue;
+            const Rect box =
+                boxes[static_cast<std::size_t>(box_of[slot])].box.clipped(width, height);
+            if (box.width() > 0 && box.height() > 0 && !win.holds(box)) continue;
+            taken[slot] = e, have[slot] = 1;
+          }
           auto put = [&](terrain::RasterBlockWriter& writer, const terrain::Grid<float>& g) {
             cells.resize(static_cast<std::size_t>(bw) * bh);
             for (int y = 0; y < bh; ++y)
@@ -203,6 +273,19 @@ MarksBlockReport marks_to_files(const MarksBlockFiles& files,
       if (!progress(static_cast<double>(j * bx_count + i + 1) / out.blocks, "marks"))
         throw Cancelled();
     }
+  // The one-pass run's sums, in its order (step by step, object by object).
+  for (int k = 0; k < out.report.steps; ++k) {
+    bool contact = false;
+    for (std::size_t i = 0; i < n_objects; ++i) {
+      const std::size_t slot = static_cast<std::size_t>(k) * n_objects + i;
+      if (!have[slot]) continue;
+      const ObjectStep& e = taken[slot];
+      out.report.collided += e.collided, out.report.displaced += e.displaced;
+      out.report.compressed += e.compressed;
+      if (e.contact) ++out.report.objects[i].contact_steps, contact = true;
+    }
+    if (contact) ++out.report.contact_steps;
+  }
   heights_out.finish();
   if (disturbed_out) disturbed_out->finish();
   return out;

@@ -38,6 +38,12 @@ struct MarksBlockFiles {
   std::filesystem::path ground, output, disturbed;  // disturbed: optional
   int block = 0;  // cells a side (0: DRIFT_BLOCK_CELLS, else 1024; rounded up to a multiple of 4)
   int halo = 64;  // cells (rounded up to a multiple of 4)
+  // The ground's materials per region, read per window as the ground is (at
+  // most one of the two; the rasters must be the ground's size):
+  std::filesystem::path materials;   // per cell 0 sand, 1 mud, 2 snow (drift marks --materials)
+  std::filesystem::path snow_depth;  // snow (`snow`) where deeper than snow_min, else `material`
+  double snow_min = 0.01;            // m
+  Material snow = *material_preset("snow");
 };
 
 struct MarksBlockReport {
@@ -48,9 +54,12 @@ struct MarksBlockReport {
   int largest_halo = 0;           // cells, the widest halo a block needed
 };
 
-// Marks `objects` make in the ground of files.ground (one material,
-// `material`, for every cell; objects' own materials still apply where they
-// walk), written to files.output. Throws drift::Error as simulate_marks does.
+// Marks `objects` make in the ground of files.ground (`material` for every
+// cell, or per region from files.materials or files.snow_depth; objects' own
+// materials still apply where they walk), written to files.output. The
+// report's volumes and contact steps count each object's step once, from a
+// window that holds its footprint whole, added in the one-pass run's order.
+// Throws drift::Error as simulate_marks does.
 MarksBlockReport marks_to_files(const MarksBlockFiles& files,
                                 const std::vector<MarkObject>& objects, const Material& material,
                                 const MarksOptions& options,

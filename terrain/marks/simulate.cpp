@@ -118,7 +118,11 @@ MarksResult simulate_marks_on(const terrain::HeightField& ground,
       result.report.compressed += r.compressed;
       ObjectReport& each = result.report.objects[i];
       ++each.steps;
-      if (r.touched() || r.contact_cells > 0) ++each.contact_steps, contact = true;
+      const bool touched = r.touched() || r.contact_cells > 0;
+      if (touched) ++each.contact_steps, contact = true;
+      if (options.window)
+        result.report.object_steps.push_back(
+            {k, static_cast<int>(i), r.collided, r.displaced, r.compressed, touched});
       if (r.clearance < each.clearance)
         each.clearance = r.clearance, each.bottom = r.bottom, each.ground = r.ground;
     }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "terrain/error.h"
 #include "terrain/marks/marks.h"
 #include "terrain/raster_io.h"
 #include "tests/marks/shapes.h"
@@ -74,9 +75,10 @@ struct BlockRun {
 };
 
 BlockRun by_blocks(const std::filesystem::path& dir, const terrain::HeightField& ground, int block,
-                   int halo) {
+                   int halo, MarksBlockFiles files = {}) {
   terrain::write_geotiff(ground, dir / "ground.tif");
-  MarksBlockFiles files{dir / "ground.tif", dir / "out.tif", dir / "dist.tif", block, halo};
+  files.ground = dir / "ground.tif", files.output = dir / "out.tif";
+  files.disturbed = dir / "dist.tif", files.block = block, files.halo = halo;
   BlockRun r;
   r.report = marks_to_files(files, objects(ground), *material_preset("sand"), {});
   r.heights = terrain::read_raster(dir / "out.tif");
@@ -98,9 +100,84 @@ TEST(MarksBlocks, SmallBlocksGiveTheOnePassRunBitForBit) {
   EXPECT_EQ(blocks.report.blocks, 28);  // 7 x 4 blocks of 32
   EXPECT_GT(blocks.report.simulated, 1);
   EXPECT_LT(blocks.report.simulated, blocks.report.blocks);  // the far corners were copied
-  // Both objects touched the ground, as in one pass.
-  for (std::size_t k = 0; k < 2; ++k)
+  // Both objects touched the ground, in as many steps as in one pass, and
+  // the volumes are the one-pass run's: each object's step counted once, from
+  // a window that holds it whole, added in the same order (overlapping
+  // windows run the same steps; the busiest block's count was reported).
+  for (std::size_t k = 0; k < 2; ++k) {
     EXPECT_GT(blocks.report.report.objects[k].contact_steps, 0) << k;
+    EXPECT_EQ(blocks.report.report.objects[k].contact_steps, one.report.objects[k].contact_steps)
+        << k;
+  }
+  EXPECT_EQ(blocks.report.report.contact_steps, one.report.contact_steps);
+  EXPECT_GT(one.report.collided, 0.0);
+  EXPECT_EQ(blocks.report.report.collided, one.report.collided);
+  EXPECT_EQ(blocks.report.report.displaced, one.report.displaced);
+  EXPECT_EQ(blocks.report.report.compressed, one.report.compressed);
+}
+
+// Per-region materials block by block (--materials, --snow-depth): each
+// window reads its cells' materials through GDAL as it reads the ground, and
+// gives the one-pass run's bits: the ball drags through sand into mud, the
+// mud box stands where the raster says snow.
+TEST(MarksBlocks, MaterialRastersGiveTheOnePassRunBitForBit) {
+  const terrain::HeightField ground = rolling();
+  const auto dir = drift::testing::test_dir("marks_blocks_materials");
+  terrain::HeightField indices(kWidth, kHeight, 0.0f, ground.geo());
+  terrain::HeightField depth(kWidth, kHeight, 0.0f, ground.geo());
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      indices(x, y) = x < 70 ? 0.0f : x < 150 ? 1.0f : 2.0f;
+      if (y > 58 && x > 85 && x < 110) indices(x, y) = 2.0f;
+      depth(x, y) = (x >= 60 && x < 120 && y < 56) ? 0.05f : 0.0f;
+    }
+  terrain::write_geotiff(indices, dir / "materials.tif");
+  terrain::write_geotiff(depth, dir / "depth.tif");
+  std::vector<Material> table;
+  for (const char* name : {"sand", "mud", "snow"}) table.push_back(*material_preset(name));
+  {
+    const MarksResult one =
+        simulate_marks(ground, objects(ground), materials_from_raster(indices, table, "m"), {});
+    const MarksResult sand = simulate_marks(ground, objects(ground), testing::only("sand"), {});
+    EXPECT_GT(differing(one.heights, sand.heights), 100u);  // the materials matter
+    MarksBlockFiles f;
+    f.materials = dir / "materials.tif";
+    const BlockRun blocks = by_blocks(dir, ground, 32, 16, f);
+    EXPECT_EQ(differing(one.heights, blocks.heights), 0u) << "heights, --materials";
+    EXPECT_EQ(differing(one.disturbed, blocks.disturbed), 0u) << "disturbance, --materials";
+    EXPECT_GT(blocks.report.simulated, 1);
+  }
+  {
+    const Material sand = *material_preset("sand"), snow = *material_preset("snow");
+    const MarksResult one = simulate_marks(ground, objects(ground),
+                                           materials_from_snow_depth(depth, 0.01, sand, snow), {});
+    MarksBlockFiles f;
+    f.snow_depth = dir / "depth.tif", f.snow_min = 0.01;
+    const BlockRun blocks = by_blocks(dir, ground, 32, 16, f);
+    EXPECT_EQ(differing(one.heights, blocks.heights), 0u) << "heights, --snow-depth";
+    EXPECT_EQ(differing(one.disturbed, blocks.disturbed), 0u) << "disturbance, --snow-depth";
+  }
+}
+
+// A material raster's bad cell is named in the raster's own cells, not the
+// window's: only the box (columns 63-130, rows 31-98 with its reach) is run,
+// so every window that reads the cell starts away from the raster's corner.
+TEST(MarksBlocks, ABadMaterialCellIsNamedInTheRastersCells) {
+  const terrain::HeightField ground = rolling();
+  const auto dir = drift::testing::test_dir("marks_blocks_bad_material");
+  terrain::write_geotiff(ground, dir / "ground.tif");
+  terrain::HeightField indices(kWidth, kHeight, 0.0f, ground.geo());
+  indices(100, 60) = 7.0f;
+  terrain::write_geotiff(indices, dir / "materials.tif");
+  MarksBlockFiles f;
+  f.ground = dir / "ground.tif", f.output = dir / "out.tif", f.block = 32, f.halo = 16;
+  f.materials = dir / "materials.tif";
+  try {
+    marks_to_files(f, {objects(ground)[1]}, *material_preset("sand"), {});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cell (100, 60) holds 7"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MarksBlocks, AHaloTooNarrowIsWidenedAndStillGivesTheSameBits) {
