@@ -84,8 +84,8 @@ void run_snowfall_in_blocks(const SnowfallCommand& c, const snow::SnowfallOption
               r.ground_volume);
   std::printf(
       "snow fall: %d blocks of %d cells, occlusion halo %d cells, stabilisation halo up to %d "
-      "cells (%d windows worked again wider)%s\n",
-      r.blocks, r.block, r.occlusion_halo, r.largest_halo, r.widened,
+      "cells (%d of the %d windows worked again wider, %d times in all)%s\n",
+      r.blocks, r.block, r.occlusion_halo, r.largest_halo, r.windows_widened, r.blocks, r.widened,
       r.converged ? "" : " (NOT at rest within the tolerance)");
 }
 

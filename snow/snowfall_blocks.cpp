@@ -335,6 +335,7 @@ SnowfallBlockReport snowfall_to_files(const SnowfallBlockFiles& files,
   }
   for (int k = 0; k < out.blocks; ++k) {
     out.largest_halo = std::max(out.largest_halo, halo_of[k]);
+    out.windows_widened += halo_of[k] > first_halo;
     out.fallen_volume += fallen[k], out.ground_volume += kept[k];
     out.converged = out.converged && at_rest[k];
   }

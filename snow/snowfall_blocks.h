@@ -46,9 +46,10 @@ struct SnowfallBlockFiles {
 struct SnowfallBlockReport {
   int width = 0, height = 0, block = 0;
   int blocks = 0;
-  int occlusion_halo = 0;  // cells
-  int widened = 0;         // times a window was worked again with a doubled halo
-  int largest_halo = 0;    // cells, the widest stabilisation halo a block needed
+  int occlusion_halo = 0;   // cells
+  int widened = 0;          // times a window was worked again with a doubled halo
+  int windows_widened = 0;  // windows worked again wider at least once (of blocks)
+  int largest_halo = 0;     // cells, the widest stabilisation halo a block needed
   double fallen_volume = 0, ground_volume = 0;  // m^3 (sums block by block)
   bool converged = true;  // no pair steeper than repose by more than the tolerance
 };

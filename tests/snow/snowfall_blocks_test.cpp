@@ -52,8 +52,12 @@ SnowfallBlockReport expect_one_pass(const HeightField& ground, const SnowfallOpt
                            block,
                            halo};
   const SnowfallBlockReport r = drift::snow::snowfall_to_files(files, o);
-  std::printf("%s: %d blocks, %d widened, largest halo %d\n", name.c_str(), r.blocks, r.widened,
-              r.largest_halo);
+  std::printf("%s: %d blocks, %d of them widened, %d doublings, largest halo %d\n", name.c_str(),
+              r.blocks, r.windows_widened, r.widened, r.largest_halo);
+  // Each widened window doubled at least once: as many doublings as windows or more.
+  EXPECT_LE(r.windows_widened, r.blocks);
+  EXPECT_LE(r.windows_widened, r.widened);
+  EXPECT_EQ(r.windows_widened > 0, r.widened > 0);
   const HeightField depth = drift::terrain::read_raster(files.depth);
   const HeightField cover = drift::terrain::read_raster(files.cover);
   const HeightField surface = drift::terrain::read_raster(files.surface);
