@@ -95,6 +95,20 @@ CLI::App& command_group(CLI::App& root, const std::string& name, const std::stri
   return *group;
 }
 
+CLI::Option* add_halo_option(CLI::App& sub, int& halo, const std::string& help) {
+  return sub.add_option("--halo", halo, help)->check(CLI::Range(0, 1 << 20))->capture_default_str();
+}
+
+void naming_input(const std::string& input, const std::function<void()>& run) {
+  try {
+    run();
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const Error& e) {
+    throw Error(input + ": " + e.what());
+  }
+}
+
 void add_seed_option(CLI::App& sub, unsigned long long& seed) {
   // CLI11 reads "-1", "2^64" and "1e23" all as 2^64 - 1 without a word: a seed
   // is the digits of a number below 2^64, nothing else.

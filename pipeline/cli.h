@@ -39,6 +39,15 @@ CLI::App& command_group(CLI::App& root, const std::string& name, const std::stri
 // Adds the standard --seed option (a 64-bit unsigned seed).
 void add_seed_option(CLI::App& sub, unsigned long long& seed);
 
+// Adds --halo N into `halo` (0 to 2^20 cells, its default shown): the cells
+// around a --block that the block's window also works, for the stages that
+// work block by block (marks, snow fall). `help` says what the halo holds.
+CLI::Option* add_halo_option(CLI::App& sub, int& halo, const std::string& help);
+
+// Runs `run`, naming `input` in any drift::Error it throws ("IN: what"), so
+// a library's message says which file it was about; a cancel passes as is.
+void naming_input(const std::string& input, const std::function<void()>& run);
+
 // The flags that set an options struct's fields, as (field, flag) pairs.
 using FlagNames = std::vector<std::pair<std::string, std::string>>;
 

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "pipeline/cli.h"
 #include "pipeline/object_list.h"
@@ -123,6 +125,21 @@ void warn_about_misses(const marks::MarksReport& report) {
   }
 }
 
+// What a run wrote (the non-empty paths of `written`), the objects that never
+// touched the ground, and its volumes; `tail` adds the block-by-block run's
+// figures to the summary line.
+void report_run(const std::vector<std::string>& written, const marks::MarksReport& report,
+                const std::string& tail) {
+  for (const std::string& path : written)
+    if (!path.empty()) std::printf("marks: wrote %s\n", path.c_str());
+  warn_about_misses(report);
+  std::printf(
+      "marks: %d steps, %d with contact; %.6g m3 under objects: %.6g displaced, %.6g compressed "
+      "away%s\n",
+      report.steps, report.contact_steps, report.collided, report.displaced, report.compressed,
+      tail.c_str());
+}
+
 // --block: the ground read, marked and written a block at a time (issue 36
 // item 3), for rasters larger than memory.
 void run_marks_by_blocks(MarksCommand& c, const CLI::App& sub) {
@@ -172,14 +189,11 @@ void run_marks_by_blocks(MarksCommand& c, const CLI::App& sub) {
   const marks::MarksBlockReport r =
       marks::marks_to_files(files, track.objects, base, o, terminal_progress("marks"));
   outputs.commit();
-  std::printf("marks: wrote %s\n", c.output.c_str());
-  if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
-  warn_about_misses(r.report);
-  std::printf(
-      "marks: %d steps, %d with contact; %.6g m3 under objects: %.6g displaced, %.6g compressed "
-      "away; %d of %d blocks of %d cells worked, halo %d cells (%d widened, widest %d)\n",
-      r.report.steps, r.report.contact_steps, r.report.collided, r.report.displaced,
-      r.report.compressed, r.simulated, r.blocks, r.block, r.halo, r.widened, r.largest_halo);
+  char blocks[160];
+  std::snprintf(blocks, sizeof blocks,
+                "; %d of %d blocks of %d cells worked, halo %d cells (%d widened, widest %d)",
+                r.simulated, r.blocks, r.block, r.halo, r.widened, r.largest_halo);
+  report_run({c.output, c.disturbed}, r.report, blocks);
 }
 
 void run_marks(MarksCommand& c, const CLI::App& sub) {
@@ -242,15 +256,7 @@ void run_marks(MarksCommand& c, const CLI::App& sub) {
       terrain::write_obj(posed, c.posed);
   }
   outputs.commit();
-  std::printf("marks: wrote %s\n", c.output.c_str());
-  if (!c.disturbed.empty()) std::printf("marks: wrote %s\n", c.disturbed.c_str());
-  if (!c.posed.empty()) std::printf("marks: wrote %s\n", c.posed.c_str());
-  warn_about_misses(r.report);
-  std::printf(
-      "marks: %d steps, %d with contact; %.6g m3 under objects: %.6g displaced, %.6g compressed "
-      "away\n",
-      r.report.steps, r.report.contact_steps, r.report.collided, r.report.displaced,
-      r.report.compressed);
+  report_run({c.output, c.disturbed, c.posed}, r.report, "");
 }
 
 }  // namespace
@@ -295,11 +301,9 @@ void marks_flags(CLI::App* sub, MarksCommand* c) {
                   "4), reading and writing the rasters a block at a time: grounds larger than "
                   "memory (0: the whole raster at once)")
       ->check(CLI::Range(0, 1 << 20));
-  sub->add_option("--halo", c->halo,
+  add_halo_option(*sub, c->halo,
                   "with --block: cells around a block that its window also works (doubled where "
-                  "marks reach the window's edge)")
-      ->check(CLI::Range(0, 1 << 20))
-      ->capture_default_str();
+                  "marks reach the window's edge)");
   c->parameters.add_to(*sub);
   sub->add_option("--seed", c->options.seed,
                   "seed of the roughness draws (sigma, paper 000, 3.5); same seed, same marks")

@@ -48,16 +48,12 @@ void run_cover(CoverCommand& c, const CLI::App& sub) {
   validate_flags([&o] { o.validate(); }, flags);
   OutputSet outputs({c.output, c.descriptor, c.accessibility}, {c.dem});
   snow::CoverFilesResult r;
-  try {
-    // Block by block: the cover is what the renderer's [snow] cover takes,
-    // snow's share 1 - t.
+  // Block by block: the cover is what the renderer's [snow] cover takes,
+  // snow's share 1 - t.
+  naming_input(c.dem, [&] {
     r = snow::snow_cover_to_files({c.dem, c.output, c.descriptor, c.accessibility, c.block}, o,
                                   terminal_progress("snow cover"));
-  } catch (const Cancelled&) {
-    throw;
-  } catch (const Error& e) {
-    throw Error(c.dem + ": " + e.what());
-  }
+  });
   outputs.commit();
   std::printf(
       "snow cover: %d x %d cells of %g m, region %d cells, probe radius %g m, mean cover %.3f, "

@@ -68,14 +68,10 @@ void run_snowfall_in_blocks(const SnowfallCommand& c, const snow::SnowfallOption
                   c.ground + " -o DEM_metric.tif");
   }
   snow::SnowfallBlockReport r;
-  try {
+  naming_input(c.ground, [&] {
     r = snow::snowfall_to_files({c.ground, c.output, c.cover, c.surface, o.block, c.halo}, o,
                                 terminal_progress("snow fall"));
-  } catch (const Cancelled&) {
-    throw;
-  } catch (const Error& e) {
-    throw Error(c.ground + ": " + e.what());
-  }
+  });
   outputs.commit();
   std::printf("snow fall: wrote %s\n", c.output.c_str());
   if (!c.cover.empty()) std::printf("snow fall: wrote %s\n", c.cover.c_str());
@@ -195,11 +191,9 @@ void snowfall_flags(CLI::App* sub, SnowfallCommand* c) {
                   "--stabilise direct the snow is also settled, read and written block by "
                   "block (rasters larger than memory); 0: one pass")
       ->capture_default_str();
-  sub->add_option("--halo", c->halo,
+  add_halo_option(*sub, c->halo,
                   "with --block and --stabilise direct: cells around a block that its window "
-                  "also settles (doubled where snow moves near the window's edge)")
-      ->check(CLI::Range(0, 1 << 20))
-      ->capture_default_str();
+                  "also settles (doubled where snow moves near the window's edge)");
   c->parameters.add_to(*sub);
   add_seed_option(*sub, c->seed);
 }

@@ -226,19 +226,28 @@ TEST(MemoryEstimate, DunesWithAndWithoutSnapshots) {
       run_measured("dunes --size 2500 --steps 2 --snapshot-every 1 -o s.tif", d));
 }
 
-// snow fall on ground of 1 m cells, 32^2 against 1400^2: 1000 m + `ax` m
-// sin(x / 17) + `ay` m cos(y / 13) (each estimate within a quarter).
-void expect_snow_fall_estimate(const std::string& name, double ax, double ay) {
+// snow fall on ground of 1 m cells, 1000 m + `ax` m sin(x / 17) + `ay` m
+// cos(y / 13), of `small` and then `big` cells a side, with `args` on the
+// small ground and `big_args` on the big one: each estimate within a quarter.
+struct SnowGround {
+  double ax, ay;
+  int small, big;
+};
+void expect_snow_fall_estimate(const std::string& name, SnowGround g, const std::string& args,
+                               const std::string& big_args) {
   const fs::path d = dir();
-  for (const int n : {32, 1400}) {
+  std::vector<Measured> runs;
+  for (const auto& [n, extra] : {std::pair{g.small, args}, std::pair{g.big, big_args}}) {
+    const std::string file = name + std::to_string(n);
     const drift::terrain::HeightField ground =
-        drift::testing::dem_from(n, 1.0, 0.5, [ax, ay](double x, double y) {
-          return 1000 + ax * std::sin(x / 17.0) + ay * std::cos(y / 13.0);
+        drift::testing::dem_from(n, 1.0, 0.5, [g](double x, double y) {
+          return 1000 + g.ax * std::sin(x / 17.0) + g.ay * std::cos(y / 13.0);
         });
-    drift::terrain::write_geotiff(ground, d / (name + std::to_string(n) + ".tif"), {"height", "m"});
+    drift::terrain::write_geotiff(ground, d / (file + ".tif"), {"height", "m"});
+    runs.push_back(
+        run_measured("snow fall " + file + ".tif" + extra + " -o " + file + "_out.tif", d));
   }
-  expect_on_small_and_big(d, "snow fall IN --maps 2 -o " + name + "@.tif", name + "32.tif",
-                          name + "1400.tif");
+  expect_estimate_within_a_quarter(runs[0], runs[1]);
 }
 
 TEST(MemoryEstimate, SnowFallOnGroundWhereSnowSlides) {
@@ -247,7 +256,7 @@ TEST(MemoryEstimate, SnowFallOnGroundWhereSnowSlides) {
   // front: on ground steeper than the repose (where snow slides, as in
   // mountains) it is all allocated. On ground that never slides the shortcut
   // never runs and the peak is about 0.78 of the estimate (docs/outputs.md).
-  expect_snow_fall_estimate("steep", 40.0, 35.0);
+  expect_snow_fall_estimate("steep", {40.0, 35.0, 32, 1400}, " --maps 2", " --maps 2");
 }
 
 TEST(MemoryEstimate, SnowFallOnGroundThatNeverSlides) {
@@ -255,7 +264,7 @@ TEST(MemoryEstimate, SnowFallOnGroundThatNeverSlides) {
   // Gentle ground, below the repose everywhere: the shortcut never runs, so
   // its workspace is never allocated and must not be counted (it was: the
   // estimate was 1.28 times the peak).
-  expect_snow_fall_estimate("gentle", 2.0, 2.0);
+  expect_snow_fall_estimate("gentle", {2.0, 2.0, 32, 1400}, " --maps 2", " --maps 2");
 }
 
 TEST(MemoryEstimate, SnowFallBlockByBlock) {
@@ -264,18 +273,8 @@ TEST(MemoryEstimate, SnowFallBlockByBlock) {
   // stabilisation's halo and the occlusion's) and a bit a cell of the raster,
   // not the raster: the estimate counts the window (snow/snowfall_blocks.h).
   // Slopes up to about 37 degrees: the windows keep their first halo.
-  const fs::path d = dir();
-  auto hills = [](int n) {
-    return drift::testing::dem_from(n, 1.0, 0.5, [](double x, double y) {
-      return 1000 + 6 * std::sin(x / 17.0) + 5 * std::cos(y / 13.0);
-    });
-  };
-  drift::terrain::write_geotiff(hills(64), d / "blocks_small.tif", {"height", "m"});
-  drift::terrain::write_geotiff(hills(3000), d / "blocks_big.tif", {"height", "m"});
-  const std::string args = " --maps 1 --spread 0 --stabilise direct -o ";
-  expect_estimate_within_a_quarter(
-      run_measured("snow fall blocks_small.tif --block 32" + args + "b0.tif", d),
-      run_measured("snow fall blocks_big.tif --block 1024" + args + "b1.tif", d));
+  const std::string args = " --maps 1 --spread 0 --stabilise direct --block ";
+  expect_snow_fall_estimate("blocks", {6.0, 5.0, 64, 3000}, args + "32", args + "1024");
 }
 
 TEST(MemoryEstimate, SnowFallDirectOnFlatAndSteepGround) {
@@ -287,28 +286,15 @@ TEST(MemoryEstimate, SnowFallDirectOnFlatAndSteepGround) {
   // buffers both alive). It now counts what each layer will hold: nothing
   // where no snow can move, else the drained surface, one queue entry a cell
   // at most and the cut cells once they are known.
-  const fs::path d = dir();
-  auto ground = [](int n, double amplitude) {
-    return drift::testing::dem_from(n, 1.0, 0.5, [amplitude](double x, double y) {
-      return 1000 + amplitude * (std::sin(x / 17.0) + std::cos(y / 13.0));
-    });
-  };
-  drift::terrain::write_geotiff(ground(32, 2), d / "flat_small.tif", {"height", "m"});
-  drift::terrain::write_geotiff(ground(1800, 2), d / "flat_big.tif", {"height", "m"});
-  drift::terrain::write_geotiff(ground(32, 40), d / "steep_small.tif", {"height", "m"});
-  drift::terrain::write_geotiff(ground(1400, 40), d / "steep_big.tif", {"height", "m"});
-  const std::string direct = " --maps 2 --stabilise direct ";
+  const std::string direct = " --maps 2 --stabilise direct";
   {
     SCOPED_TRACE("flat, 4 layers");
-    expect_estimate_within_a_quarter(
-        run_measured("snow fall flat_small.tif" + direct + "-o f0.tif", d),
-        run_measured("snow fall flat_big.tif" + direct + "-o f1.tif", d));
+    expect_snow_fall_estimate("flat_direct", {2.0, 2.0, 32, 1800}, direct, direct);
   }
   {
     SCOPED_TRACE("steep, 1 layer");
-    expect_estimate_within_a_quarter(
-        run_measured("snow fall steep_small.tif" + direct + "--direct-layers 1 -o s0.tif", d),
-        run_measured("snow fall steep_big.tif" + direct + "--direct-layers 1 -o s1.tif", d));
+    const std::string one_layer = direct + " --direct-layers 1";
+    expect_snow_fall_estimate("steep_direct", {40.0, 40.0, 32, 1400}, one_layer, one_layer);
   }
 }
 

@@ -15,6 +15,8 @@
 #include "render/height_field.h"
 #include "render/renderer.h"
 #include "render/terrain_scene.h"
+#include "tests/render/relief_fixture.h"
+#include "tests/render/render_fixtures.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -35,14 +37,9 @@ HeightGrid relief(int w, int h) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> noise(-1.0f, 1.0f);
   for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) {
-      float z = 900.0f + 500.0f * std::sin(c * 0.013f) * std::cos(r * 0.021f) +
-                (c > w / 2 ? 8.0f * noise(rng) : 0.01f * noise(rng));
-      if (c < 20 && r < 40) z = 1234.5f;            // flat blocks
-      if (c == 77) z += 300.0f;                     // a cliff through blocks
-      if ((c * 7 + r * 13) % 101 == 0) z += 60.0f;  // spikes
-      g.z[static_cast<std::size_t>(r) * w + c] = z;
-    }
+    for (int c = 0; c < w; ++c)
+      g.z[static_cast<std::size_t>(r) * w + c] =
+          drift::testing::quantised_relief(c, r, w, noise(rng), /*flat_corner=*/true);
   return g;
 }
 
@@ -171,24 +168,17 @@ TEST(QuantisedHeights, SceneAndFrameAreWithinTheBoundOfFloatHeights) {
       largest = std::max(largest, hi - lo);
     }
   const float bound = largest / 65535.0f / 2.0f + 4 * ulp(1600.0f);
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  const Eigen::Vector2f half = floats.extent() / 2;
   float worst = 0.0f;
-  for (int i = 0; i < 2000; ++i) {
-    const Eigen::Vector3f o(u(rng) * half.x() * 0.99f, u(rng) * half.y() * 0.99f, 2000.0f);
-    const Eigen::Vector3f d(0, 0, -1);
+  const Eigen::Vector2f inside = floats.extent() / 2 * 0.99f;
+  drift::testing::random_rays(2000, 9, inside, 2000.0f, 0.0f, [&](int i, auto o, auto d) {
     const float a = floats.hit_distance(o, d), b = sixteen.hit_distance(o, d);
     ASSERT_TRUE(std::isfinite(a) && std::isfinite(b)) << "ray " << i;
     worst = std::max(worst, std::fabs(a - b));
     ASSERT_LE(std::fabs(a - b), bound) << "ray " << i;
     EXPECT_NEAR(floats.height_at(o.x(), o.y()), sixteen.height_at(o.x(), o.y()), bound);
-  }
+  });
   EXPECT_GT(worst, 0.0f);  // the heights did move
-  RenderSettings rs;
-  rs.width = 64;
-  rs.height = 36;
-  rs.samples_per_pixel = 2;
+  const RenderSettings rs = drift::testing::frame_settings(64, 36, 2);
   const Image a = render_image(floats, in, default_camera(floats), rs);
   const Image b = render_image(sixteen, in, default_camera(sixteen), rs);
   double diff = 0.0, sum = 0.0;

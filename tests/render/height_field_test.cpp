@@ -13,6 +13,7 @@
 
 #include "render/terrain_scene.h"
 #include "terrain/error.h"
+#include "tests/render/relief_fixture.h"
 
 using namespace drift::render;
 using drift::terrain::HeightField;
@@ -25,19 +26,12 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // wavelengths, steep faces, flat patches (equal heights make degenerate
 // diagonals) and a few spikes.
 HeightField relief(int w, int h) {
-  HeightField dem(w, h, 0.0f, drift::terrain::local_georeference(2.5));
-  dem.geo().geotransform[0] = 600000.0;
-  dem.geo().geotransform[3] = 4000000.0;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<float> noise(-1.0f, 1.0f);
-  for (int r = 0; r < h; ++r)
-    for (int x = 0; x < w; ++x) {
-      float z = 40.0f * std::sin(x * 0.07f) * std::cos(r * 0.05f) + 6.0f * noise(rng);
-      if (x > w / 2 && r < h / 3) z = 10.0f;       // a plateau
-      if ((x * 7 + r * 13) % 97 == 0) z += 30.0f;  // spikes
-      dem(x, r) = z;
-    }
-  return dem;
+  return drift::testing::noisy_relief(w, h, 2.5, 7, [w, h](int x, int r, float noise) {
+    float z = 40.0f * std::sin(x * 0.07f) * std::cos(r * 0.05f) + 6.0f * noise;
+    if (x > w / 2 && r < h / 3) z = 10.0f;       // a plateau
+    if ((x * 7 + r * 13) % 97 == 0) z += 30.0f;  // spikes
+    return z;
+  });
 }
 
 SceneInput input_of(const HeightField& dem) {

@@ -10,7 +10,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <random>
 #include <vector>
 
 #include "render/camera_setup.h"
@@ -19,6 +18,8 @@
 #include "render/terrain_scene.h"
 #include "terrain/error.h"
 #include "terrain/raster_io.h"
+#include "tests/render/relief_fixture.h"
+#include "tests/render/render_fixtures.h"
 #include "tests/test_files.h"
 
 using namespace drift::render;
@@ -31,22 +32,11 @@ constexpr float kExaggeration = 1.5f;
 // 301 x 545 cells at 2 m: slopes, rough ground, a cliff, spikes, a nodata
 // hole; 545 rows make 34 block rows, the last owning 17 vertex rows.
 HeightField dem() {
-  const int w = 301, h = 545;
-  HeightField d(w, h, 0.0f, drift::terrain::local_georeference(2.0));
-  d.geo().geotransform[0] = 500000.0;
-  d.geo().geotransform[3] = 5200000.0;
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> noise(-1.0f, 1.0f);
-  for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) {
-      float z = 900.0f + 500.0f * std::sin(c * 0.013f) * std::cos(r * 0.021f) +
-                (c > w / 2 ? 8.0f * noise(rng) : 0.01f * noise(rng));
-      if (c == 77) z += 300.0f;
-      if ((c * 7 + r * 13) % 101 == 0) z += 60.0f;
-      if (c > 200 && c < 230 && r > 250 && r < 270) z = NAN;  // nodata: the lowest height
-      d(c, r) = z;
-    }
-  return d;
+  constexpr int w = 301;
+  return drift::testing::noisy_relief(w, 545, 2.0, 5, [](int c, int r, float noise) {
+    if (c > 200 && c < 230 && r > 250 && r < 270) return NAN;  // nodata: the lowest height
+    return drift::testing::quantised_relief(c, r, w, noise, /*flat_corner=*/false);
+  });
 }
 
 std::filesystem::path written(const HeightField& d) {
@@ -128,14 +118,11 @@ TEST(StreamedHeights, SceneTracesAndRendersAsTheWholeDemBitForBit) {
   EXPECT_EQ(streamed.surround_reach(), whole.surround_reach());
   EXPECT_EQ(streamed.bottom(), whole.bottom());
   EXPECT_EQ(streamed.top(), whole.top());
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   const Eigen::Vector2f half = whole.extent() / 2;
   int ring = 0;
-  for (int i = 0; i < 3000; ++i) {
-    // Rays over the DEM and over the ring beyond its edge, oblique.
-    const Eigen::Vector3f o(u(rng) * half.x() * 3.0f, u(rng) * half.y() * 2.0f, 2500.0f);
-    const Eigen::Vector3f dir = Eigen::Vector3f(u(rng) * 0.5f, u(rng) * 0.5f, -1.0f).normalized();
+  // Rays over the DEM and over the ring beyond its edge, oblique.
+  const Eigen::Vector2f spread(half.x() * 3.0f, half.y() * 2.0f);
+  drift::testing::random_rays(3000, 3, spread, 2500.0f, 0.5f, [&](int i, auto o, auto dir) {
     Eigen::Vector3f na, nb;
     const float a = whole.hit_distance(o, dir, &na), b = streamed.hit_distance(o, dir, &nb);
     ASSERT_EQ(a, b) << "ray " << i;
@@ -144,12 +131,9 @@ TEST(StreamedHeights, SceneTracesAndRendersAsTheWholeDemBitForBit) {
     }
     const Eigen::Vector3f p = o + a * dir;
     if (std::isfinite(a) && (std::fabs(p.x()) > half.x() || std::fabs(p.y()) > half.y())) ++ring;
-  }
+  });
   EXPECT_GT(ring, 300) << "rays must meet the ring beyond the edge too";
-  RenderSettings rs;
-  rs.width = 64;
-  rs.height = 36;
-  rs.samples_per_pixel = 2;
+  const RenderSettings rs = drift::testing::frame_settings(64, 36, 2);
   const Image a = render_image(whole, in, default_camera(whole), rs);
   const Image b = render_image(streamed, none, default_camera(streamed), rs);
   ASSERT_EQ(a.pixels.size(), b.pixels.size());

@@ -16,9 +16,7 @@
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
-using drift::snow::SnowfallBlockFiles;
-using drift::snow::SnowfallBlockReport;
-using drift::snow::SnowfallOptions;
+namespace snow = drift::snow;
 using drift::terrain::HeightField;
 
 namespace {
@@ -31,8 +29,8 @@ HeightField ground_of(int w, int h, const std::function<double(int, int)>& z) {
   return g;
 }
 
-SnowfallOptions options() {
-  SnowfallOptions o;
+snow::SnowfallOptions options() {
+  snow::SnowfallOptions o;
   o.azimuth_deg = 300, o.elevation_deg = 60, o.spread_deg = 5, o.maps = 2;
   o.rate_m_per_h = 0.05, o.hours = 10;
   o.direct_stabilise = true;  // the default 4 layers
@@ -40,18 +38,18 @@ SnowfallOptions options() {
 }
 
 // Runs the blocks on `ground` and expects the rasters of one pass, bit for bit.
-SnowfallBlockReport expect_one_pass(const HeightField& ground, const SnowfallOptions& o, int block,
-                                    int halo, const std::string& name) {
+snow::SnowfallBlockReport expect_one_pass(const HeightField& ground, const snow::SnowfallOptions& o,
+                                          int block, int halo, const std::string& name) {
   const fs::path d = drift::testing::test_dir("drift_snowfall_blocks");
   drift::terrain::write_geotiff(ground, d / (name + "_ground.tif"));
   const drift::snow::SnowfallResult one = drift::snow::simulate_snowfall(ground, {}, o);
-  SnowfallBlockFiles files{d / (name + "_ground.tif"),
-                           d / (name + "_depth.tif"),
-                           d / (name + "_cover.tif"),
-                           d / (name + "_surface.tif"),
-                           block,
-                           halo};
-  const SnowfallBlockReport r = drift::snow::snowfall_to_files(files, o);
+  snow::SnowfallBlockFiles files{d / (name + "_ground.tif"),
+                                 d / (name + "_depth.tif"),
+                                 d / (name + "_cover.tif"),
+                                 d / (name + "_surface.tif"),
+                                 block,
+                                 halo};
+  const snow::SnowfallBlockReport r = drift::snow::snowfall_to_files(files, o);
   std::printf("%s: %d blocks, %d of them widened, %d doublings, largest halo %d\n", name.c_str(),
               r.blocks, r.windows_widened, r.widened, r.largest_halo);
   // Each widened window doubled at least once: as many doublings as windows or more.
@@ -101,9 +99,9 @@ TEST(SnowfallBlocks, SameRastersAsOnePass) {
   });
   HeightField holes = g;
   holes(5, 100) = holes(6, 100) = holes(120, 3) = std::nanf("");
-  const SnowfallBlockReport r = expect_one_pass(holes, options(), 32, 4, "waves");
+  const snow::SnowfallBlockReport r = expect_one_pass(holes, options(), 32, 4, "waves");
   EXPECT_GT(r.widened, 0) << "a 4-cell halo is too small for the towers' heaps";
-  SnowfallOptions one_layer = options();
+  snow::SnowfallOptions one_layer = options();
   one_layer.direct_layers = 1;
   expect_one_pass(g, one_layer, 40, 8, "waves1");
 }
@@ -118,9 +116,9 @@ TEST(SnowfallBlocks, SnowSlidingAcrossSeveralBlocks) {
     const double slope = x < 90 ? (90 - x) * rise : 0.0;
     return slope + 0.02 * std::sin(y / 3.0);
   });
-  SnowfallOptions o = options();
+  snow::SnowfallOptions o = options();
   o.elevation_deg = 90, o.spread_deg = 0, o.maps = 1;
-  const SnowfallBlockReport r = expect_one_pass(g, o, 16, 4, "slope");
+  const snow::SnowfallBlockReport r = expect_one_pass(g, o, 16, 4, "slope");
   EXPECT_GE(r.largest_halo, 64) << "the slope's snow crosses several blocks";
 }
 
@@ -138,8 +136,8 @@ TEST(SnowfallBlocks, DepositSpreadingOutOfItsBlock) {
     const double r = std::max(std::abs(x - 95.5), std::abs(y - 31.5));
     return r < 28 ? (28 - r) * rise : 0.0;
   });
-  SnowfallOptions o = options();
+  snow::SnowfallOptions o = options();
   o.elevation_deg = 90, o.spread_deg = 0, o.maps = 1, o.hours = 160;
-  const SnowfallBlockReport r = expect_one_pass(g, o, 64, 4, "pyramid");
+  const snow::SnowfallBlockReport r = expect_one_pass(g, o, 64, 4, "pyramid");
   EXPECT_GT(r.widened, 0);
 }

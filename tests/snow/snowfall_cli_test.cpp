@@ -77,6 +77,21 @@ std::string mountains_run(const fs::path& d) {
   return (d / "ground.tif").string() + " --maps 1 --rate 0.05 --hours 10 --threads 1 -o ";
 }
 
+// Gentle waves with 3 x 3 towers 8 m high every 23 cells, w x h cells of 1 m
+// at UTM coordinates, written to D/ground.tif: long shadows and snow that
+// slides off the towers, a relief (~10 m) whose occlusion halo (~33 cells at
+// 35 degrees) is smaller than the raster. Returns the file.
+fs::path write_towers_ground(const fs::path& d, int w, int h) {
+  drift::terrain::HeightField ground(w, h, 0.0f, drift::terrain::local_georeference(1.0));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      ground(x, y) = static_cast<float>(std::sin(x / 9.0) * std::cos(y / 13.0) +
+                                        ((x % 23 < 3 && y % 23 < 3) ? 8.0 : 0.0));
+  ground.geo().geotransform[0] = 600000.0, ground.geo().geotransform[3] = 4000000.0;
+  drift::terrain::write_geotiff(ground, d / "ground.tif");
+  return d / "ground.tif";
+}
+
 double total(const drift::terrain::HeightField& f) {
   double sum = 0.0;
   for (float v : f.values()) sum += v;
@@ -135,17 +150,8 @@ TEST(SnowfallCli, DirectLayersReachTheOneStepSolver) {
 // --block: the ground's occlusion on blocks with their halo gives the bytes of one pass.
 TEST(SnowfallCli, BlockByBlockOcclusionGivesTheSameRasters) {
   const fs::path d = dir();
-  // Gentle waves with 3 x 3 towers 8 m high every 23 cells: long shadows, a
-  // relief (~10 m) whose halo (~33 cells at 35 degrees) is smaller than the raster.
-  drift::terrain::HeightField ground(160, 160, 0.0f, drift::terrain::local_georeference(1.0));
-  for (int y = 0; y < 160; ++y)
-    for (int x = 0; x < 160; ++x)
-      ground(x, y) = static_cast<float>(std::sin(x / 9.0) * std::cos(y / 13.0) +
-                                        ((x % 23 < 3 && y % 23 < 3) ? 8.0 : 0.0));
-  ground.geo().geotransform[0] = 600000.0, ground.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(ground, d / "ground.tif");
   const std::string common =
-      (d / "ground.tif").string() +
+      write_towers_ground(d, 160, 160).string() +
       " --direction 300,35 --spread 0 --maps 2 --rate 0.05 --hours 10 --threads 1 -o ";
   ASSERT_EQ(run(common + (d / "one.tif").string(), d), 0) << output(d);
   ASSERT_EQ(run(common + (d / "blocks.tif").string() + " --block 8", d), 0) << output(d);
@@ -171,15 +177,8 @@ TEST(SnowfallCli, BlockByBlockOcclusionGivesTheSameRasters) {
 // bit, though the towers' snow slides across the blocks' windows.
 TEST(SnowfallCli, BlockByBlockStabilisationGivesTheSameRasters) {
   const fs::path d = dir();
-  drift::terrain::HeightField ground(90, 70, 0.0f, drift::terrain::local_georeference(1.0));
-  for (int y = 0; y < 70; ++y)
-    for (int x = 0; x < 90; ++x)
-      ground(x, y) = static_cast<float>(std::sin(x / 9.0) * std::cos(y / 13.0) +
-                                        ((x % 23 < 3 && y % 23 < 3) ? 8.0 : 0.0));
-  ground.geo().geotransform[0] = 600000.0, ground.geo().geotransform[3] = 4000000.0;
-  drift::terrain::write_geotiff(ground, d / "ground.tif");
   const std::string common =
-      (d / "ground.tif").string() +
+      write_towers_ground(d, 90, 70).string() +
       " --direction 300,35 --spread 5 --maps 2 --rate 0.05 --hours 40 --stabilise direct -o ";
   auto rasters = [&](const std::string& name, const std::string& extra) {
     const std::string out = (d / name).string();
