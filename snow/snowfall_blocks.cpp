@@ -247,14 +247,18 @@ SnowfallBlockReport snowfall_to_files(const SnowfallBlockFiles& files,
   std::vector<char> at_rest(halo_of.size(), 1);
   const double cell_area = run.frame().dx * run.frame().dy;
 
+  // A halo doubled, up to the whole raster.
+  const auto doubled = [&](int halo) {
+    return static_cast<int>(
+        std::min<std::int64_t>(std::int64_t{2} * halo, std::max(width, height)));
+  };
   // Settles block k from its halo, doubling it until nothing moved in the
   // band (check 1), and writes its cells.
   auto work = [&](int k) {
     const int i = k % bx_count, j = k / bx_count;
     const Rect blk = Rect{i * block, j * block, std::min(width, (i + 1) * block),
                           std::min(height, (j + 1) * block)};
-    for (int& halo = halo_of[k];; halo = static_cast<int>(std::min<std::int64_t>(
-                                      std::int64_t{2} * halo, std::max(width, height)))) {
+    for (int& halo = halo_of[k];; halo = doubled(halo)) {
       const Rect win = blk.grown(halo, width, height);
       require_memory(run.bytes(win, block) + std::uint64_t(width) * height / 8 + gdal_cache,
                      "snow fall block by block (a window of " + std::to_string(win.width()) +
@@ -327,9 +331,9 @@ SnowfallBlockReport snowfall_to_files(const SnowfallBlockFiles& files,
     again = false;
     for (int k = 0; k < out.blocks; ++k) {
       if (!reached_from_outside(k)) continue;
-      ++out.widened, again = true;
-      halo_of[k] = static_cast<int>(
-          std::min<std::int64_t>(std::int64_t{2} * halo_of[k], std::max(width, height)));
+      ++out.widened;
+      again = true;
+      halo_of[k] = doubled(halo_of[k]);
       work(k);
     }
   }
