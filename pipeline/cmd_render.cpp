@@ -31,6 +31,11 @@ namespace drift::pipeline {
 
 namespace {
 
+// Cells a side of the coarse stand-in for the relief that what runs before
+// the scene (placing the camera, the sun) sees when the scene itself reads
+// the DEM in pages or strips, not whole.
+constexpr int kCoarseTerrainSide = 1024;
+
 struct RenderOptions {
   std::string scene;
   std::vector<std::string> variables;  // --set NAME=VALUE
@@ -372,9 +377,9 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
       usage_error("--memory-budget '" + o.memory_budget +
                   "' is not a size; give bytes with an optional K, M, G or T (e.g. 4G, 512M)");
     // Out of core: what needs the relief before the scene (placing the
-    // camera, the sun) sees it at most 1024 cells a side; the scene reads
-    // the full raster in pages.
-    scene.coarse_terrain_side = 1024;
+    // camera, the sun) sees a coarse stand-in; the scene reads the full
+    // raster in pages.
+    scene.coarse_terrain_side = kCoarseTerrainSide;
     if (o.height_bits == 16)
       usage_error(
           "--height-bits 16 quantises the heights held in core; with --memory-budget "
@@ -384,7 +389,7 @@ void run_render(const RenderOptions& o, const CLI::App& sub) {
   // quantises it as it reads (the floats never all exist, issue 36) unless
   // something before the scene needs the whole DEM.
   const bool streamed = !budget && o.height_bits == 16 && !scene.needs_dem_before_scene();
-  if (streamed) scene.coarse_terrain_side = 1024;
+  if (streamed) scene.coarse_terrain_side = kCoarseTerrainSide;
   OutputSet outputs(written, inputs);
   load_scene_terrain(scene);
   const auto start = std::chrono::steady_clock::now();
